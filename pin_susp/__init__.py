@@ -1,0 +1,36 @@
+"""pin_susp: suspension kinematics on Pinocchio.
+
+A corner is read from a YAML file of hardpoints, generated as a URDF tree
+plus loop closures, and solved by Newton's method on the joint manifold.
+
+    import pin_susp
+    corner = pin_susp.Corner("examples/double_wishbone.yaml")
+    results = corner.run_sweep("examples/bump_steer.yaml")
+    results["camber"]            # deg, one value per step
+    results.to_csv("out.csv")
+
+Files, the CLI, the CSV and this API speak mm and degrees; inside, the model
+is in SI units (m, rad).
+"""
+
+__version__ = "0.1.0"
+
+from .corner import Corner, Results  # noqa: E402
+from .errors import InputError, PinSuspError  # noqa: E402
+from .geometry import Geometry, load_geometry  # noqa: E402
+from .metrics import METRICS, Pose  # noqa: E402
+from .sweep import Sweep, Target, load_sweep  # noqa: E402
+
+__all__ = [
+    "METRICS",
+    "Corner",
+    "Geometry",
+    "InputError",
+    "PinSuspError",
+    "Pose",
+    "Results",
+    "Sweep",
+    "Target",
+    "load_geometry",
+    "load_sweep",
+]

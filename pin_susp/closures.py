@@ -1,0 +1,132 @@
+"""Points, loop closures and targets: each gives residual rows and their Jacobian.
+
+Every object here has ``residual(kin)`` and ``jacobian(kin)`` for the
+current state of a :class:`Kinematics`; the Newton solver only stacks their
+rows. Residuals are in metres; Jacobians are d(residual)/dv with v in the
+tangent space of the joint configuration (``pin.integrate``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+from .geometry import wheel_down
+
+WORLD = pin.LOCAL_WORLD_ALIGNED
+
+
+class Kinematics:
+    """Pinocchio model + data; ``update(q)`` computes every frame and Jacobian."""
+
+    def __init__(self, model: pin.Model):
+        self.model = model
+        self.data = model.createData()
+
+    def update(self, q: np.ndarray) -> None:
+        pin.computeJointJacobians(self.model, self.data, q)
+        pin.updateFramePlacements(self.model, self.data)
+
+    def frame_jacobian(self, frame_id: int) -> np.ndarray:
+        """6×nv: linear velocity of the frame origin, then angular velocity, world axes."""
+        return pin.getFrameJacobian(self.model, self.data, frame_id, WORLD)
+
+
+class FramePoint:
+    """A point fixed to a body: a Pinocchio frame of the model."""
+
+    def __init__(self, name: str, frame_id: int, body: str):
+        self.name = name
+        self.frame_id = frame_id
+        self.body = body
+
+    def position(self, kin: Kinematics) -> np.ndarray:
+        return kin.data.oMf[self.frame_id].translation
+
+    def jacobian(self, kin: Kinematics) -> np.ndarray:
+        return kin.frame_jacobian(self.frame_id)[:3]
+
+
+class ContactPatchPoint:
+    """CP = WC + R·d̂(â): the lowest point of the tyre disc; not fixed to a body.
+
+    Its Jacobian is the chain rule through d̂: with u = −Ẑ + a_z·â and
+    dâ = ω × â, du = (dâ·Ẑ)·â + a_z·dâ and dd̂ = (I − d̂d̂ᵀ)·du / |u|.
+    """
+
+    body = "upright"
+
+    def __init__(self, name: str, center: FramePoint, axle_in: FramePoint, axle_out: FramePoint,
+                 radius: float):
+        self.name = name
+        self.center, self.axle_in, self.axle_out = center, axle_in, axle_out
+        self.radius = radius
+
+    def _axis(self, kin: Kinematics) -> np.ndarray:
+        a = self.axle_out.position(kin) - self.axle_in.position(kin)
+        return a / np.linalg.norm(a)
+
+    def position(self, kin: Kinematics) -> np.ndarray:
+        down, _ = wheel_down(self._axis(kin))
+        return self.center.position(kin) + self.radius * down
+
+    def jacobian(self, kin: Kinematics) -> np.ndarray:
+        a = self._axis(kin)
+        down, norm = wheel_down(a)
+        j = kin.frame_jacobian(self.center.frame_id)
+        da = -pin.skew(a) @ j[3:]  # ω × â, for each column
+        du = np.outer(a, da[2]) + a[2] * da
+        dd = (np.eye(3) - np.outer(down, down)) @ du / norm
+        return j[:3] + self.radius * dd
+
+
+class BallClosure:
+    """Two anchors on different bodies coincide: r = p_b − p_a (3 rows, m)."""
+
+    size = 3
+
+    def __init__(self, name: str, a: FramePoint, b: FramePoint):
+        self.name, self.a, self.b = name, a, b
+
+    def residual(self, kin: Kinematics) -> np.ndarray:
+        return self.b.position(kin) - self.a.position(kin)
+
+    def jacobian(self, kin: Kinematics) -> np.ndarray:
+        return self.b.jacobian(kin) - self.a.jacobian(kin)
+
+
+class DistanceClosure:
+    """A rigid link between two ball joints: r = |p_b − p_a| − L (1 row, m)."""
+
+    size = 1
+
+    def __init__(self, name: str, a: FramePoint, b: FramePoint, length: float):
+        self.name, self.a, self.b, self.length = name, a, b, length
+
+    def residual(self, kin: Kinematics) -> np.ndarray:
+        return np.array([np.linalg.norm(self.b.position(kin) - self.a.position(kin)) - self.length])
+
+    def jacobian(self, kin: Kinematics) -> np.ndarray:
+        d = self.b.position(kin) - self.a.position(kin)
+        return (d / np.linalg.norm(d)) @ (self.b.jacobian(kin) - self.a.jacobian(kin))[None]
+
+
+class PointTarget:
+    """A named point held on a plane: r = P·d̂ − value (1 row, m)."""
+
+    size = 1
+
+    def __init__(self, point, direction: np.ndarray, value: float = 0.0):
+        self.point = point
+        self.direction = np.asarray(direction, dtype=float)
+        self.value = value
+
+    @property
+    def name(self) -> str:
+        return f"target {self.point.name}"
+
+    def residual(self, kin: Kinematics) -> np.ndarray:
+        return np.array([self.point.position(kin) @ self.direction - self.value])
+
+    def jacobian(self, kin: Kinematics) -> np.ndarray:
+        return (self.direction @ self.point.jacobian(kin))[None]

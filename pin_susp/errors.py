@@ -1,0 +1,26 @@
+"""The few exceptions pin_susp raises for a user's mistake.
+
+The CLI turns each into one line on stderr and exit code 2; the Python API
+lets them propagate. Anything else is a bug in pin_susp.
+"""
+
+from __future__ import annotations
+
+
+class PinSuspError(Exception):
+    """Base class: a problem the user can act on."""
+
+
+class InputError(PinSuspError):
+    """A geometry or sweep file (or dict) that cannot be used as it is.
+
+    The message names the source, the key path and what is wrong, e.g.
+    ``corner.yaml: hardpoints.upper_wishbone_outboard: missing point``.
+    """
+
+    def __init__(self, source: str, key: str, problem: str):
+        self.source = source
+        self.key = key
+        self.problem = problem
+        where = f"{source}: {key}" if key else source
+        super().__init__(f"{where}: {problem}")

@@ -1,0 +1,385 @@
+"""Geometry file → validated Geometry (SI units), and the derived-point formulas.
+
+The file format is documented in ``docs/geometry.md`` (it is the one of
+open-kinematics 0.4). Lengths arrive in mm and leave this module in metres;
+nothing after it converts units.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .yamlio import Reader, load_yaml
+
+MM = 1e-3
+INCH = 0.0254
+
+WISHBONE_POINTS = (
+    "lower_wishbone_inboard_front",
+    "lower_wishbone_inboard_rear",
+    "lower_wishbone_outboard",
+    "upper_wishbone_inboard_front",
+    "upper_wishbone_inboard_rear",
+    "upper_wishbone_outboard",
+)
+STEERING_POINTS = {
+    "rack": ("trackrod_inboard", "trackrod_outboard"),
+    "none": ("toe_link_inboard", "toe_link_outboard"),
+}
+AXLE_POINTS = ("axle_inboard", "axle_outboard")
+COILOVER_POINTS = ("strut_top", "strut_bottom")
+
+# Points computed from the upright's hardpoints and the wheel (spec/geometry.md).
+DERIVED_POINTS = (
+    "axle_midpoint",
+    "wheel_center",
+    "wheel_inboard",
+    "wheel_outboard",
+    "contact_patch_center",
+)
+
+# Anything closer than this is "the same point" for an axis or a link.
+COINCIDENT = 1e-6  # m
+
+
+@dataclass(frozen=True)
+class Wheel:
+    """Wheel offset and tyre size, in metres."""
+
+    offset: float
+    section_width: float
+    aspect_ratio: float
+    rim_diameter: float
+
+    @property
+    def radius(self) -> float:
+        """Unloaded tyre radius R = (rim + 2·aspect·section) / 2."""
+        return 0.5 * self.rim_diameter + self.aspect_ratio * self.section_width
+
+
+@dataclass(frozen=True)
+class CamberShim:
+    """Outboard camber shim stack (config.camber_shim), SI units."""
+
+    point_a: np.ndarray
+    point_b: np.ndarray
+    normal: np.ndarray  # unit, from camber block to upright body
+    design_thickness: float
+    setup_thickness: float
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """One suspension corner at its design condition, SI units, world frame."""
+
+    name: str
+    side: str  # "left" | "right"
+    steering: str  # "rack" | "none"
+    actuation: str  # "direct"
+    actuation_mount: str  # "lower_wishbone" | "upright"
+    spring: str  # "none" | "coilover"
+    hardpoints: dict[str, np.ndarray]
+    wheel: Wheel
+    cg_position: np.ndarray | None = None
+    wheelbase: float | None = None
+    axle_position: str | None = None
+    front_brake_bias: float | None = None
+    driven_axle: str | None = None
+    camber_shim: CamberShim | None = None
+    source: str = "<dict>"
+    sha256: str | None = None
+    data: dict = field(default_factory=dict, repr=False)
+
+    @property
+    def sign(self) -> float:
+        """s = +1 for a left corner, −1 for a right one (spec/results.md)."""
+        return 1.0 if self.side == "left" else -1.0
+
+    @property
+    def steering_points(self) -> tuple[str, str]:
+        """(inboard, outboard) of the trackrod, or of the fixed toe link."""
+        return STEERING_POINTS[self.steering]
+
+    def design_points(self) -> dict[str, np.ndarray]:
+        """Every hardpoint and derived point at the design condition."""
+        points = dict(self.hardpoints)
+        points.update(wheel_points(points["axle_inboard"], points["axle_outboard"], self.wheel))
+        return points
+
+
+def hardpoint_names(steering: str, spring: str) -> tuple[str, ...]:
+    """The hardpoints of a double-wishbone corner, in output order."""
+    names = WISHBONE_POINTS + STEERING_POINTS[steering] + AXLE_POINTS
+    if spring == "coilover":
+        names += COILOVER_POINTS
+    return names
+
+
+def unit(v: np.ndarray) -> np.ndarray:
+    """v / |v| along the last axis."""
+    return v / np.linalg.norm(v, axis=-1, keepdims=True)
+
+
+def wheel_points(
+    axle_inboard: np.ndarray, axle_outboard: np.ndarray, wheel: Wheel
+) -> dict[str, np.ndarray]:
+    """Derived points fixed to the upright: works on (3,) or (n, 3) arrays.
+
+    â = unit(axle_outboard − axle_inboard); wheel_center = axle_outboard − offset·â;
+    wheel_inboard/outboard = wheel_center ∓ (section_width/2)·â; the contact
+    patch centre is added too (it is not fixed to the upright).
+    """
+    a = unit(axle_outboard - axle_inboard)
+    center = axle_outboard - wheel.offset * a
+    half = 0.5 * wheel.section_width * a
+    return {
+        "axle_midpoint": 0.5 * (axle_inboard + axle_outboard),
+        "wheel_center": center,
+        "wheel_inboard": center - half,
+        "wheel_outboard": center + half,
+        "contact_patch_center": contact_patch(center, a, wheel.radius),
+    }
+
+
+def wheel_down(spin_axis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """d̂ = unit(−Ẑ − ((−Ẑ)·â)â) and the length of the vector before normalising.
+
+    World down projected into the wheel plane; the contact patch is R·d̂ from
+    the wheel centre. Works on (3,) or (n, 3).
+    """
+    a = spin_axis
+    u = a * a[..., 2:3]
+    u[..., 2] -= 1.0
+    norm = np.linalg.norm(u, axis=-1, keepdims=True)
+    return u / norm, norm
+
+
+def contact_patch(wheel_center: np.ndarray, spin_axis: np.ndarray, radius: float) -> np.ndarray:
+    """Lowest point of a thin disc of radius R in the wheel plane."""
+    down, _ = wheel_down(spin_axis)
+    return wheel_center + radius * down
+
+
+def load_geometry(source: str | Path | dict) -> Geometry:
+    """Read and validate a geometry file (path) or an already-loaded dict.
+
+    Raises InputError naming the file, the key and the problem.
+    """
+    data, name, sha = load_yaml(source)
+    return _parse(data, Reader(name), sha)
+
+
+def _parse(data: dict, r: Reader, sha: str | None) -> Geometry:
+    r.mapping(
+        data,
+        "",
+        required=("hardpoints",),
+        optional=(
+            "type",
+            "scope",
+            "side",
+            "name",
+            "version",
+            "units",
+            "actuation",
+            "spring",
+            "config",
+        ),
+    )
+    kind = r.choice(data.get("type", "double_wishbone"), "type", ("double_wishbone", "macpherson"))
+    if kind != "double_wishbone":
+        r.fail("type", "macpherson is not supported yet (this version models double_wishbone)")
+    scope = r.choice(data.get("scope", "corner"), "scope", ("corner", "axle"))
+    if scope != "corner":
+        r.fail("scope", "axle is not supported yet (this version models one corner)")
+    side = r.choice(data.get("side", "left"), "side", ("left", "right"))
+    name = r.text(data.get("name", "unnamed corner"), "name")
+    if "version" in data:
+        r.text(data["version"], "version")
+    r.choice(data.get("units", "millimeters"), "units", ("millimeters",))
+
+    act = r.mapping(
+        data.get("actuation", {}), "actuation", optional=("type", "mount")
+    )
+    actuation = r.choice(act.get("type", "direct"), "actuation.type", ("direct", "pushrod_rocker"))
+    if actuation == "pushrod_rocker":
+        r.fail("actuation.type", "pushrod_rocker is not supported yet (use direct)")
+    mount = r.choice(
+        act.get("mount", "lower_wishbone"), "actuation.mount", ("lower_wishbone", "upright")
+    )
+    spring_map = r.mapping(data.get("spring", {}), "spring", optional=("type",))
+    spring = r.choice(
+        spring_map.get("type", "none"), "spring.type", ("none", "coilover", "torsion_bar")
+    )
+    if spring == "torsion_bar":
+        r.fail("spring.type", "a torsion bar needs actuation type pushrod_rocker")
+
+    config = r.mapping(
+        data.get("config"),
+        "config",
+        required=("wheel",),
+        optional=(
+            "steering",
+            "cg_position",
+            "wheelbase",
+            "axle_position",
+            "front_brake_bias",
+            "driven_axle",
+            "camber_shim",
+        ),
+    )
+    steer_map = r.mapping(config.get("steering", {}), "config.steering", optional=("type",))
+    steering = r.choice(steer_map.get("type", "rack"), "config.steering.type", ("rack", "none"))
+    wheel = _wheel(config["wheel"], r)
+
+    names = hardpoint_names(steering, spring)
+    hp_map = data["hardpoints"]
+    if not isinstance(hp_map, dict):
+        r.fail("hardpoints", "expected a mapping of point name to {x, y, z}")
+    for key in hp_map:
+        if key not in names:
+            r.fail(f"hardpoints.{key}", _unknown_point_hint(key, steering, spring, names))
+    hardpoints = {}
+    for key in names:
+        if key not in hp_map:
+            r.fail(f"hardpoints.{key}", "missing point")
+        hardpoints[key] = r.vector(hp_map[key], f"hardpoints.{key}") * MM
+
+    sign = 1.0 if side == "left" else -1.0
+    for key, p in hardpoints.items():
+        if sign * p[1] < 0.0:
+            want = "y >= 0" if side == "left" else "y <= 0"
+            r.fail(
+                f"hardpoints.{key}",
+                f"y = {p[1] / MM:g} mm on a {side} corner ({side} hardpoints have {want};"
+                " check 'side' or the sign of y)",
+            )
+    _check_linkage(hardpoints, steering, spring, r)
+
+    cg = config.get("cg_position")
+    bias = config.get("front_brake_bias")
+    return Geometry(
+        name=name,
+        side=side,
+        steering=steering,
+        actuation=actuation,
+        actuation_mount=mount,
+        spring=spring,
+        hardpoints=hardpoints,
+        wheel=wheel,
+        cg_position=None if cg is None else r.vector(cg, "config.cg_position") * MM,
+        wheelbase=(
+            None
+            if "wheelbase" not in config
+            else r.positive(config["wheelbase"], "config.wheelbase") * MM
+        ),
+        axle_position=(
+            None
+            if "axle_position" not in config
+            else r.choice(config["axle_position"], "config.axle_position", ("front", "rear"))
+        ),
+        front_brake_bias=None if bias is None else _fraction(bias, r),
+        driven_axle=(
+            None
+            if "driven_axle" not in config
+            else r.choice(config["driven_axle"], "config.driven_axle", ("front", "rear"))
+        ),
+        camber_shim=(
+            None if "camber_shim" not in config else _camber_shim(config["camber_shim"], r)
+        ),
+        source=r.source,
+        sha256=sha,
+        data=data,
+    )
+
+
+def _wheel(value, r: Reader) -> Wheel:
+    w = r.mapping(value, "config.wheel", required=("tire",), optional=("offset",))
+    tire = r.mapping(
+        w["tire"],
+        "config.wheel.tire",
+        required=("aspect_ratio", "section_width", "rim_diameter"),
+    )
+    return Wheel(
+        offset=r.number(w.get("offset", 0.0), "config.wheel.offset") * MM,
+        section_width=r.positive(tire["section_width"], "config.wheel.tire.section_width") * MM,
+        aspect_ratio=r.positive(tire["aspect_ratio"], "config.wheel.tire.aspect_ratio"),
+        rim_diameter=r.positive(tire["rim_diameter"], "config.wheel.tire.rim_diameter") * INCH,
+    )
+
+
+def _fraction(value, r: Reader) -> float:
+    x = r.number(value, "config.front_brake_bias")
+    if not 0.0 <= x <= 1.0:
+        r.fail("config.front_brake_bias", f"must be between 0 and 1, got {x:g}")
+    return x
+
+
+def _camber_shim(value, r: Reader) -> CamberShim:
+    key = "config.camber_shim"
+    s = r.mapping(
+        value,
+        key,
+        required=(
+            "shim_face_point_a",
+            "shim_face_point_b",
+            "shim_face_normal",
+            "design_thickness",
+            "setup_thickness",
+        ),
+    )
+    a = r.vector(s["shim_face_point_a"], f"{key}.shim_face_point_a") * MM
+    b = r.vector(s["shim_face_point_b"], f"{key}.shim_face_point_b") * MM
+    n = r.vector(s["shim_face_normal"], f"{key}.shim_face_normal")
+    if np.linalg.norm(b - a) < COINCIDENT:
+        r.fail(f"{key}.shim_face_point_b", "coincides with shim_face_point_a (A and B must differ)")
+    if np.linalg.norm(n) < 1e-12:
+        r.fail(f"{key}.shim_face_normal", "is the zero vector (it needs a direction)")
+    design = r.number(s["design_thickness"], f"{key}.design_thickness", minimum=0.0) * MM
+    setup = r.number(s["setup_thickness"], f"{key}.setup_thickness", minimum=0.0) * MM
+    if setup != design:
+        # The as-shimmed assembly solve is not in this version: refuse
+        # rather than sweep the design geometry as if it were shimmed.
+        r.fail(
+            f"{key}.setup_thickness",
+            "a setup thickness different from design_thickness is not supported yet",
+        )
+    return CamberShim(a, b, n / np.linalg.norm(n), design, setup)
+
+
+def _check_linkage(p: dict[str, np.ndarray], steering: str, spring: str, r: Reader) -> None:
+    """Reject geometry that defines no mechanism: coincident ends, balls on pivots."""
+    inner, outer = STEERING_POINTS[steering]
+    pairs = [
+        ("lower_wishbone_inboard_front", "lower_wishbone_inboard_rear", "pivot axis"),
+        ("upper_wishbone_inboard_front", "upper_wishbone_inboard_rear", "pivot axis"),
+        ("lower_wishbone_outboard", "upper_wishbone_outboard", "steering axis"),
+        ("axle_inboard", "axle_outboard", "spin axis"),
+        (inner, outer, "link"),
+    ]
+    if spring == "coilover":
+        pairs.append(("strut_top", "strut_bottom", "coilover"))
+    for a, b, what in pairs:
+        if np.linalg.norm(p[b] - p[a]) < COINCIDENT:
+            r.fail(f"hardpoints.{b}", f"coincides with {a}: the {what} needs two distinct points")
+    for arm in ("lower_wishbone", "upper_wishbone"):
+        front = p[f"{arm}_inboard_front"]
+        axis = unit(p[f"{arm}_inboard_rear"] - front)
+        arm_vec = p[f"{arm}_outboard"] - front
+        if np.linalg.norm(arm_vec - axis * (arm_vec @ axis)) < COINCIDENT:
+            r.fail(
+                f"hardpoints.{arm}_outboard",
+                f"lies on the {arm} pivot axis (inboard_front→inboard_rear): the arm has no length",
+            )
+
+
+def _unknown_point_hint(key: str, steering: str, spring: str, names: tuple[str, ...]) -> str:
+    for other, pts in STEERING_POINTS.items():
+        if key in pts and other != steering:
+            return f"not a point of a corner with config.steering.type {steering} (it belongs to {other})"
+    if key in COILOVER_POINTS and spring != "coilover":
+        return "not a point of this corner (strut points need spring type coilover)"
+    return f"unknown hardpoint (this corner has: {', '.join(names)})"

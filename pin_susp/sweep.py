@@ -1,0 +1,118 @@
+"""Sweep file → targets per step (spec/sweep.md).
+
+A sweep speaks the file's units: target values in mm. Targets are paired by
+index (step i uses value i of every target), not a Cartesian product.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+
+from .yamlio import Reader, load_yaml
+
+AXES = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
+
+
+@dataclass(frozen=True)
+class Target:
+    """Hold ``point`` at ``values`` (mm) along ``direction`` ("x", "y", "z" or a vector).
+
+    ``mode="relative"`` adds each value to the point's design position along
+    the direction; ``"absolute"`` takes it as a world coordinate.
+    """
+
+    point: str
+    direction: str | Sequence[float]
+    values: float | Sequence[float] = 0.0
+    mode: str = "relative"
+
+    def __post_init__(self):
+        object.__setattr__(self, "values", np.atleast_1d(np.asarray(self.values, dtype=float)))
+
+    @property
+    def unit_direction(self) -> np.ndarray:
+        if isinstance(self.direction, str):
+            return np.array(AXES[self.direction])
+        d = np.asarray(self.direction, dtype=float)
+        return d / np.linalg.norm(d)
+
+    def at_design(self) -> Target:
+        """The same target holding the point where it is at the design state."""
+        return replace(self, values=0.0, mode="relative")
+
+
+@dataclass(frozen=True)
+class Sweep:
+    targets: list[Target]
+    source: str = "<dict>"
+    sha256: str | None = None
+    data: dict = field(default_factory=dict, repr=False)
+
+    @property
+    def steps(self) -> int:
+        return len(self.targets[0].values)
+
+
+def load_sweep(source: str | Path | dict) -> Sweep:
+    """Read and validate a sweep file (path) or an already-loaded dict."""
+    data, name, sha = load_yaml(source)
+    r = Reader(name)
+    r.mapping(data, "", required=("targets",), optional=("version", "steps", "name"))
+    steps = None
+    if "steps" in data:
+        steps = data["steps"]
+        if isinstance(steps, bool) or not isinstance(steps, int) or steps < 1:
+            r.fail("steps", f"expected a whole number >= 1, got {steps!r}")
+    raw_targets = data["targets"]
+    if not isinstance(raw_targets, list) or not raw_targets:
+        r.fail("targets", "expected a non-empty list of targets")
+    targets = [_target(t, f"targets[{i}]", steps, r) for i, t in enumerate(raw_targets)]
+    lengths = {len(t.values) for t in targets}
+    if len(lengths) > 1:
+        detail = ", ".join(f"targets[{i}]: {len(t.values)}" for i, t in enumerate(targets))
+        r.fail("targets", f"every target needs the same number of values ({detail})")
+    return Sweep(targets, name, sha, data)
+
+
+def _target(value, key: str, steps: int | None, r: Reader) -> Target:
+    t = r.mapping(
+        value,
+        key,
+        required=("point", "direction"),
+        optional=("mode", "start", "stop", "values"),
+    )
+    point = r.text(t["point"], f"{key}.point")
+    d = r.mapping(t["direction"], f"{key}.direction", optional=("axis", "vector"))
+    if ("axis" in d) == ("vector" in d):
+        r.fail(f"{key}.direction", "give exactly one of axis: x|y|z or vector: [x, y, z]")
+    if "axis" in d:
+        direction = r.choice(d["axis"], f"{key}.direction.axis", tuple(AXES))
+    else:
+        direction = r.vector(d["vector"], f"{key}.direction.vector")
+        if np.linalg.norm(direction) < 1e-12:
+            r.fail(f"{key}.direction.vector", "is the zero vector (it needs a direction)")
+    mode = r.choice(t.get("mode", "relative"), f"{key}.mode", ("relative", "absolute"))
+
+    if "values" in t:
+        if "start" in t or "stop" in t:
+            r.fail(key, "give either values or start/stop, not both")
+        raw = t["values"]
+        if not isinstance(raw, list) or not raw:
+            r.fail(f"{key}.values", "expected a non-empty list of numbers (mm)")
+        values = [r.number(v, f"{key}.values[{i}]") for i, v in enumerate(raw)]
+        if steps is not None and len(values) != steps:
+            r.fail(f"{key}.values", f"has {len(values)} values but steps is {steps}")
+    else:
+        for end in ("start", "stop"):
+            if end not in t:
+                r.fail(f"{key}.{end}", "missing key (or give values: [...])")
+        if steps is None:
+            r.fail("steps", "missing key (start/stop targets need the number of steps)")
+        start = r.number(t["start"], f"{key}.start")
+        stop = r.number(t["stop"], f"{key}.stop")
+        values = np.linspace(start, stop, steps)
+    return Target(point, direction, values, mode)
