@@ -83,7 +83,10 @@ def _parser() -> argparse.ArgumentParser:
         "sweep; write its geometry, sweep, URDF and results CSV into DIR.",
     )
     d.add_argument(
-        "-o", "--output", default="pin_susp_demo", metavar="DIR",
+        "-o",
+        "--output",
+        default="pin_susp_demo",
+        metavar="DIR",
         help="output folder (default: ./pin_susp_demo)",
     )
     d.set_defaults(run=_demo)
@@ -126,25 +129,40 @@ def _demo(args) -> int:
     results.to_csv(out / "demo_results.csv")
     print(f"pin_susp demo: {corner.geometry.name}, {sweep.steps}-step bump + steer sweep")
     _summary(results, out / "demo_results.csv")
-    print(f"  geometry {geometry_path}\n  sweep    {sweep_path}\n  URDF     {out / 'demo_corner.urdf'}")
+    print(f"  geometry {geometry_path}\n  sweep    {sweep_path}")
+    print(f"  URDF     {out / 'demo_corner.urdf'}")
     return _report_failures(results)
 
 
 def _summary(results: Results, path) -> None:
     ok = results["solver_converged"]
-    print(f"wrote {path}: {len(results)} steps, {int(ok.sum())} converged, "
-          f"max residual {np.nanmax(results['solver_max_residual']):.1e} mm, "
-          f"{np.median(results['solver_iterations']):g} iterations per step (median)")
-    rows = [(name, results.units[name]) for name in (
-        "wheel_travel", "camber", "roadwheel_angle", "caster", "kpi",
-        "scrub_radius", "mechanical_trail", "half_track")]
+    print(
+        f"wrote {path}: {len(results)} steps, {int(ok.sum())} converged, "
+        f"max residual {np.nanmax(results['solver_max_residual']):.1e} mm, "
+        f"{np.median(results['solver_iterations']):g} iterations per step (median)"
+    )
+    rows = [
+        (name, results.units[name])
+        for name in (
+            "wheel_travel",
+            "camber",
+            "roadwheel_angle",
+            "caster",
+            "kpi",
+            "scrub_radius",
+            "mechanical_trail",
+            "half_track",
+        )
+    ]
     print(f"  {'metric':<18}{'unit':>5}{'first':>12}{'last':>12}{'min':>12}{'max':>12}")
     for name, unit in rows:
         v = results[name]
         if np.all(np.isnan(v)):
             continue
-        print(f"  {name:<18}{unit:>5}{v[0]:>12.4f}{v[-1]:>12.4f}"
-              f"{np.nanmin(v):>12.4f}{np.nanmax(v):>12.4f}")
+        print(
+            f"  {name:<18}{unit:>5}{v[0]:>12.4f}{v[-1]:>12.4f}"
+            f"{np.nanmin(v):>12.4f}{np.nanmax(v):>12.4f}"
+        )
 
 
 def _report_failures(results: Results) -> int:
@@ -171,7 +189,9 @@ def _progress_bar(total: int, quiet: bool):
     def show(done: int, total: int) -> None:
         filled = width * done // total
         end = "\n" if done == total else ""
-        sys.stderr.write(f"\r  solving [{'#' * filled}{'.' * (width - filled)}] {done}/{total}{end}")
+        sys.stderr.write(
+            f"\r  solving [{'#' * filled}{'.' * (width - filled)}] {done}/{total}{end}"
+        )
         sys.stderr.flush()
 
     return show

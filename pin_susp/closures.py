@@ -56,8 +56,14 @@ class ContactPatchPoint:
 
     body = "upright"
 
-    def __init__(self, name: str, center: FramePoint, axle_in: FramePoint, axle_out: FramePoint,
-                 radius: float):
+    def __init__(
+        self,
+        name: str,
+        center: FramePoint,
+        axle_in: FramePoint,
+        axle_out: FramePoint,
+        radius: float,
+    ):
         self.name = name
         self.center, self.axle_in, self.axle_out = center, axle_in, axle_out
         self.radius = radius

@@ -181,7 +181,8 @@ class Corner:
             raise InputError(
                 source,
                 "targets",
-                f"{len(targets)} target(s) given, this corner needs exactly {self.mobility} ({what})",
+                f"{len(targets)} target(s) given, this corner needs exactly "
+                f"{self.mobility} ({what})",
             )
         if self.actuators and len(moving_rack) != 1:
             raise InputError(

@@ -46,7 +46,9 @@ def corner_tree(g: Geometry) -> Tree:
     ]
     if g.steering == "rack":
         bodies.append(
-            Body("rack", "chassis", Joint("rack_slide", "prismatic", p[inner], np.array([0, 1.0, 0])))
+            Body(
+                "rack", "chassis", Joint("rack_slide", "prismatic", p[inner], np.array([0, 1.0, 0]))
+            )
         )
 
     body_of = {

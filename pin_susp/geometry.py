@@ -201,9 +201,7 @@ def _parse(data: dict, r: Reader, sha: str | None) -> Geometry:
         r.text(data["version"], "version")
     r.choice(data.get("units", "millimeters"), "units", ("millimeters",))
 
-    act = r.mapping(
-        data.get("actuation", {}), "actuation", optional=("type", "mount")
-    )
+    act = r.mapping(data.get("actuation", {}), "actuation", optional=("type", "mount"))
     actuation = r.choice(act.get("type", "direct"), "actuation.type", ("direct", "pushrod_rocker"))
     if actuation == "pushrod_rocker":
         r.fail("actuation.type", "pushrod_rocker is not supported yet (use direct)")
@@ -379,7 +377,10 @@ def _check_linkage(p: dict[str, np.ndarray], steering: str, spring: str, r: Read
 def _unknown_point_hint(key: str, steering: str, spring: str, names: tuple[str, ...]) -> str:
     for other, pts in STEERING_POINTS.items():
         if key in pts and other != steering:
-            return f"not a point of a corner with config.steering.type {steering} (it belongs to {other})"
+            return (
+                f"not a point of a corner with config.steering.type {steering}"
+                f" (it belongs to {other})"
+            )
     if key in COILOVER_POINTS and spring != "coilover":
         return "not a point of this corner (strut points need spring type coilover)"
     return f"unknown hardpoint (this corner has: {', '.join(names)})"

@@ -11,8 +11,8 @@ axle_inboard); k̂ = unit(UBJ − LBJ); WC = wheel centre, CP = contact patch.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
 
 import numpy as np
 
@@ -139,9 +139,7 @@ def metric_columns(
 ) -> dict[str, tuple[np.ndarray, str]]:
     """Every metric that applies to this corner, in output units: name → (values, unit)."""
     ps = PointSet(points, design, geometry)
-    return {
-        m.name: (m.function(ps) * m.scale, m.unit) for m in METRICS if m.applies(geometry)
-    }
+    return {m.name: (m.function(ps) * m.scale, m.unit) for m in METRICS if m.applies(geometry)}
 
 
 def point_columns(names, points: dict[str, np.ndarray]) -> dict[str, tuple[np.ndarray, str]]:

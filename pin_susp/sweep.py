@@ -6,9 +6,9 @@ index (step i uses value i of every target), not a Cartesian product.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Sequence
 
 import numpy as np
 

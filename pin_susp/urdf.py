@@ -102,8 +102,15 @@ def tree_to_urdf(tree: Tree, comment: str = "") -> str:
             for i, (letter, axis) in enumerate(BALL_AXES):
                 child = body.name if i == 2 else f"{j.name}_link_{letter}"
                 links[child] = ET.SubElement(robot, "link", {"name": child})
-                _joint(robot, f"{j.name}_{letter}", "revolute", parent, child,
-                       j.origin - origin_of[parent], np.array(axis))
+                _joint(
+                    robot,
+                    f"{j.name}_{letter}",
+                    "revolute",
+                    parent,
+                    child,
+                    j.origin - origin_of[parent],
+                    np.array(axis),
+                )
                 origin_of[child] = j.origin
                 parent = child
         else:
@@ -170,7 +177,9 @@ def _joint(robot, name, kind, parent, child, xyz, axis=None):
     ET.SubElement(j, "axis", {"xyz": _fmt(axis)})
     limit = REVOLUTE_LIMIT if kind == "revolute" else PRISMATIC_LIMIT
     ET.SubElement(
-        j, "limit", {"lower": _fmt([-limit]), "upper": _fmt([limit]), "effort": "0", "velocity": "0"}
+        j,
+        "limit",
+        {"lower": _fmt([-limit]), "upper": _fmt([limit]), "effort": "0", "velocity": "0"},
     )
 
 

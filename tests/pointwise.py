@@ -14,19 +14,31 @@ import itertools
 import numpy as np
 from scipy.optimize import least_squares
 
-UPRIGHT = ("lower_wishbone_outboard", "upper_wishbone_outboard", "outer", "axle_inboard",
-           "axle_outboard")
+UPRIGHT = (
+    "lower_wishbone_outboard",
+    "upper_wishbone_outboard",
+    "outer",
+    "axle_inboard",
+    "axle_outboard",
+)
 
 
 class PointwiseCorner:
     """Hardpoints in mm, as in the file; solutions in mm."""
 
     def __init__(self, data: dict):
-        hp = {k: np.array([v["x"], v["y"], v["z"]], float) if isinstance(v, dict) else
-              np.array(v, float) for k, v in data["hardpoints"].items()}
+        hp = {
+            k: np.array([v["x"], v["y"], v["z"]], float)
+            if isinstance(v, dict)
+            else np.array(v, float)
+            for k, v in data["hardpoints"].items()
+        }
         self.steering = data["config"].get("steering", {}).get("type", "rack")
-        self.inner, outer = (("trackrod_inboard", "trackrod_outboard") if self.steering == "rack"
-                             else ("toe_link_inboard", "toe_link_outboard"))
+        self.inner, outer = (
+            ("trackrod_inboard", "trackrod_outboard")
+            if self.steering == "rack"
+            else ("toe_link_inboard", "toe_link_outboard")
+        )
         self.names = [n.replace("outer", outer) for n in UPRIGHT]
         self.hp = hp
         self.s = 1.0 if data.get("side", "left") == "left" else -1.0
@@ -35,8 +47,10 @@ class PointwiseCorner:
         self.width = tire["section_width"]
         self.radius = tire["rim_diameter"] * 25.4 / 2 + tire["aspect_ratio"] * tire["section_width"]
         # Rigid upright: every pairwise distance between its five points.
-        self.pairs = [(i, j, np.linalg.norm(hp[self.names[i]] - hp[self.names[j]]))
-                      for i, j in itertools.combinations(range(5), 2)]
+        self.pairs = [
+            (i, j, np.linalg.norm(hp[self.names[i]] - hp[self.names[j]]))
+            for i, j in itertools.combinations(range(5), 2)
+        ]
         self.arms = []  # (upright point index, chassis point, length)
         for i, arm in ((0, "lower_wishbone"), (1, "upper_wishbone")):
             for end in ("inboard_front", "inboard_rear"):
@@ -58,10 +72,13 @@ class PointwiseCorner:
         wc = out["axle_outboard"] - self.offset * a
         down = np.array([0.0, 0.0, -1.0]) + a[2] * a
         down = down / np.linalg.norm(down)
-        out.update(axle_midpoint=0.5 * (out["axle_inboard"] + out["axle_outboard"]),
-                   wheel_center=wc, wheel_inboard=wc - 0.5 * self.width * a,
-                   wheel_outboard=wc + 0.5 * self.width * a,
-                   contact_patch_center=wc + self.radius * down)
+        out.update(
+            axle_midpoint=0.5 * (out["axle_inboard"] + out["axle_outboard"]),
+            wheel_center=wc,
+            wheel_inboard=wc - 0.5 * self.width * a,
+            wheel_outboard=wc + 0.5 * self.width * a,
+            contact_patch_center=wc + self.radius * down,
+        )
         return out
 
     def residual(self, x, wc_z, rack):
@@ -82,10 +99,10 @@ class PointwiseCorner:
         row = 0
         for i, j, _ in self.pairs:
             u = (p[i] - p[j]) / np.linalg.norm(p[i] - p[j])
-            J[row, 3 * i:3 * i + 3], J[row, 3 * j:3 * j + 3] = u, -u
+            J[row, 3 * i : 3 * i + 3], J[row, 3 * j : 3 * j + 3] = u, -u
             row += 1
         for i, c, _ in self.arms:
-            J[row, 3 * i:3 * i + 3] = (p[i] - c) / np.linalg.norm(p[i] - c)
+            J[row, 3 * i : 3 * i + 3] = (p[i] - c) / np.linalg.norm(p[i] - c)
             row += 1
         d = p[2] - (self.hp[self.inner] + np.array([0.0, r, 0.0]))
         u = d / np.linalg.norm(d)
@@ -104,8 +121,16 @@ class PointwiseCorner:
     def solve(self, wc_z: float, rack: float, x0=None):
         """Wheel centre z (absolute, mm) and rack displacement (mm)."""
         x0 = self.x if x0 is None else x0
-        sol = least_squares(self.residual, x0, jac=self.jacobian, args=(wc_z, rack), method="lm",
-                            xtol=1e-15, ftol=1e-15, gtol=1e-15)
+        sol = least_squares(
+            self.residual,
+            x0,
+            jac=self.jacobian,
+            args=(wc_z, rack),
+            method="lm",
+            xtol=1e-15,
+            ftol=1e-15,
+            gtol=1e-15,
+        )
         return sol.x, float(np.max(np.abs(sol.fun)))
 
 

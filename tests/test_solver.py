@@ -68,10 +68,12 @@ def parallelogram() -> dict:
 def test_parallelogram_corner_follows_its_circle(dz):
     """LBJ swings on a 400 mm arm: Δy = 400·(cos(asin(dz/400)) − 1); camber and toe fixed."""
     corner = pin_susp.Corner(parallelogram())
-    design = corner.solve_pose([pin_susp.Target("wheel_center", "z", 0.0),
-                                pin_susp.Target("trackrod_inboard", "y", 0.0)])
-    pose = corner.solve_pose([pin_susp.Target("wheel_center", "z", dz),
-                              pin_susp.Target("trackrod_inboard", "y", 0.0)])
+    design = corner.solve_pose(
+        [pin_susp.Target("wheel_center", "z", 0.0), pin_susp.Target("trackrod_inboard", "y", 0.0)]
+    )
+    pose = corner.solve_pose(
+        [pin_susp.Target("wheel_center", "z", dz), pin_susp.Target("trackrod_inboard", "y", 0.0)]
+    )
     assert pose.converged and pose.max_residual <= 1e-9
     dy = 400.0 * (np.cos(np.arcsin(dz / 400.0)) - 1.0)
     for name in ("lower_wishbone_outboard", "upper_wishbone_outboard", "wheel_center"):
@@ -87,8 +89,9 @@ def test_pure_rack_travel_turns_the_parallelogram_upright_about_its_kingpin():
     """With the wheel centre held, rack travel steers the wheel; toe-out for +Y on the left
     when the trackrod is ahead of the axle."""
     corner = pin_susp.Corner(parallelogram())
-    pose = corner.solve_pose([pin_susp.Target("wheel_center", "z", 0.0),
-                              pin_susp.Target("trackrod_inboard", "y", 10.0)])
+    pose = corner.solve_pose(
+        [pin_susp.Target("wheel_center", "z", 0.0), pin_susp.Target("trackrod_inboard", "y", 10.0)]
+    )
     assert pose.converged
     # Vertical kingpin through x = 0; trackrod 120 mm ahead: the arm turns by ≈ asin(10/120).
     assert pose.metrics["roadwheel_angle"] < -4.0
@@ -111,11 +114,14 @@ def rows_of(corner, targets):
 
 @pytest.mark.parametrize("point", ["wheel_center", "contact_patch_center", "trackrod_outboard"])
 def test_every_jacobian_row_matches_central_differences(corner, point):
-    targets = [pin_susp.Target(point, [0.3, -0.2, 0.9], 0.0),
-               pin_susp.Target("trackrod_inboard", "y", 0.0)]
+    targets = [
+        pin_susp.Target(point, [0.3, -0.2, 0.9], 0.0),
+        pin_susp.Target("trackrod_inboard", "y", 0.0),
+    ]
     solver = corner.solver_for(targets)
-    q = corner.solve_pose([pin_susp.Target("wheel_center", "z", 35.0),
-                           pin_susp.Target("trackrod_inboard", "y", -8.0)]).q
+    q = corner.solve_pose(
+        [pin_susp.Target("wheel_center", "z", 35.0), pin_susp.Target("trackrod_inboard", "y", -8.0)]
+    ).q
     solver.evaluate(q)
     J = solver.jacobian.copy()
     assert J.shape == (6, corner.model.nv)
@@ -139,26 +145,38 @@ def test_warm_started_steps_take_few_iterations(corner):
 
 def test_absolute_and_vector_targets_agree_with_relative_axis_targets(corner):
     wc = corner.design_positions["wheel_center"] * 1e3
-    relative = corner.solve_pose([pin_susp.Target("wheel_center", "z", 20.0),
-                                  pin_susp.Target("trackrod_inboard", "y", 5.0)])
-    absolute = corner.solve_pose([
-        pin_susp.Target("wheel_center", [0, 0, 2.0], wc[2] + 20.0, mode="absolute"),
-        pin_susp.Target("trackrod_inboard", "y", 200.0 + 5.0, mode="absolute")])
+    relative = corner.solve_pose(
+        [pin_susp.Target("wheel_center", "z", 20.0), pin_susp.Target("trackrod_inboard", "y", 5.0)]
+    )
+    absolute = corner.solve_pose(
+        [
+            pin_susp.Target("wheel_center", [0, 0, 2.0], wc[2] + 20.0, mode="absolute"),
+            pin_susp.Target("trackrod_inboard", "y", 200.0 + 5.0, mode="absolute"),
+        ]
+    )
     for name in relative.points:
         np.testing.assert_allclose(absolute.points[name], relative.points[name], atol=1e-9)
 
 
 def test_contact_patch_target_holds_its_point(corner):
-    pose = corner.solve_pose([pin_susp.Target("contact_patch_center", "z", 30.0),
-                              pin_susp.Target("trackrod_inboard", "y", 3.0)])
+    pose = corner.solve_pose(
+        [
+            pin_susp.Target("contact_patch_center", "z", 30.0),
+            pin_susp.Target("trackrod_inboard", "y", 3.0),
+        ]
+    )
     design = corner.design_positions["contact_patch_center"][2] * 1e3
     assert pose.points["contact_patch_center"][2] == pytest.approx(design + 30.0, abs=1e-9)
 
 
 def test_unreachable_step_is_flagged_and_the_sweep_goes_on(corner):
-    sweep = {"steps": 3, "targets": [
-        {"point": "wheel_center", "direction": {"axis": "z"}, "values": [10.0, 900.0, 20.0]},
-        {"point": "trackrod_inboard", "direction": {"axis": "y"}, "values": [0.0, 0.0, 0.0]}]}
+    sweep = {
+        "steps": 3,
+        "targets": [
+            {"point": "wheel_center", "direction": {"axis": "z"}, "values": [10.0, 900.0, 20.0]},
+            {"point": "trackrod_inboard", "direction": {"axis": "y"}, "values": [0.0, 0.0, 0.0]},
+        ],
+    }
     results = corner.run_sweep(sweep)
     assert list(results["solver_converged"]) == [True, False, True]
     assert results["solver_max_residual"][1] > 1e-3

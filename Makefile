@@ -1,0 +1,41 @@
+# Two commands on a fresh machine: `make demo` and `make test`.
+# Both create .venv and install pin_susp into it when needed.
+
+PYTHON ?= python3
+VENV := .venv
+BIN := $(VENV)/bin
+STAMP := $(VENV)/.installed
+DEMO_DIR ?= demo_output
+GEOMETRIES := $(shell grep -l '^hardpoints:' examples/*.yaml)
+
+.PHONY: demo test urdf lint format clean
+
+$(STAMP): pyproject.toml
+	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet -e '.[dev]'
+	touch $(STAMP)
+
+demo: $(STAMP)
+	$(BIN)/pin-susp demo -o $(DEMO_DIR)
+
+# pytest exits 5 when it collects no test: that is a failure here too.
+test: $(STAMP)
+	$(BIN)/python -m pytest -q
+
+# Regenerate urdf/ from examples/ (a test fails when they differ).
+urdf: $(STAMP)
+	@for g in $(GEOMETRIES); do \
+		$(BIN)/pin-susp urdf $$g -o urdf/$$(basename $$g .yaml).urdf; \
+	done
+
+lint: $(STAMP)
+	$(BIN)/ruff check .
+	$(BIN)/ruff format --check .
+
+format: $(STAMP)
+	$(BIN)/ruff format .
+	$(BIN)/ruff check --fix .
+
+clean:
+	rm -rf $(VENV) $(DEMO_DIR) .pytest_cache .ruff_cache
