@@ -183,3 +183,19 @@ def test_unreachable_step_is_flagged_and_the_sweep_goes_on(corner):
     assert np.isnan(results["camber"][1]) and np.isnan(results["wheel_center_z"][1])
     assert results["wheel_travel"][2] == pytest.approx(20.0, abs=1e-9)
     assert results["solver_iterations"][1] > 12  # it subdivided before giving up
+
+
+def test_relative_target_along_a_reversed_vector_moves_the_other_way(corner):
+    up = corner.solve_pose(
+        [pin_susp.Target("wheel_center", "z", 20.0), pin_susp.Target("trackrod_inboard", "y", 0)]
+    )
+    down_vector = corner.solve_pose(
+        [
+            pin_susp.Target("wheel_center", [0, 0, -3.0], -20.0),
+            pin_susp.Target("trackrod_inboard", [0, -1.0, 0], 0.0),
+        ]
+    )
+    np.testing.assert_allclose(
+        down_vector.points["wheel_center"], up.points["wheel_center"], atol=1e-9
+    )
+    assert up.metrics["wheel_travel"] == pytest.approx(20.0, abs=1e-10)

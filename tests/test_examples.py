@@ -1,0 +1,19 @@
+"""The example scripts run as they are."""
+
+import subprocess
+import sys
+
+from conftest import EXAMPLES
+
+
+def test_quickstart_runs(tmp_path):
+    proc = subprocess.run(
+        [sys.executable, str(EXAMPLES / "quickstart.py")],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert "sweep of 41 steps" in proc.stdout
+    assert (tmp_path / "quickstart_results.csv").exists()
