@@ -199,3 +199,21 @@ def test_relative_target_along_a_reversed_vector_moves_the_other_way(corner):
         down_vector.points["wheel_center"], up.points["wheel_center"], atol=1e-9
     )
     assert up.metrics["wheel_travel"] == pytest.approx(20.0, abs=1e-10)
+
+
+def test_singular_jacobian_takes_a_bounded_damped_step(corner):
+    """At a lock-up J has no inverse: the step is damped least squares, finite and bounded."""
+    from pin_susp.solver import MAX_STEP
+
+    solver = corner.solver_for(
+        [pin_susp.Target("wheel_center", "z", 0.0), pin_susp.Target("trackrod_inboard", "y", 0)]
+    )
+    solver.evaluate(corner.q_design)
+    solver.jacobian[5] = solver.jacobian[4]  # two equal rows: rank 5
+    solver.residual[:] = [0, 0, 0, 0, 1e-3, 2e-3]
+    dv = solver._step()
+    assert np.all(np.isfinite(dv)) and np.max(np.abs(dv)) <= MAX_STEP
+    # it moves the residual of the duplicated row towards the mean of its two targets
+    change = solver.jacobian @ dv
+    assert change[4] == pytest.approx(-1.5e-3, rel=1e-3)
+    np.testing.assert_allclose(change[:4], 0.0, atol=1e-6)  # λ = |r|² bends it slightly
