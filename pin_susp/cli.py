@@ -15,6 +15,7 @@ from importlib import resources
 from pathlib import Path
 
 import numpy as np
+import yaml
 
 from . import __version__
 from .corner import Corner, Results
@@ -22,6 +23,18 @@ from .errors import PinSuspError
 from .export import write_text
 from .geometry import load_geometry
 from .sweep import load_sweep
+
+SHEET_METRICS = (  # column, unit, short heading
+    ("camber", "deg", "camber"),
+    ("roadwheel_angle", "deg", "toe"),
+    ("caster", "deg", "caster"),
+    ("kpi", "deg", "KPI"),
+    ("scrub_radius", "mm", "scrub"),
+    ("mechanical_trail", "mm", "trail"),
+    ("half_track", "mm", "half track"),
+    ("ride_height_change", "mm", "ride height"),
+)
+SETUP_COLUMNS = ("shim_thickness", "trackrod_length_delta", "pushrod_length_delta")
 
 EXIT_NOT_CONVERGED = 1
 EXIT_INPUT = 2
@@ -90,7 +103,82 @@ def _parser() -> argparse.ArgumentParser:
         help="output folder (default: ./pin_susp_demo)",
     )
     d.set_defaults(run=_demo)
+
+    t = sub.add_parser(
+        "setup",
+        help="setup sheet: static metrics, shim/trackrod/pushrod rows, sensitivities, inverse",
+        description="Print the static metrics of GEOMETRY as set (camber shim and length "
+        "adjusters applied). List values to see one row each; ask for exact sensitivities; "
+        "or give target values to find the shim, trackrod and pushrod settings that hit them.",
+        epilog="Example: pin-susp setup examples/camber_shim.yaml --shim 15,20,25,30 "
+        "--sensitivities; pin-susp setup examples/camber_shim.yaml --camber -2.5 --toe 0.1 "
+        "-o set.yaml",
+    )
+    t.add_argument("geometry", metavar="GEOMETRY", help="geometry YAML (hardpoints in mm)")
+    t.add_argument(
+        "--shim",
+        type=_numbers,
+        default=[],
+        metavar="MM,MM,...",
+        help="fitted shim stack thicknesses, one row each",
+    )
+    t.add_argument(
+        "--trackrod",
+        type=_numbers,
+        default=[],
+        metavar="MM,MM,...",
+        help="trackrod length changes (+ longer), one row each",
+    )
+    t.add_argument(
+        "--pushrod",
+        type=_numbers,
+        default=[],
+        metavar="MM,MM,...",
+        help="pushrod length changes (+ longer), one row each",
+    )
+    t.add_argument(
+        "--sensitivities",
+        action="store_true",
+        help="exact d(camber, toe, ride height)/d(shim, trackrod, pushrod)",
+    )
+    t.add_argument(
+        "--thread-pitch",
+        type=float,
+        metavar="MM",
+        help="also give sensitivities per turn of an adjuster with this pitch "
+        "(length change per turn; a left/right-hand turnbuckle: twice the pitch)",
+    )
+    t.add_argument("--camber", type=float, metavar="DEG", help="target static camber (shim)")
+    t.add_argument(
+        "--toe",
+        type=float,
+        metavar="DEG",
+        help="target static roadwheel angle, + toe-in (trackrod)",
+    )
+    t.add_argument(
+        "--ride-height-change",
+        type=float,
+        metavar="MM",
+        help="target ride-height change, + car higher (pushrod)",
+    )
+    t.add_argument(
+        "-o",
+        "--output",
+        metavar="SET.yaml",
+        help="with targets: write the geometry with the setup found",
+    )
+    t.add_argument("--csv", metavar="OUT.csv", help="also write the sheet's rows as CSV")
+    t.set_defaults(run=_setup)
     return p
+
+
+def _numbers(text: str) -> list[float]:
+    try:
+        return [float(x) for x in text.split(",") if x.strip()]
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected numbers separated by commas, got {text!r}"
+        ) from None
 
 
 def _sweep(args) -> int:
@@ -199,3 +287,95 @@ def _progress_bar(total: int, quiet: bool):
 
 if __name__ == "__main__":
     sys.exit(main())
+
+
+def _setup(args) -> int:
+    from . import setup
+
+    geometry = load_geometry(args.geometry)
+    targets = {
+        name: value
+        for name, value in (
+            ("camber", args.camber),
+            ("roadwheel_angle", args.toe),
+            ("ride_height_change", args.ride_height_change),
+        )
+        if value is not None
+    }
+    if args.output and not targets:
+        raise PinSuspError("-o writes a solved setup: give --camber, --toe or --ride-height-change")
+    print(f"{geometry.name}: setup sheet ({geometry.source})")
+    if targets:
+        found = setup.solve_setup(geometry, targets)
+        _sheet([found.before, found.after], ["before", "after"])
+        print(
+            f"  hit {', '.join(f'{k} {v:g}' for k, v in targets.items())} "
+            f"in {found.iterations} Newton iterations"
+        )
+        if args.output:
+            data = setup.geometry_data(found.geometry)
+            text = yaml.safe_dump(data, sort_keys=False, default_flow_style=None)
+            write_text(f"# {geometry.name}: setup solved by pin-susp setup\n" + text, args.output)
+            print(f"wrote {args.output}")
+        return 0
+    rows = setup.setup_sheet(geometry, args.shim, args.trackrod, args.pushrod)
+    labels = (
+        ["as set"]
+        + ["shim"] * len(args.shim)
+        + ["trackrod"] * len(args.trackrod)
+        + ["pushrod"] * len(args.pushrod)
+    )
+    _sheet(rows, labels)
+    if args.sensitivities:
+        _sensitivities(rows[0], geometry, args.thread_pitch)
+    if args.csv:
+        _sheet_csv(rows, labels, args.csv)
+    return 0
+
+
+def _sheet(rows, labels) -> None:
+    print(
+        f"  {'':9}{'shim':>8}{'trackrod':>9}{'pushrod':>8}"
+        + "".join(f"{head:>12}" for _, _, head in SHEET_METRICS)
+    )
+    print(
+        f"  {'':9}{'mm':>8}{'Δ mm':>9}{'Δ mm':>8}"
+        + "".join(f"{unit:>12}" for _, unit, _ in SHEET_METRICS)
+    )
+    for label, row in zip(labels, rows, strict=True):
+        line = f"  {label:9}" + "".join(
+            f"{v + 0.0:>{w}.3f}" for v, w in zip(row.setup, (8, 9, 8), strict=True)
+        )
+        line += "".join(f"{row.metrics[name] + 0.0:>12.4f}" for name, _, _ in SHEET_METRICS)
+        print(line)
+
+
+def _sensitivities(state, geometry, pitch) -> None:
+    drawn = geometry.drawn or geometry
+    have = (drawn.camber_shim is not None, True, drawn.has_pushrod)
+    columns = [("per mm shim", 0, 1.0), ("per mm trackrod", 1, 1.0), ("per mm pushrod", 2, 1.0)]
+    if pitch:
+        columns += [("per turn trackrod", 1, pitch), ("per turn pushrod", 2, pitch)]
+    columns = [c for c in columns if have[c[1]]]
+    print("  exact sensitivities at the static state:")
+    print(f"  {'':26}" + "".join(f"{c[0]:>19}" for c in columns))
+    for name, unit in (("camber", "deg"), ("roadwheel_angle", "deg"), ("ride_height_change", "mm")):
+        d = state.derivatives[name]
+        print(
+            f"  {name + ' (' + unit + ')':26}"
+            + "".join(f"{d[i] * k:>19.6g}" for _, i, k in columns)
+        )
+
+
+def _sheet_csv(rows, labels, path) -> None:
+    from .export import atomic_write, format_cell
+
+    names = ["row", *SETUP_COLUMNS] + [name for name, _, _ in SHEET_METRICS]
+    with atomic_write(path) as f:
+        f.write(f"# pin_susp {__version__} setup sheet; lengths mm, angles deg\n")
+        f.write(",".join(names) + "\n")
+        for label, row in zip(labels, rows, strict=True):
+            cells = [label, *map(format_cell, row.setup)]
+            cells += [format_cell(row.metrics[name]) for name, _, _ in SHEET_METRICS]
+            f.write(",".join(cells) + "\n")
+    print(f"wrote {path}")

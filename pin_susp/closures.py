@@ -24,6 +24,7 @@ class Kinematics:
         self.data = model.createData()
 
     def update(self, q: np.ndarray) -> None:
+        self.q = q
         pin.computeJointJacobians(self.model, self.data, q)
         pin.updateFramePlacements(self.model, self.data)
 
@@ -136,3 +137,77 @@ class PointTarget:
 
     def jacobian(self, kin: Kinematics) -> np.ndarray:
         return (self.direction @ self.point.jacobian(kin))[None]
+
+
+class JointTarget:
+    """A joint held at a value: r = q_j − value (1 row; rad or m).
+
+    Holds the rack at its design position, or the rocker at its design
+    angle, while a setup adjuster is applied.
+    """
+
+    size = 1
+
+    def __init__(self, model: pin.Model, joint: str, value: float = 0.0):
+        j = model.joints[model.getJointId(joint)]
+        self.name = f"hold {joint}"
+        self.index_q, self.index_v = j.idx_q, j.idx_v
+        self.row = np.zeros((1, model.nv))
+        self.row[0, self.index_v] = 1.0
+        self.value = value
+
+    def residual(self, kin: Kinematics) -> np.ndarray:
+        return np.array([kin.q[self.index_q] - self.value])
+
+    def jacobian(self, kin: Kinematics) -> np.ndarray:
+        return self.row
+
+
+class ShimGap:
+    """A shim stack between two faces: p_body − p_block − t·n_block = 0 (3 rows, m).
+
+    ``block`` and ``body`` are the facing datum points of the camber block and
+    the upright body; n_block = R_block·n₀ turns with the block, so
+    d(n_block) = ω_block × n_block.
+    """
+
+    size = 3
+
+    def __init__(self, name: str, block: FramePoint, body: FramePoint, normal, thickness: float):
+        self.name, self.block, self.body = name, block, body
+        self.normal = np.asarray(normal, dtype=float)
+        self.thickness = thickness
+
+    def residual(self, kin: Kinematics) -> np.ndarray:
+        n = kin.data.oMf[self.block.frame_id].rotation @ self.normal
+        return self.body.position(kin) - self.block.position(kin) - self.thickness * n
+
+    def jacobian(self, kin: Kinematics) -> np.ndarray:
+        n = kin.data.oMf[self.block.frame_id].rotation @ self.normal
+        j_block = kin.frame_jacobian(self.block.frame_id)
+        return self.body.jacobian(kin) - j_block[:3] + self.thickness * pin.skew(n) @ j_block[3:]
+
+
+class FaceAlignment:
+    """Two faces keep one orientation: R_body·n₀ − R_block·n₀ = 0 (3 rows).
+
+    The vector difference (not a cross product) rejects the anti-parallel branch.
+    """
+
+    size = 3
+
+    def __init__(self, name: str, block: FramePoint, body: FramePoint, normal):
+        self.name, self.block, self.body = name, block, body
+        self.normal = np.asarray(normal, dtype=float)
+
+    def residual(self, kin: Kinematics) -> np.ndarray:
+        rot = kin.data.oMf
+        return (rot[self.body.frame_id].rotation - rot[self.block.frame_id].rotation) @ self.normal
+
+    def jacobian(self, kin: Kinematics) -> np.ndarray:
+        rot = kin.data.oMf
+        n_body = rot[self.body.frame_id].rotation @ self.normal
+        n_block = rot[self.block.frame_id].rotation @ self.normal
+        w_body = kin.frame_jacobian(self.body.frame_id)[3:]
+        w_block = kin.frame_jacobian(self.block.frame_id)[3:]
+        return -pin.skew(n_body) @ w_body + pin.skew(n_block) @ w_block

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from . import __version__
+from . import __version__, setup
 from .closures import (
     BallClosure,
     ContactPatchPoint,
@@ -39,9 +39,11 @@ class Corner:
     >>> pose.metrics["camber"]  # deg
     """
 
-    def __init__(self, geometry: Geometry | str | dict):
+    def __init__(self, geometry: Geometry | str | dict, apply_setup: bool = True):
         if not isinstance(geometry, Geometry):
             geometry = load_geometry(geometry)
+        if apply_setup:  # shims and adjusters: the as-set state is the design state
+            geometry = setup.apply_setup(geometry)
         self.geometry = geometry
         self.tree = corner_tree(geometry)
         self.urdf = tree_to_urdf(
@@ -58,7 +60,9 @@ class Corner:
                 anchors[spec.name, i] = self._add_anchor(f"{spec.name}/{i}", link, offset)
         self.kin = Kinematics(self.model)  # data after every frame is added
 
-        self.point_names = hardpoint_names(geometry.steering, geometry.spring) + DERIVED_POINTS
+        self.point_names = (
+            hardpoint_names(geometry.steering, geometry.actuation, geometry.spring) + DERIVED_POINTS
+        )
         self.points: dict[str, FramePoint | ContactPatchPoint] = {
             name: FramePoint(name, self.model.getFrameId(name), body)
             for name, (body, _) in self.tree.points.items()

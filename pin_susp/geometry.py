@@ -30,6 +30,7 @@ STEERING_POINTS = {
     "none": ("toe_link_inboard", "toe_link_outboard"),
 }
 AXLE_POINTS = ("axle_inboard", "axle_outboard")
+PUSHROD_ROCKER_POINTS = ("pushrod_outboard", "pushrod_inboard", "rocker_axis_a", "rocker_axis_b")
 COILOVER_POINTS = ("strut_top", "strut_bottom")
 
 # Points computed from the upright's hardpoints and the wheel (spec/geometry.md).
@@ -78,9 +79,9 @@ class Geometry:
     name: str
     side: str  # "left" | "right"
     steering: str  # "rack" | "none"
-    actuation: str  # "direct"
+    actuation: str  # "direct" | "pushrod_rocker"
     actuation_mount: str  # "lower_wishbone" | "upright"
-    spring: str  # "none" | "coilover"
+    spring: str  # "none" | "coilover" | "torsion_bar"
     hardpoints: dict[str, np.ndarray]
     wheel: Wheel
     cg_position: np.ndarray | None = None
@@ -89,6 +90,12 @@ class Geometry:
     front_brake_bias: float | None = None
     driven_axle: str | None = None
     camber_shim: CamberShim | None = None
+    trackrod_length_delta: float = 0.0  # m, config.setup
+    pushrod_length_delta: float = 0.0  # m, config.setup
+    # Set on an as-set geometry (setup.apply_setup): the geometry as drawn, and
+    # the wheel's move relative to the chassis it caused (m, + = car higher).
+    drawn: Geometry | None = None
+    ride_height_change: float = 0.0
     source: str = "<dict>"
     sha256: str | None = None
     data: dict = field(default_factory=dict, repr=False)
@@ -97,6 +104,20 @@ class Geometry:
     def sign(self) -> float:
         """s = +1 for a left corner, −1 for a right one (spec/results.md)."""
         return 1.0 if self.side == "left" else -1.0
+
+    @property
+    def has_pushrod(self) -> bool:
+        return self.actuation == "pushrod_rocker"
+
+    @property
+    def needs_setup(self) -> bool:
+        """True when shims or adjusters move the corner away from its drawn state."""
+        shim = self.camber_shim
+        return self.drawn is None and (
+            (shim is not None and shim.setup_thickness != shim.design_thickness)
+            or self.trackrod_length_delta != 0.0
+            or self.pushrod_length_delta != 0.0
+        )
 
     @property
     def steering_points(self) -> tuple[str, str]:
@@ -110,9 +131,11 @@ class Geometry:
         return points
 
 
-def hardpoint_names(steering: str, spring: str) -> tuple[str, ...]:
+def hardpoint_names(steering: str, actuation: str, spring: str) -> tuple[str, ...]:
     """The hardpoints of a double-wishbone corner, in output order."""
     names = WISHBONE_POINTS + STEERING_POINTS[steering] + AXLE_POINTS
+    if actuation == "pushrod_rocker":
+        names += PUSHROD_ROCKER_POINTS
     if spring == "coilover":
         names += COILOVER_POINTS
     return names
@@ -203,8 +226,6 @@ def _parse(data: dict, r: Reader, sha: str | None) -> Geometry:
 
     act = r.mapping(data.get("actuation", {}), "actuation", optional=("type", "mount"))
     actuation = r.choice(act.get("type", "direct"), "actuation.type", ("direct", "pushrod_rocker"))
-    if actuation == "pushrod_rocker":
-        r.fail("actuation.type", "pushrod_rocker is not supported yet (use direct)")
     mount = r.choice(
         act.get("mount", "lower_wishbone"), "actuation.mount", ("lower_wishbone", "upright")
     )
@@ -212,7 +233,7 @@ def _parse(data: dict, r: Reader, sha: str | None) -> Geometry:
     spring = r.choice(
         spring_map.get("type", "none"), "spring.type", ("none", "coilover", "torsion_bar")
     )
-    if spring == "torsion_bar":
+    if spring == "torsion_bar" and actuation != "pushrod_rocker":
         r.fail("spring.type", "a torsion bar needs actuation type pushrod_rocker")
 
     config = r.mapping(
@@ -227,19 +248,22 @@ def _parse(data: dict, r: Reader, sha: str | None) -> Geometry:
             "front_brake_bias",
             "driven_axle",
             "camber_shim",
+            "setup",
         ),
     )
     steer_map = r.mapping(config.get("steering", {}), "config.steering", optional=("type",))
     steering = r.choice(steer_map.get("type", "rack"), "config.steering.type", ("rack", "none"))
     wheel = _wheel(config["wheel"], r)
 
-    names = hardpoint_names(steering, spring)
+    names = hardpoint_names(steering, actuation, spring)
     hp_map = data["hardpoints"]
     if not isinstance(hp_map, dict):
         r.fail("hardpoints", "expected a mapping of point name to {x, y, z}")
     for key in hp_map:
         if key not in names:
-            r.fail(f"hardpoints.{key}", _unknown_point_hint(key, steering, spring, names))
+            r.fail(
+                f"hardpoints.{key}", _unknown_point_hint(key, steering, actuation, spring, names)
+            )
     hardpoints = {}
     for key in names:
         if key not in hp_map:
@@ -255,7 +279,8 @@ def _parse(data: dict, r: Reader, sha: str | None) -> Geometry:
                 f"y = {p[1] / MM:g} mm on a {side} corner ({side} hardpoints have {want};"
                 " check 'side' or the sign of y)",
             )
-    _check_linkage(hardpoints, steering, spring, r)
+    _check_linkage(hardpoints, steering, actuation, spring, r)
+    adjusters = _setup_block(config.get("setup", {}), actuation, r)
 
     cg = config.get("cg_position")
     bias = config.get("front_brake_bias")
@@ -288,6 +313,8 @@ def _parse(data: dict, r: Reader, sha: str | None) -> Geometry:
         camber_shim=(
             None if "camber_shim" not in config else _camber_shim(config["camber_shim"], r)
         ),
+        trackrod_length_delta=adjusters[0],
+        pushrod_length_delta=adjusters[1],
         source=r.source,
         sha256=sha,
         data=data,
@@ -336,19 +363,34 @@ def _camber_shim(value, r: Reader) -> CamberShim:
         r.fail(f"{key}.shim_face_point_b", "coincides with shim_face_point_a (A and B must differ)")
     if np.linalg.norm(n) < 1e-12:
         r.fail(f"{key}.shim_face_normal", "is the zero vector (it needs a direction)")
+    n = n / np.linalg.norm(n)
+    ab = unit(b - a)
+    if np.linalg.norm(np.cross(ab, n)) < 1e-6:
+        r.fail(
+            f"{key}.shim_face_point_b",
+            "A→B runs along the shim face normal: A and B must clock the face (lie across it)",
+        )
     design = r.number(s["design_thickness"], f"{key}.design_thickness", minimum=0.0) * MM
     setup = r.number(s["setup_thickness"], f"{key}.setup_thickness", minimum=0.0) * MM
-    if setup != design:
-        # The as-shimmed assembly solve is not in this version: refuse
-        # rather than sweep the design geometry as if it were shimmed.
+    return CamberShim(a, b, n, design, setup)
+
+
+def _setup_block(value, actuation: str, r: Reader) -> tuple[float, float]:
+    key = "config.setup"
+    s = r.mapping(value, key, optional=("trackrod_length_delta", "pushrod_length_delta"))
+    trackrod = r.number(s.get("trackrod_length_delta", 0.0), f"{key}.trackrod_length_delta")
+    pushrod = r.number(s.get("pushrod_length_delta", 0.0), f"{key}.pushrod_length_delta")
+    if pushrod != 0.0 and actuation != "pushrod_rocker":
         r.fail(
-            f"{key}.setup_thickness",
-            "a setup thickness different from design_thickness is not supported yet",
+            f"{key}.pushrod_length_delta",
+            f"this corner has no pushrod (actuation type {actuation})",
         )
-    return CamberShim(a, b, n / np.linalg.norm(n), design, setup)
+    return trackrod * MM, pushrod * MM
 
 
-def _check_linkage(p: dict[str, np.ndarray], steering: str, spring: str, r: Reader) -> None:
+def _check_linkage(
+    p: dict[str, np.ndarray], steering: str, actuation: str, spring: str, r: Reader
+) -> None:
     """Reject geometry that defines no mechanism: coincident ends, balls on pivots."""
     inner, outer = STEERING_POINTS[steering]
     pairs = [
@@ -360,6 +402,9 @@ def _check_linkage(p: dict[str, np.ndarray], steering: str, spring: str, r: Read
     ]
     if spring == "coilover":
         pairs.append(("strut_top", "strut_bottom", "coilover"))
+    if actuation == "pushrod_rocker":
+        pairs.append(("rocker_axis_a", "rocker_axis_b", "rocker axis"))
+        pairs.append(("pushrod_outboard", "pushrod_inboard", "pushrod"))
     for a, b, what in pairs:
         if np.linalg.norm(p[b] - p[a]) < COINCIDENT:
             r.fail(f"hardpoints.{b}", f"coincides with {a}: the {what} needs two distinct points")
@@ -372,9 +417,19 @@ def _check_linkage(p: dict[str, np.ndarray], steering: str, spring: str, r: Read
                 f"hardpoints.{arm}_outboard",
                 f"lies on the {arm} pivot axis (inboard_front→inboard_rear): the arm has no length",
             )
+    if actuation == "pushrod_rocker":
+        axis = unit(p["rocker_axis_b"] - p["rocker_axis_a"])
+        arm_vec = p["pushrod_inboard"] - p["rocker_axis_a"]
+        if np.linalg.norm(arm_vec - axis * (arm_vec @ axis)) < COINCIDENT:
+            r.fail(
+                "hardpoints.pushrod_inboard",
+                "lies on the rocker axis (rocker_axis_a→rocker_axis_b): the pushrod cannot turn it",
+            )
 
 
-def _unknown_point_hint(key: str, steering: str, spring: str, names: tuple[str, ...]) -> str:
+def _unknown_point_hint(
+    key: str, steering: str, actuation: str, spring: str, names: tuple[str, ...]
+) -> str:
     for other, pts in STEERING_POINTS.items():
         if key in pts and other != steering:
             return (
@@ -383,4 +438,8 @@ def _unknown_point_hint(key: str, steering: str, spring: str, names: tuple[str, 
             )
     if key in COILOVER_POINTS and spring != "coilover":
         return "not a point of this corner (strut points need spring type coilover)"
+    if key in PUSHROD_ROCKER_POINTS and actuation != "pushrod_rocker":
+        return (
+            "not a point of this corner (pushrod and rocker points need actuation pushrod_rocker)"
+        )
     return f"unknown hardpoint (this corner has: {', '.join(names)})"

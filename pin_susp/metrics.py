@@ -23,11 +23,17 @@ STEERING_AXIS_FLAT = 1e-6  # |k_z| below this: the axis never meets the ground
 
 @dataclass
 class PointSet:
-    """Solved positions (m) of every named point, design positions, and the geometry."""
+    """Solved positions (m) of every named point, design positions, and the geometry.
+
+    ``rates`` optionally holds a velocity for each point (same shapes): the
+    ``d_<metric>`` functions return the metric's directional derivative
+    along it, exactly (the chain rule written out, no differencing).
+    """
 
     points: dict[str, np.ndarray]
     design: dict[str, np.ndarray]
     geometry: Geometry
+    rates: dict[str, np.ndarray] | None = None
 
     @property
     def s(self) -> float:
@@ -36,20 +42,58 @@ class PointSet:
     def __getitem__(self, name: str) -> np.ndarray:
         return self.points[name]
 
+    def d(self, name: str) -> np.ndarray:
+        return self.rates[name]
+
     def spin_axis(self) -> np.ndarray:
         return unit(self["axle_outboard"] - self["axle_inboard"])
+
+    def d_spin_axis(self) -> np.ndarray:
+        return _d_unit(
+            self["axle_outboard"] - self["axle_inboard"],
+            self.d("axle_outboard") - self.d("axle_inboard"),
+        )
 
     def steering_axis(self) -> np.ndarray:
         return unit(self["upper_wishbone_outboard"] - self["lower_wishbone_outboard"])
 
+    def d_steering_axis(self) -> np.ndarray:
+        return _d_unit(
+            self["upper_wishbone_outboard"] - self["lower_wishbone_outboard"],
+            self.d("upper_wishbone_outboard") - self.d("lower_wishbone_outboard"),
+        )
+
     def steering_axis_on_ground(self) -> np.ndarray:
-        """G: the point of the steering axis at the contact patch height."""
-        lbj = self["lower_wishbone_outboard"]
-        k = self.steering_axis()
+        """G = LBJ + t·K, K = UBJ − LBJ, t = (CP_z − LBJ_z)/K_z: the axis at CP height."""
+        lbj, k = self["lower_wishbone_outboard"], self["upper_wishbone_outboard"]
+        k = k - lbj
         with np.errstate(divide="ignore", invalid="ignore"):
             t = (self["contact_patch_center"][:, 2] - lbj[:, 2]) / k[:, 2]
-        t[np.abs(k[:, 2]) < STEERING_AXIS_FLAT] = np.nan
+        t[np.abs(unit(k)[:, 2]) < STEERING_AXIS_FLAT] = np.nan
         return lbj + t[:, None] * k
+
+    def d_steering_axis_on_ground(self) -> np.ndarray:
+        lbj = self["lower_wishbone_outboard"]
+        k = self["upper_wishbone_outboard"] - lbj
+        dlbj = self.d("lower_wishbone_outboard")
+        dk = self.d("upper_wishbone_outboard") - dlbj
+        h = self["contact_patch_center"][:, 2] - lbj[:, 2]
+        dh = self.d("contact_patch_center")[:, 2] - dlbj[:, 2]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = h / k[:, 2]
+            dt = (dh * k[:, 2] - h * dk[:, 2]) / k[:, 2] ** 2
+        return dlbj + dt[:, None] * k + t[:, None] * dk
+
+
+def _d_unit(v: np.ndarray, dv: np.ndarray) -> np.ndarray:
+    """d(v/|v|) = (dv − â(â·dv))/|v|, rows."""
+    n = np.linalg.norm(v, axis=-1, keepdims=True)
+    a = v / n
+    return (dv - a * np.sum(a * dv, axis=-1, keepdims=True)) / n
+
+
+def _d_atan2(y, x, dy, dx):
+    return (x * dy - y * dx) / (x * x + y * y)
 
 
 def camber(ps: PointSet) -> np.ndarray:
@@ -58,10 +102,20 @@ def camber(ps: PointSet) -> np.ndarray:
     return -np.arctan2(a[:, 2], ps.s * a[:, 1])
 
 
+def d_camber(ps: PointSet) -> np.ndarray:
+    a, da = ps.spin_axis(), ps.d_spin_axis()
+    return -_d_atan2(a[:, 2], ps.s * a[:, 1], da[:, 2], ps.s * da[:, 1])
+
+
 def caster(ps: PointSet) -> np.ndarray:
     """atan2(−k_x, k_z): positive = top of the steering axis rearward."""
     k = ps.steering_axis()
     return np.arctan2(-k[:, 0], k[:, 2])
+
+
+def d_caster(ps: PointSet) -> np.ndarray:
+    k, dk = ps.steering_axis(), ps.d_steering_axis()
+    return _d_atan2(-k[:, 0], k[:, 2], -dk[:, 0], dk[:, 2])
 
 
 def kpi(ps: PointSet) -> np.ndarray:
@@ -70,17 +124,39 @@ def kpi(ps: PointSet) -> np.ndarray:
     return np.arctan2(-ps.s * k[:, 1], k[:, 2])
 
 
+def d_kpi(ps: PointSet) -> np.ndarray:
+    k, dk = ps.steering_axis(), ps.d_steering_axis()
+    return _d_atan2(-ps.s * k[:, 1], k[:, 2], -ps.s * dk[:, 1], dk[:, 2])
+
+
 def roadwheel_angle(ps: PointSet) -> np.ndarray:
     """atan2(â_x, s·â_y), the toe: positive = toe-in, on each side."""
     a = ps.spin_axis()
     return np.arctan2(a[:, 0], ps.s * a[:, 1])
 
 
+def d_roadwheel_angle(ps: PointSet) -> np.ndarray:
+    a, da = ps.spin_axis(), ps.d_spin_axis()
+    return _d_atan2(a[:, 0], ps.s * a[:, 1], da[:, 0], ps.s * da[:, 1])
+
+
+def _ground_direction(ps: PointSet) -> tuple[np.ndarray, np.ndarray]:
+    flat = np.array([1.0, 1.0, 0.0])
+    return ps.spin_axis() * flat, (ps.d_spin_axis() * flat if ps.rates is not None else None)
+
+
 def scrub_radius(ps: PointSet) -> np.ndarray:
     """−(G − CP)·ŵ, ŵ = unit(â_x, â_y, 0): positive = axis meets the ground inboard of CP."""
-    a = ps.spin_axis()
-    w = unit(a * np.array([1.0, 1.0, 0.0]))
+    w = unit(_ground_direction(ps)[0])
     return -np.sum((ps.steering_axis_on_ground() - ps["contact_patch_center"]) * w, axis=1)
+
+
+def d_scrub_radius(ps: PointSet) -> np.ndarray:
+    h, dh = _ground_direction(ps)
+    w, dw = unit(h), _d_unit(h, dh)
+    gap = ps.steering_axis_on_ground() - ps["contact_patch_center"]
+    dgap = ps.d_steering_axis_on_ground() - ps.d("contact_patch_center")
+    return -np.sum(dgap * w + gap * dw, axis=1)
 
 
 def mechanical_trail(ps: PointSet) -> np.ndarray:
@@ -88,9 +164,17 @@ def mechanical_trail(ps: PointSet) -> np.ndarray:
     return ps.steering_axis_on_ground()[:, 0] - ps["contact_patch_center"][:, 0]
 
 
+def d_mechanical_trail(ps: PointSet) -> np.ndarray:
+    return ps.d_steering_axis_on_ground()[:, 0] - ps.d("contact_patch_center")[:, 0]
+
+
 def wheel_travel(ps: PointSet) -> np.ndarray:
     """WC_z − WC_z,design: positive = bump."""
     return ps["wheel_center"][:, 2] - ps.design["wheel_center"][:, 2]
+
+
+def d_wheel_travel(ps: PointSet) -> np.ndarray:
+    return ps.d("wheel_center")[:, 2]
 
 
 def half_track(ps: PointSet) -> np.ndarray:
@@ -98,9 +182,45 @@ def half_track(ps: PointSet) -> np.ndarray:
     return np.abs(ps["contact_patch_center"][:, 1])
 
 
+def d_half_track(ps: PointSet) -> np.ndarray:
+    return np.sign(ps["contact_patch_center"][:, 1]) * ps.d("contact_patch_center")[:, 1]
+
+
 def damper_length(ps: PointSet) -> np.ndarray:
     """|strut_top − strut_bottom| (coilover)."""
     return np.linalg.norm(ps["strut_top"] - ps["strut_bottom"], axis=1)
+
+
+def d_damper_length(ps: PointSet) -> np.ndarray:
+    u = unit(ps["strut_top"] - ps["strut_bottom"])
+    return np.sum(u * (ps.d("strut_top") - ps.d("strut_bottom")), axis=1)
+
+
+def _rocker_arm(ps: PointSet):
+    """Rocker axis û and the arm to pushrod_inboard, now and at design, normal to û."""
+    a = ps["rocker_axis_a"]
+    u = unit(ps["rocker_axis_b"] - a)
+
+    def normal(v):
+        return v - u * np.sum(u * v, axis=1, keepdims=True)
+
+    arm0 = normal(ps.design["pushrod_inboard"] - ps.design["rocker_axis_a"])
+    return u, arm0, normal(ps["pushrod_inboard"] - a), normal
+
+
+def rocker_angle(ps: PointSet) -> np.ndarray:
+    """s·(rotation of pushrod_inboard about rocker_axis_a→b from design, right-hand rule)."""
+    u, arm0, arm, _ = _rocker_arm(ps)
+    y = np.sum(u * np.cross(arm0, arm), axis=1)
+    return ps.s * np.arctan2(y, np.sum(arm0 * arm, axis=1))
+
+
+def d_rocker_angle(ps: PointSet) -> np.ndarray:
+    u, arm0, arm, normal = _rocker_arm(ps)
+    darm = normal(ps.d("pushrod_inboard") - ps.d("rocker_axis_a"))
+    y, x = np.sum(u * np.cross(arm0, arm), axis=1), np.sum(arm0 * arm, axis=1)
+    dy, dx = np.sum(u * np.cross(arm0, darm), axis=1), np.sum(arm0 * darm, axis=1)
+    return ps.s * _d_atan2(y, x, dy, dx)
 
 
 def _always(g: Geometry) -> bool:
@@ -113,6 +233,7 @@ class Metric:
     unit: str  # output unit: "deg" or "mm"
     label: str
     function: Callable[[PointSet], np.ndarray]
+    derivative: Callable[[PointSet], np.ndarray]  # along PointSet.rates
     applies: Callable[[Geometry], bool] = field(default=_always)
 
     @property
@@ -122,16 +243,37 @@ class Metric:
 
 
 METRICS = (
-    Metric("camber", "deg", "Camber", camber),
-    Metric("caster", "deg", "Caster", caster),
-    Metric("kpi", "deg", "Kingpin inclination", kpi),
-    Metric("roadwheel_angle", "deg", "Roadwheel angle (toe, + in)", roadwheel_angle),
-    Metric("scrub_radius", "mm", "Scrub radius", scrub_radius),
-    Metric("mechanical_trail", "mm", "Mechanical trail", mechanical_trail),
-    Metric("wheel_travel", "mm", "Wheel travel (+ bump)", wheel_travel),
-    Metric("half_track", "mm", "Half track", half_track),
-    Metric("damper_length", "mm", "Damper length", damper_length, lambda g: g.spring == "coilover"),
+    Metric("camber", "deg", "Camber", camber, d_camber),
+    Metric("caster", "deg", "Caster", caster, d_caster),
+    Metric("kpi", "deg", "Kingpin inclination", kpi, d_kpi),
+    Metric(
+        "roadwheel_angle", "deg", "Roadwheel angle (toe, + in)", roadwheel_angle, d_roadwheel_angle
+    ),
+    Metric("scrub_radius", "mm", "Scrub radius", scrub_radius, d_scrub_radius),
+    Metric("mechanical_trail", "mm", "Mechanical trail", mechanical_trail, d_mechanical_trail),
+    Metric("wheel_travel", "mm", "Wheel travel (+ bump)", wheel_travel, d_wheel_travel),
+    Metric("half_track", "mm", "Half track", half_track, d_half_track),
+    Metric(
+        "damper_length",
+        "mm",
+        "Damper length",
+        damper_length,
+        d_damper_length,
+        lambda g: g.spring == "coilover",
+    ),
+    Metric(
+        "rocker_angle", "deg", "Rocker angle", rocker_angle, d_rocker_angle, lambda g: g.has_pushrod
+    ),
+    Metric(
+        "torsion_bar_twist",
+        "deg",
+        "Torsion bar twist",
+        rocker_angle,
+        d_rocker_angle,
+        lambda g: g.spring == "torsion_bar",
+    ),
 )
+METRIC_BY_NAME = {m.name: m for m in METRICS}
 
 
 def metric_columns(

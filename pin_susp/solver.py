@@ -1,5 +1,8 @@
 """Newton's method on the joint manifold for closures plus targets.
 
+(With more rows than unknowns, as in the camber-shim assembly, the step is
+Gauss-Newton: the least-squares solution of J·dv = −r.)
+
 The residual stacks every closure and target (metres). Each iteration
 solves J·dv = −r and moves q ← integrate(q, dv). Where J is singular or
 the step is wild (a toggle position, lock-up) it takes a damped
@@ -70,7 +73,10 @@ class NewtonSolver:
     def _step(self) -> np.ndarray:
         J, r = self.jacobian, self.residual
         try:
-            dv = np.linalg.solve(J, -r)
+            if J.shape[0] == J.shape[1]:
+                dv = np.linalg.solve(J, -r)
+            else:  # consistent but redundant rows: Gauss-Newton
+                dv = np.linalg.lstsq(J, -r, rcond=None)[0]
             if np.all(np.isfinite(dv)) and np.max(np.abs(dv)) <= MAX_STEP:
                 return dv
         except np.linalg.LinAlgError:

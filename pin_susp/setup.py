@@ -1,0 +1,369 @@
+"""Setup options: camber shim, trackrod and pushrod adjusters, and their inverse.
+
+Forward (``apply_setup``): the shim assembly (``shim.py``) first, then the
+length adjusters on the main mechanism, holding the static load path — the
+rocker at its design angle where there is a pushrod-rocker (the spring keeps
+its static length), otherwise the wheel-centre height — and the rack at its
+design position. The result, the as-set geometry, is the design state of
+every later sweep; ``ride_height_change`` is −ΔCP_z from the drawn design.
+
+Exact sensitivities (``SetupModel``): a camber shim of Δt adds a rigid offset
+−Δt·n₀ (in the upright's design frame) between the lower and upper ball
+joints, because the datums A and B with aligned normals leave the block
+and the body no relative rotation. So the drawn mechanism, with that offset
+and the adjusted lengths as parameters p, reaches the as-set state in two
+solves: q₁ (shim: lower wishbone, rack and rocker held) and q₂ (adjusters:
+rack and rocker or wheel-centre height held). The implicit function theorem
+through both gives dq₂/dp, and the metrics' exact derivatives follow.
+"""
+
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass, replace
+
+import numpy as np
+import pinocchio as pin
+
+from .closures import DistanceClosure, JointTarget, PointTarget
+from .errors import InputError
+from .geometry import MM, Geometry
+from .metrics import METRIC_BY_NAME, PointSet
+from .solver import NewtonSolver
+
+PARAMETERS = ("shim_thickness", "trackrod_length", "pushrod_length")
+PARAMETER_KEYS = {
+    "shim_thickness": "config.camber_shim.setup_thickness",
+    "trackrod_length": "config.setup.trackrod_length_delta",
+    "pushrod_length": "config.setup.pushrod_length_delta",
+}
+STATIC_METRICS = (
+    "camber",
+    "roadwheel_angle",
+    "caster",
+    "kpi",
+    "scrub_radius",
+    "mechanical_trail",
+    "half_track",
+)
+Z = np.array([0.0, 0.0, 1.0])
+
+
+def apply_setup(g: Geometry) -> Geometry:
+    """The as-set geometry: shim, then adjusters. Unchanged (the same object) when
+    the setup equals the design."""
+    if not g.needs_setup:
+        return g
+    hardpoints = dict(g.hardpoints)
+    shim = g.camber_shim
+    if shim is not None and shim.setup_thickness != shim.design_thickness:
+        from .shim import ShimAssembly
+
+        hardpoints.update(ShimAssembly(g).shimmed_hardpoints())
+    as_set = replace(g, hardpoints=hardpoints, drawn=g)
+    if g.trackrod_length_delta != 0.0 or g.pushrod_length_delta != 0.0:
+        hardpoints.update(_adjusted_hardpoints(as_set))
+        as_set = replace(as_set, hardpoints=hardpoints)
+    cp_drawn = g.design_points()["contact_patch_center"][2]
+    cp_set = as_set.design_points()["contact_patch_center"][2]
+    return replace(as_set, ride_height_change=-(cp_set - cp_drawn))
+
+
+def _adjusted_hardpoints(g: Geometry) -> dict[str, np.ndarray]:
+    """Apply the trackrod/pushrod length changes with the static load path held."""
+    from .corner import Corner
+
+    corner = Corner(g)
+    delta = {
+        "trackrod": g.trackrod_length_delta,
+        "toe_link": g.trackrod_length_delta,
+        "pushrod": g.pushrod_length_delta,
+    }
+    closures = [
+        DistanceClosure(c.name, c.a, c.b, c.length + delta[c.name])
+        if isinstance(c, DistanceClosure)
+        else c
+        for c in corner.closures
+    ]
+    solver = NewtonSolver(corner.kin, closures, _holds(corner, corner.q_design))
+    solution = solver.newton(corner.q_design)
+    if not solution.converged:
+        key = "trackrod_length_delta" if g.pushrod_length_delta == 0.0 else "pushrod_length_delta"
+        raise InputError(
+            g.source,
+            f"config.setup.{key}",
+            f"the corner does not assemble with these lengths (residual "
+            f"{solution.max_residual * 1e3:.3g} mm): beyond the linkage's reach",
+        )
+    positions = corner.positions(solution.q)
+    return {name: positions[name] for name in g.hardpoints}
+
+
+def _holds(corner, q_static: np.ndarray) -> list:
+    """The static load path: rack at design; rocker at design, else wheel-centre height."""
+    holds = []
+    if corner.geometry.steering == "rack":
+        holds.append(JointTarget(corner.model, "rack_slide"))
+    if corner.geometry.has_pushrod:
+        holds.append(JointTarget(corner.model, "rocker_pivot"))
+    else:
+        wc = corner.positions(q_static)["wheel_center"][2]
+        holds.append(PointTarget(corner.points["wheel_center"], Z, wc))
+    return holds
+
+
+def setup_values(g: Geometry) -> np.ndarray:
+    """p = (shim setup thickness, trackrod delta, pushrod delta), m."""
+    shim = g.camber_shim
+    return np.array(
+        [
+            shim.setup_thickness if shim is not None else 0.0,
+            g.trackrod_length_delta,
+            g.pushrod_length_delta,
+        ]
+    )
+
+
+def with_setup(g: Geometry, p) -> Geometry:
+    """The drawn geometry with setup values p (m), not yet applied."""
+    g = g.drawn or g
+    shim = g.camber_shim
+    if shim is not None:
+        shim = replace(shim, setup_thickness=float(p[0]))
+    return replace(
+        g, camber_shim=shim, trackrod_length_delta=float(p[1]), pushrod_length_delta=float(p[2])
+    )
+
+
+@dataclass
+class SetupState:
+    """Static metrics of an as-set corner (output units) and their exact derivatives.
+
+    ``derivatives[metric]`` has one entry per PARAMETERS, in the metric's unit
+    per mm (shim thickness, trackrod length, pushrod length).
+    """
+
+    setup: np.ndarray  # mm: shim thickness, trackrod delta, pushrod delta
+    metrics: dict[str, float]
+    derivatives: dict[str, np.ndarray]
+
+
+class SetupModel:
+    """The drawn corner with the setup p as parameters: static state and dq/dp."""
+
+    def __init__(self, g: Geometry):
+        from .corner import Corner
+
+        self.drawn = g.drawn or g
+        self.corner = Corner(self.drawn, apply_setup=False)
+        c = self.corner
+        self.ball = next(x for x in c.closures if x.name == "upper_ball_joint")
+        self.links = {x.name: x for x in c.closures if isinstance(x, DistanceClosure)}
+        self.link_name = "trackrod" if "trackrod" in self.links else "toe_link"
+        shim = self.drawn.camber_shim
+        self.normal = shim.normal if shim is not None else np.zeros(3)
+        self.t_design = shim.design_thickness if shim is not None else 0.0
+        anchor = c.model.frames[self.ball.b.frame_id]
+        self.ubj_offset = anchor.placement.translation.copy()
+
+    def _set_shim(self, thickness: float) -> None:
+        """The upright's UBJ anchor moves by −Δt·n₀ in the upright's frame."""
+        model = self.corner.model
+        frame = model.frames[self.ball.b.frame_id]
+        offset = self.ubj_offset - (thickness - self.t_design) * self.normal
+        frame.placement = pin.SE3(frame.placement.rotation, offset)
+        model.frames[self.ball.b.frame_id] = frame
+
+    def state(self, p) -> SetupState:
+        """Solve the static state at setup p (m) and differentiate it."""
+        c = self.corner
+        kin = c.kin
+        p = np.asarray(p, dtype=float)
+        self._set_shim(p[0])
+        link0 = self.links[self.link_name]
+
+        # q₁: the shim alone, lower wishbone, rack and rocker held.
+        holds1 = [JointTarget(c.model, "lower_wishbone_pivot")]
+        holds1 += [
+            JointTarget(c.model, j)
+            for j in ("rack_slide", "rocker_pivot")
+            if c.model.existJointName(j)
+        ]
+        s1 = NewtonSolver(kin, [self.ball, link0], holds1)
+        q1 = self._solve(s1, c.q_design, PARAMETER_KEYS["shim_thickness"])
+        s1.evaluate(q1)
+        j1 = s1.jacobian.copy()
+        f1_p = np.zeros((s1.nrows, 3))
+        f1_p[:3, 0] = -kin.data.oMf[self.ball.b.frame_id].rotation @ self.normal
+        dq1 = -np.linalg.solve(j1, f1_p)
+        pushrod_q1 = None
+        if "pushrod" in self.links:
+            pr = self.links["pushrod"]
+            d = pr.b.position(kin) - pr.a.position(kin)
+            length1 = float(np.linalg.norm(d))
+            pushrod_q1 = pr.jacobian(kin)[0]  # ∇_q of the pushrod length at q₁
+        wc_q1 = c.points["wheel_center"].jacobian(kin)[2].copy()
+
+        # q₂: the adjusters, the static load path held.
+        closures = [self.ball, DistanceClosure(link0.name, link0.a, link0.b, link0.length + p[1])]
+        if pushrod_q1 is not None:
+            pr = self.links["pushrod"]
+            closures.append(DistanceClosure("pushrod", pr.a, pr.b, length1 + p[2]))
+        s2 = NewtonSolver(kin, closures, _holds(c, q1))
+        key = PARAMETER_KEYS["pushrod_length" if p[2] else "trackrod_length"]
+        q2 = self._solve(s2, q1, key)
+        s2.evaluate(q2)
+        j2 = s2.jacobian.copy()
+        f2_p = np.zeros((s2.nrows, 3))
+        f2_p[:3, 0] = -kin.data.oMf[self.ball.b.frame_id].rotation @ self.normal
+        f2_p[3, 1] = -1.0
+        f2_q1 = np.zeros((s2.nrows, c.model.nv))
+        if pushrod_q1 is not None:
+            f2_p[4, 2] = -1.0
+            f2_q1[4] = -pushrod_q1
+        else:
+            f2_q1[-1] = -wc_q1
+        dq2 = -np.linalg.solve(j2, f2_p + f2_q1 @ dq1)
+        return self._metrics(q2, dq2, p)
+
+    def _solve(self, solver: NewtonSolver, q0, key: str) -> np.ndarray:
+        solution = solver.newton(q0)
+        if not solution.converged:
+            raise InputError(
+                self.drawn.source,
+                key,
+                f"the corner does not assemble with this setup (residual "
+                f"{solution.max_residual * 1e3:.3g} mm): beyond the linkage's reach",
+            )
+        return solution.q
+
+    def _metrics(self, q2, dq2, p) -> SetupState:
+        """Static metrics at q₂ and their derivatives: point velocities through the metrics."""
+        c = self.corner
+        c.kin.update(q2)
+        names = c.point_names
+        pos = {n: np.repeat(c.points[n].position(c.kin)[None], 3, axis=0) for n in names}
+        rates = {n: (c.points[n].jacobian(c.kin) @ dq2).T for n in names}
+        design = {k: v[None] for k, v in c.design_positions.items()}
+        ps = PointSet(pos, design, c.geometry, rates)
+        metrics, derivatives = {}, {}
+        for name in STATIC_METRICS:
+            m = METRIC_BY_NAME[name]
+            metrics[name] = float(m.function(ps)[0] * m.scale)
+            derivatives[name] = m.derivative(ps) * m.scale * MM  # per mm of each parameter
+        cp0 = c.design_positions["contact_patch_center"][2]
+        metrics["ride_height_change"] = -(pos["contact_patch_center"][0, 2] - cp0) / MM
+        derivatives["ride_height_change"] = -rates["contact_patch_center"][:, 2]
+        return SetupState(p / MM, metrics, derivatives)
+
+
+@dataclass
+class InverseResult:
+    geometry: Geometry  # drawn geometry with the found setup values
+    before: SetupState
+    after: SetupState
+    iterations: int
+
+
+TARGET_PARAMETER = {"camber": 0, "roadwheel_angle": 1, "ride_height_change": 2}
+
+
+def solve_setup(g: Geometry, targets: dict[str, float], max_iterations: int = 25) -> InverseResult:
+    """Find shim thickness, trackrod and pushrod deltas that hit the targets.
+
+    ``targets`` maps camber (deg), roadwheel_angle (deg, the toe) and
+    ride_height_change (mm) to their wanted static values; each moves its
+    own adjuster (shim, trackrod, pushrod). Newton with exact sensitivities.
+    """
+    drawn = g.drawn or g
+    for name in targets:
+        if name == "camber" and drawn.camber_shim is None:
+            raise InputError(
+                drawn.source,
+                "config.camber_shim",
+                "a camber target needs a camber shim in the geometry",
+            )
+        if name == "ride_height_change" and not drawn.has_pushrod:
+            raise InputError(
+                drawn.source,
+                "actuation.type",
+                "a ride-height target needs a pushrod (actuation pushrod_rocker)",
+            )
+    free = [TARGET_PARAMETER[n] for n in targets]
+    goal = np.array(list(targets.values()))
+    model = SetupModel(drawn)
+    p = setup_values(g)
+    before = state = model.state(p)
+    for steps in range(max_iterations + 1):
+        error = np.array([state.metrics[n] for n in targets]) - goal
+        if np.max(np.abs(error)) <= 1e-11:
+            break
+        if steps == max_iterations:
+            raise _unreachable(drawn, targets, p, "Newton did not converge")
+        jac = np.array([[state.derivatives[n][i] for i in free] for n in targets])
+        step = np.linalg.solve(jac, -error) * MM
+        p = p.copy()
+        p[free] += step
+        try:
+            state = model.state(p)
+        except InputError:
+            raise _unreachable(drawn, targets, p, "the corner locks up on the way") from None
+    if drawn.camber_shim is not None and p[0] < 0.0:
+        raise _unreachable(
+            drawn, targets, p, f"it needs a shim stack of {p[0] / MM:.3f} mm, thinner than none"
+        )
+    return InverseResult(with_setup(drawn, p), before, state, steps)
+
+
+def _unreachable(g: Geometry, targets: dict, p, why: str) -> InputError:
+    wanted = ", ".join(f"{k} {v:g}" for k, v in targets.items())
+    return InputError(g.source, "targets", f"{wanted} not reachable: {why}")
+
+
+def geometry_data(g: Geometry) -> dict:
+    """The geometry file's data with the setup values of g written in (mm)."""
+    data = copy.deepcopy(g.data)
+    config = data.setdefault("config", {})
+    if g.camber_shim is not None:
+        config["camber_shim"]["setup_thickness"] = g.camber_shim.setup_thickness / MM
+    adjusters = {}
+    if g.trackrod_length_delta:
+        adjusters["trackrod_length_delta"] = g.trackrod_length_delta / MM
+    if g.pushrod_length_delta:
+        adjusters["pushrod_length_delta"] = g.pushrod_length_delta / MM
+    if adjusters:
+        config["setup"] = adjusters
+    else:
+        config.pop("setup", None)
+    return data
+
+
+def setup_sheet(
+    g: Geometry,
+    shim: list[float] = (),
+    trackrod: list[float] = (),
+    pushrod: list[float] = (),
+) -> list[SetupState]:
+    """The as-set static state, then one state per listed value (mm) of one adjuster.
+
+    ``shim`` lists fitted stack thicknesses; ``trackrod`` and ``pushrod`` list
+    length deltas. Each row changes that one value from the file's setup.
+    """
+    drawn = g.drawn or g
+    if shim and drawn.camber_shim is None:
+        raise InputError(drawn.source, "config.camber_shim", "--shim needs a camber shim")
+    if pushrod and not drawn.has_pushrod:
+        raise InputError(
+            drawn.source, "actuation.type", "--pushrod needs a pushrod (actuation pushrod_rocker)"
+        )
+    if any(v < 0 for v in shim):
+        raise InputError("--shim", "", "a shim stack cannot be thinner than 0 mm")
+    model = SetupModel(drawn)
+    p0 = setup_values(drawn)
+    rows = [model.state(p0)]
+    for index, values in enumerate((shim, trackrod, pushrod)):
+        for value in values:
+            p = p0.copy()
+            p[index] = value * MM
+            rows.append(model.state(p))
+    return rows
