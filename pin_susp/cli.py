@@ -285,10 +285,6 @@ def _progress_bar(total: int, quiet: bool):
     return show
 
 
-if __name__ == "__main__":
-    sys.exit(main())
-
-
 def _setup(args) -> int:
     from . import setup
 
@@ -379,3 +375,7 @@ def _sheet_csv(rows, labels, path) -> None:
             cells += [format_cell(row.metrics[name]) for name, _, _ in SHEET_METRICS]
             f.write(",".join(cells) + "\n")
     print(f"wrote {path}")
+
+
+if __name__ == "__main__":
+    sys.exit(main())
