@@ -190,7 +190,8 @@ class SetupModel:
             if c.model.existJointName(j)
         ]
         s1 = NewtonSolver(kin, [self.ball, link0], holds1)
-        q1 = self._solve(s1, c.q_design, PARAMETER_KEYS["shim_thickness"])
+        q1 = self._solve(s1, c.q_design, PARAMETER_KEYS["shim_thickness"],
+                         "the shimmed upright does not assemble")
         s1.evaluate(q1)
         j1 = s1.jacobian.copy()
         f1_p = np.zeros((s1.nrows, 3))
@@ -211,7 +212,7 @@ class SetupModel:
             closures.append(DistanceClosure("pushrod", pr.a, pr.b, length1 + p[2]))
         s2 = NewtonSolver(kin, closures, _holds(c, q1))
         key = PARAMETER_KEYS["pushrod_length" if p[2] else "trackrod_length"]
-        q2 = self._solve(s2, q1, key)
+        q2 = self._solve(s2, q1, key, "the corner does not assemble with these lengths")
         s2.evaluate(q2)
         j2 = s2.jacobian.copy()
         f2_p = np.zeros((s2.nrows, 3))
@@ -226,14 +227,14 @@ class SetupModel:
         dq2 = -np.linalg.solve(j2, f2_p + f2_q1 @ dq1)
         return self._metrics(q2, dq2, p)
 
-    def _solve(self, solver: NewtonSolver, q0, key: str) -> np.ndarray:
+    def _solve(self, solver: NewtonSolver, q0, key: str, what: str) -> np.ndarray:
         solution = solver.newton(q0)
         if not solution.converged:
             raise InputError(
                 self.drawn.source,
                 key,
-                f"the corner does not assemble with this setup (residual "
-                f"{solution.max_residual * 1e3:.3g} mm): beyond the linkage's reach",
+                f"{what} (residual {solution.max_residual * 1e3:.3g} mm): "
+                "beyond the linkage's reach",
             )
         return solution.q
 

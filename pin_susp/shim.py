@@ -117,7 +117,7 @@ class ShimAssembly:
                 self.geometry.source,
                 KEY,
                 f"the shimmed upright does not assemble (residual "
-                f"{solution.max_residual * 1e3:.3g} mm): the stack is out of the linkage's reach",
+                f"{solution.max_residual * 1e3:.3g} mm): beyond the linkage's reach",
             )
         pin.framesForwardKinematics(self.model, self.kin.data, solution.q)
         return solution

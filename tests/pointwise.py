@@ -3,8 +3,8 @@
 Unknowns are the coordinates of the moving hardpoints (and the rack
 displacement); constraints are rigid-body distances between hardpoints;
 scipy's least_squares solves them. It shares no code with pin_susp: the
-derived points and metrics are written again here from spec/geometry.md
-and spec/results.md.
+derived points, the shim assembly and the metrics are written again here
+from spec/geometry.md, spec/results.md and the reference article.
 """
 
 from __future__ import annotations
@@ -14,59 +14,78 @@ import itertools
 import numpy as np
 from scipy.optimize import least_squares
 
-UPRIGHT = (
-    "lower_wishbone_outboard",
-    "upper_wishbone_outboard",
-    "outer",
-    "axle_inboard",
-    "axle_outboard",
-)
+
+def _vec(v) -> np.ndarray:
+    return np.array([v["x"], v["y"], v["z"]], float) if isinstance(v, dict) else np.array(v, float)
 
 
 class PointwiseCorner:
     """Hardpoints in mm, as in the file; solutions in mm."""
 
-    def __init__(self, data: dict):
-        hp = {
-            k: np.array([v["x"], v["y"], v["z"]], float)
-            if isinstance(v, dict)
-            else np.array(v, float)
-            for k, v in data["hardpoints"].items()
-        }
-        self.steering = data["config"].get("steering", {}).get("type", "rack")
-        self.inner, outer = (
+    def __init__(self, data: dict, hardpoints: dict | None = None):
+        hp = hardpoints or {k: _vec(v) for k, v in data["hardpoints"].items()}
+        config = data["config"]
+        steering = config.get("steering", {}).get("type", "rack")
+        actuation = data.get("actuation", {}).get("type", "direct")
+        mount = data.get("actuation", {}).get("mount", "lower_wishbone")
+        spring = data.get("spring", {}).get("type", "none")
+        self.inner, self.outer = (
             ("trackrod_inboard", "trackrod_outboard")
-            if self.steering == "rack"
+            if steering == "rack"
             else ("toe_link_inboard", "toe_link_outboard")
         )
-        self.names = [n.replace("outer", outer) for n in UPRIGHT]
+        bodies = {
+            "lower_wishbone": [
+                "lower_wishbone_inboard_front",
+                "lower_wishbone_inboard_rear",
+                "lower_wishbone_outboard",
+            ],
+            "upper_wishbone": [
+                "upper_wishbone_inboard_front",
+                "upper_wishbone_inboard_rear",
+                "upper_wishbone_outboard",
+            ],
+            "upright": [
+                "lower_wishbone_outboard",
+                "upper_wishbone_outboard",
+                self.outer,
+                "axle_inboard",
+                "axle_outboard",
+            ],
+        }
+        fixed = {n for n in hp if "inboard_front" in n or "inboard_rear" in n}
+        fixed |= {"strut_top", "rocker_axis_a", "rocker_axis_b", self.inner}
+        self.links = [(self.outer, self.inner)]
+        if actuation == "pushrod_rocker":
+            bodies[mount].append("pushrod_outboard")
+            bodies["rocker"] = ["rocker_axis_a", "rocker_axis_b", "pushrod_inboard"]
+            if spring == "coilover":
+                bodies["rocker"].append("strut_bottom")
+            self.links.append(("pushrod_outboard", "pushrod_inboard"))
+        elif spring == "coilover":
+            bodies[mount].append("strut_bottom")
+        self.moving = sorted({n for pts in bodies.values() for n in pts} - fixed)
+        self.column = {n: 3 * i for i, n in enumerate(self.moving)}
+        self.rack = 3 * len(self.moving)
+        self.pairs = [
+            (a, b, np.linalg.norm(hp[a] - hp[b]))
+            for pts in bodies.values()
+            for a, b in itertools.combinations(pts, 2)
+            if not (a in fixed and b in fixed)
+        ]
+        self.pairs += [(a, b, np.linalg.norm(hp[a] - hp[b])) for a, b in self.links]
         self.hp = hp
         self.s = 1.0 if data.get("side", "left") == "left" else -1.0
-        tire = data["config"]["wheel"]["tire"]
-        self.offset = data["config"]["wheel"].get("offset", 0.0)
+        tire = config["wheel"]["tire"]
+        self.offset = config["wheel"].get("offset", 0.0)
         self.width = tire["section_width"]
         self.radius = tire["rim_diameter"] * 25.4 / 2 + tire["aspect_ratio"] * tire["section_width"]
-        # Rigid upright: every pairwise distance between its five points.
-        self.pairs = [
-            (i, j, np.linalg.norm(hp[self.names[i]] - hp[self.names[j]]))
-            for i, j in itertools.combinations(range(5), 2)
-        ]
-        self.arms = []  # (upright point index, chassis point, length)
-        for i, arm in ((0, "lower_wishbone"), (1, "upper_wishbone")):
-            for end in ("inboard_front", "inboard_rear"):
-                c = hp[f"{arm}_{end}"]
-                self.arms.append((i, c, np.linalg.norm(hp[self.names[i]] - c)))
-        self.link = np.linalg.norm(hp[self.names[2]] - hp[self.inner])
-        self.x = np.concatenate([hp[n] for n in self.names] + [[0.0]])
-
-    def unpack(self, x):
-        return x[:15].reshape(5, 3), x[15]
+        self.x = np.concatenate([hp[n] for n in self.moving] + [[0.0]])
 
     def points(self, x) -> dict[str, np.ndarray]:
-        p, rack = self.unpack(x)
         out = dict(self.hp)
-        out.update(zip(self.names, p, strict=True))
-        out[self.inner] = self.hp[self.inner] + np.array([0.0, rack, 0.0])
+        out.update({n: x[c : c + 3] for n, c in self.column.items()})
+        out[self.inner] = self.hp[self.inner] + np.array([0.0, x[self.rack], 0.0])
         a = out["axle_outboard"] - out["axle_inboard"]
         a = a / np.linalg.norm(a)
         wc = out["axle_outboard"] - self.offset * a
@@ -82,40 +101,30 @@ class PointwiseCorner:
         return out
 
     def residual(self, x, wc_z, rack):
-        p, r = self.unpack(x)
-        res = [np.linalg.norm(p[i] - p[j]) - d for i, j, d in self.pairs]
-        res += [np.linalg.norm(p[i] - c) - d for i, c, d in self.arms]
-        tri = self.hp[self.inner] + np.array([0.0, r, 0.0])
-        res.append(np.linalg.norm(p[2] - tri) - self.link)
-        a = p[4] - p[3]
-        a = a / np.linalg.norm(a)
-        res.append((p[4] - self.offset * a)[2] - wc_z)
-        res.append(r - rack)
+        p = self.points(x)
+        res = [np.linalg.norm(p[a] - p[b]) - d for a, b, d in self.pairs]
+        res.append(p["wheel_center"][2] - wc_z)
+        res.append(x[self.rack] - rack)
         return np.array(res)
 
     def jacobian(self, x, wc_z, rack):
-        p, r = self.unpack(x)
-        J = np.zeros((len(self.pairs) + 4 + 3, 16))
-        row = 0
-        for i, j, _ in self.pairs:
-            u = (p[i] - p[j]) / np.linalg.norm(p[i] - p[j])
-            J[row, 3 * i : 3 * i + 3], J[row, 3 * j : 3 * j + 3] = u, -u
-            row += 1
-        for i, c, _ in self.arms:
-            J[row, 3 * i : 3 * i + 3] = (p[i] - c) / np.linalg.norm(p[i] - c)
-            row += 1
-        d = p[2] - (self.hp[self.inner] + np.array([0.0, r, 0.0]))
-        u = d / np.linalg.norm(d)
-        J[row, 6:9], J[row, 15] = u, -u[1]
-        row += 1
-        v = p[4] - p[3]
+        p = self.points(x)
+        J = np.zeros((len(self.pairs) + 2, len(x)))
+        for row, (a, b, _) in enumerate(self.pairs):
+            u = (p[a] - p[b]) / np.linalg.norm(p[a] - p[b])
+            for name, sign in ((a, 1.0), (b, -1.0)):
+                if name in self.column:
+                    J[row, self.column[name] : self.column[name] + 3] += sign * u
+                elif name == self.inner:
+                    J[row, self.rack] += sign * u[1]
+        v = p["axle_outboard"] - p["axle_inboard"]
         n = np.linalg.norm(v)
         a = v / n
-        da_dv = (np.eye(3) - np.outer(a, a)) / n  # d â / d(AO − AI)
-        J[row, 12:15] = np.array([0, 0, 1.0]) - self.offset * da_dv[2]
-        J[row, 9:12] = self.offset * da_dv[2]
-        row += 1
-        J[row, 15] = 1.0
+        da_dz = ((np.eye(3) - np.outer(a, a)) / n)[2]  # d â_z / d(AO − AI)
+        ao, ai = self.column["axle_outboard"], self.column["axle_inboard"]
+        J[-2, ao : ao + 3] = np.array([0, 0, 1.0]) - self.offset * da_dz
+        J[-2, ai : ai + 3] = self.offset * da_dz
+        J[-1, self.rack] = 1.0
         return J
 
     def solve(self, wc_z: float, rack: float, x0=None):
@@ -152,3 +161,68 @@ def spec_metrics(p: dict[str, np.ndarray], s: float) -> dict[str, float]:
         "mechanical_trail": g[0] - cp[0],
         "half_track": abs(cp[1]),
     }
+
+
+def rodrigues(v: np.ndarray, rotvec: np.ndarray) -> np.ndarray:
+    """v turned by the rotation vector (axis·angle)."""
+    angle = np.linalg.norm(rotvec)
+    if angle < 1e-300:
+        return v.copy()
+    k = rotvec / angle
+    return v * np.cos(angle) + np.cross(k, v) * np.sin(angle) + k * (k @ v) * (1 - np.cos(angle))
+
+
+def shim_assembly(data: dict) -> dict[str, np.ndarray]:
+    """The camber-shim solve of the reference article: 7 unknowns, 10 residuals (mm).
+
+    x = [upper wishbone angle, camber block rotation vector about the UBJ,
+    upright body rotation vector about the LBJ]; residuals: datum A and B
+    closures, face normal alignment, trackrod length with the rack fixed.
+    Returns the moved hardpoints.
+    """
+    hp = {k: _vec(v) for k, v in data["hardpoints"].items()}
+    shim = data["config"]["camber_shim"]
+    n0 = _vec(shim["shim_face_normal"])
+    n0 = n0 / np.linalg.norm(n0)
+    td, ts = shim["design_thickness"], shim["setup_thickness"]
+    a, b = _vec(shim["shim_face_point_a"]), _vec(shim["shim_face_point_b"])
+    front, rear = hp["upper_wishbone_inboard_front"], hp["upper_wishbone_inboard_rear"]
+    axis = (rear - front) / np.linalg.norm(rear - front)
+    ubj, lbj = hp["upper_wishbone_outboard"], hp["lower_wishbone_outboard"]
+    steering = data["config"].get("steering", {}).get("type", "rack")
+    inner, outer = (
+        ("trackrod_inboard", "trackrod_outboard")
+        if steering == "rack"
+        else ("toe_link_inboard", "toe_link_outboard")
+    )
+    length = np.linalg.norm(hp[outer] - hp[inner])
+    block = {d: p - td / 2 * n0 - ubj for d, p in (("a", a), ("b", b))}
+    body = {d: p + td / 2 * n0 - lbj for d, p in (("a", a), ("b", b))}
+
+    def residual(x):
+        ubj_x = front + rodrigues(ubj - front, axis * x[0])
+        n_block, n_body = rodrigues(n0, x[1:4]), rodrigues(n0, x[4:7])
+        res = []
+        for d in "ab":
+            p_block = ubj_x + rodrigues(block[d], x[1:4])
+            p_body = lbj + rodrigues(body[d], x[4:7])
+            res.append(p_body - p_block - ts * n_block)
+        res.append(n_body - n_block)
+        tro = lbj + rodrigues(hp[outer] - lbj, x[4:7])
+        res.append([np.linalg.norm(tro - hp[inner]) - length])
+        return np.concatenate(res)
+
+    sol = least_squares(residual, np.zeros(7), method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15)
+    assert np.max(np.abs(sol.fun)) < 1e-10, sol.fun
+    x = sol.x
+    moved = {"upper_wishbone_outboard": front + rodrigues(ubj - front, axis * x[0])}
+    on_body = [outer, "axle_inboard", "axle_outboard"]
+    if data.get("actuation", {}).get("mount") == "upright":
+        on_body += [
+            n
+            for n in ("pushrod_outboard", "strut_bottom")
+            if n in hp and not (n == "strut_bottom" and data["actuation"]["type"] != "direct")
+        ]
+    for name in on_body:
+        moved[name] = lbj + rodrigues(hp[name] - lbj, x[4:7])
+    return moved
