@@ -196,30 +196,40 @@ def d_damper_length(ps: PointSet) -> np.ndarray:
     return np.sum(u * (ps.d("strut_top") - ps.d("strut_bottom")), axis=1)
 
 
-def _rocker_arm(ps: PointSet):
-    """Rocker axis û and the arm to pushrod_inboard, now and at design, normal to û."""
+def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return np.sum(a * b, axis=1, keepdims=True)
+
+
+def _rocker_arms(ps: PointSet):
+    """û = unit(b − a), and w, w₀ = pushrod_inboard − a now and at design."""
     a = ps["rocker_axis_a"]
     u = unit(ps["rocker_axis_b"] - a)
-
-    def normal(v):
-        return v - u * np.sum(u * v, axis=1, keepdims=True)
-
-    arm0 = normal(ps.design["pushrod_inboard"] - ps.design["rocker_axis_a"])
-    return u, arm0, normal(ps["pushrod_inboard"] - a), normal
+    w = ps["pushrod_inboard"] - a
+    w0 = ps.design["pushrod_inboard"] - ps.design["rocker_axis_a"]
+    return u, w, w0
 
 
 def rocker_angle(ps: PointSet) -> np.ndarray:
     """s·(rotation of pushrod_inboard about rocker_axis_a→b from design, right-hand rule)."""
-    u, arm0, arm, _ = _rocker_arm(ps)
+    u, w, w0 = _rocker_arms(ps)
+    arm, arm0 = w - u * _dot(u, w), w0 - u * _dot(u, w0)  # both normal to û
     y = np.sum(u * np.cross(arm0, arm), axis=1)
     return ps.s * np.arctan2(y, np.sum(arm0 * arm, axis=1))
 
 
 def d_rocker_angle(ps: PointSet) -> np.ndarray:
-    u, arm0, arm, normal = _rocker_arm(ps)
-    darm = normal(ps.d("pushrod_inboard") - ps.d("rocker_axis_a"))
-    y, x = np.sum(u * np.cross(arm0, arm), axis=1), np.sum(arm0 * arm, axis=1)
-    dy, dx = np.sum(u * np.cross(arm0, darm), axis=1), np.sum(arm0 * darm, axis=1)
+    u, w, w0 = _rocker_arms(ps)
+    du = _d_unit(
+        ps["rocker_axis_b"] - ps["rocker_axis_a"], ps.d("rocker_axis_b") - ps.d("rocker_axis_a")
+    )
+    dw = ps.d("pushrod_inboard") - ps.d("rocker_axis_a")
+    arm, arm0 = w - u * _dot(u, w), w0 - u * _dot(u, w0)
+    darm = dw - u * _dot(u, dw) - du * _dot(u, w) - u * _dot(du, w)
+    darm0 = -du * _dot(u, w0) - u * _dot(du, w0)
+    cross = np.cross(arm0, arm)
+    y, x = np.sum(u * cross, axis=1), np.sum(arm0 * arm, axis=1)
+    dy = np.sum(du * cross + u * (np.cross(darm0, arm) + np.cross(arm0, darm)), axis=1)
+    dx = np.sum(darm0 * arm + arm0 * darm, axis=1)
     return ps.s * _d_atan2(y, x, dy, dx)
 
 

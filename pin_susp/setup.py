@@ -190,8 +190,12 @@ class SetupModel:
             if c.model.existJointName(j)
         ]
         s1 = NewtonSolver(kin, [self.ball, link0], holds1)
-        q1 = self._solve(s1, c.q_design, PARAMETER_KEYS["shim_thickness"],
-                         "the shimmed upright does not assemble")
+        q1 = self._solve(
+            s1,
+            c.q_design,
+            PARAMETER_KEYS["shim_thickness"],
+            "the shimmed upright does not assemble",
+        )
         s1.evaluate(q1)
         j1 = s1.jacobian.copy()
         f1_p = np.zeros((s1.nrows, 3))

@@ -138,3 +138,45 @@ def test_registry_gives_every_column_a_unit_and_label():
     assert len({m.name for m in METRICS}) == len(METRICS)
     for m in METRICS:
         assert m.unit in ("deg", "mm") and m.label and m.function.__doc__
+
+
+@pytest.mark.parametrize("side", ["left", "right"])
+def test_every_metric_derivative_matches_central_differences(side):
+    """d<metric> along arbitrary point velocities, against differences of the metric itself."""
+    from pin_susp.metrics import PointSet
+
+    data = example("pushrod_rocker.yaml")
+    data = mirrored(data) if side == "right" else data
+    corner = pin_susp.Corner(data)
+    s = 1.0 if side == "left" else -1.0
+    pose = corner.solve_pose(
+        [
+            pin_susp.Target("wheel_center", "z", 35.0),
+            pin_susp.Target("trackrod_inboard", "y", 7.0 * s),
+        ]
+    )
+    points = {k: v[None] * 1e-3 for k, v in pose.points.items()}
+    design = {k: v[None] for k, v in corner.design_positions.items()}
+    rng = np.random.default_rng(7)
+    rates = {k: rng.normal(size=(1, 3)) for k in points}
+    h = 1e-7
+    for m in METRICS:
+        if not m.applies(corner.geometry):
+            continue
+        exact = m.derivative(PointSet(points, design, corner.geometry, rates))[0]
+        plus = {k: v + h * rates[k] for k, v in points.items()}
+        minus = {k: v - h * rates[k] for k, v in points.items()}
+        fd = (
+            m.function(PointSet(plus, design, corner.geometry))[0]
+            - m.function(PointSet(minus, design, corner.geometry))[0]
+        ) / (2 * h)
+        assert exact == pytest.approx(fd, rel=1e-6, abs=1e-8), m.name
+
+
+def test_mirrored_pushrod_rocker_corner_gives_the_same_rocker_and_damper():
+    left_geo, sweep = example("pushrod_rocker.yaml"), example("bump_steer.yaml")
+    left = pin_susp.Corner(left_geo).run_sweep(sweep)
+    right = pin_susp.Corner(mirrored(left_geo)).run_sweep(mirrored_sweep(sweep))
+    for name in SIDE_FREE + ("rocker_angle", "damper_length"):
+        np.testing.assert_allclose(right[name], left[name], atol=1e-9, err_msg=name)
+    assert abs(left["rocker_angle"][0]) > 1.0

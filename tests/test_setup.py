@@ -199,11 +199,22 @@ def test_trackrod_adjuster_holds_wheel_centre_height_and_toes_out():
     assert static(data).metrics["roadwheel_angle"] < -0.4
 
 
+def shimmed_pushrod() -> dict:
+    """The pushrod-rocker corner with the shim of the shim example, 25 of 30 mm fitted."""
+    data = example("pushrod_rocker.yaml")
+    data["config"]["camber_shim"] = shimmed(25.0)["config"]["camber_shim"]
+    return data
+
+
 @pytest.mark.parametrize(
-    "example_name", ["camber_shim.yaml", "pushrod_rocker.yaml", "fixed_toe_link.yaml"]
+    "example_name",
+    ["camber_shim.yaml", "pushrod_rocker.yaml", "fixed_toe_link.yaml", "shimmed pushrod"],
 )
 def test_exact_setup_sensitivities_match_central_differences(example_name):
-    g = load_geometry(EXAMPLES / example_name)
+    if example_name == "shimmed pushrod":
+        g = load_geometry(shimmed_pushrod())
+    else:
+        g = load_geometry(EXAMPLES / example_name)
     model = SetupModel(g)
     p0 = setup_values(g) + np.array([0.0, 0.4, 0.6 if g.has_pushrod else 0.0]) * MM
     state = model.state(p0)
