@@ -22,6 +22,7 @@ from .corner import Corner, Results
 from .errors import PinSuspError
 from .export import write_text
 from .geometry import load_geometry
+from .metrics import METRICS
 from .sweep import load_sweep
 
 SHEET_METRICS = (  # column, unit, short heading
@@ -229,19 +230,7 @@ def _summary(results: Results, path) -> None:
         f"max residual {np.nanmax(results['solver_max_residual']):.1e} mm, "
         f"{np.median(results['solver_iterations']):g} iterations per step (median)"
     )
-    rows = [
-        (name, results.units[name])
-        for name in (
-            "wheel_travel",
-            "camber",
-            "roadwheel_angle",
-            "caster",
-            "kpi",
-            "scrub_radius",
-            "mechanical_trail",
-            "half_track",
-        )
-    ]
+    rows = [(m.name, m.unit) for m in METRICS if m.name in results.columns]
     print(f"  {'metric':<18}{'unit':>5}{'first':>12}{'last':>12}{'min':>12}{'max':>12}")
     for name, unit in rows:
         v = results[name]
