@@ -289,9 +289,10 @@ def _setup(args) -> int:
     }
     if args.output and not targets:
         raise PinSuspError("-o writes a solved setup: give --camber, --toe or --ride-height-change")
-    print(f"{geometry.name}: setup sheet ({geometry.source})")
+    title = f"{geometry.name}: setup sheet ({geometry.source})"
     if targets:
         found = setup.solve_setup(geometry, targets)
+        print(title)
         _sheet([found.before, found.after], ["before", "after"])
         print(
             f"  hit {', '.join(f'{k} {v:g}' for k, v in targets.items())} "
@@ -310,6 +311,7 @@ def _setup(args) -> int:
         + ["trackrod"] * len(args.trackrod)
         + ["pushrod"] * len(args.pushrod)
     )
+    print(title)
     _sheet(rows, labels)
     if args.sensitivities:
         _sensitivities(rows[0], geometry, args.thread_pitch)

@@ -304,20 +304,40 @@ def solve_setup(g: Geometry, targets: dict[str, float], max_iterations: int = 25
         if np.max(np.abs(error)) <= 1e-11:
             break
         if steps == max_iterations:
-            raise _unreachable(drawn, targets, p, "Newton did not converge")
+            reached = ", ".join(f"{n} {state.metrics[n]:.4g}" for n in targets)
+            raise _unreachable(
+                drawn, targets, p, f"the adjusters stall (last: {reached} with {_describe(p)})"
+            )
         jac = np.array([[state.derivatives[n][i] for i in free] for n in targets])
-        step = np.linalg.solve(jac, -error) * MM
-        p = p.copy()
-        p[free] += step
         try:
-            state = model.state(p)
-        except InputError:
-            raise _unreachable(drawn, targets, p, "the corner locks up on the way") from None
+            step = np.linalg.solve(jac, -error) * MM
+        except np.linalg.LinAlgError:
+            raise _unreachable(
+                drawn, targets, p, "the adjusters do not move these metrics independently here"
+            ) from None
+        p, state = _step_within_reach(model, p, free, step, drawn, targets)
     if drawn.camber_shim is not None and p[0] < 0.0:
         raise _unreachable(
             drawn, targets, p, f"it needs a shim stack of {p[0] / MM:.3f} mm, thinner than none"
         )
     return InverseResult(with_setup(drawn, p), before, state, steps)
+
+
+def _step_within_reach(model, p, free, step, drawn, targets, halvings: int = 8):
+    """Take the Newton step, halving it while the corner does not assemble."""
+    for _ in range(halvings + 1):
+        trial = p.copy()
+        trial[free] += step
+        try:
+            return trial, model.state(trial)
+        except InputError:
+            step = 0.5 * step
+    raise _unreachable(drawn, targets, trial, "the corner locks up on the way")
+
+
+def _describe(p) -> str:
+    names = ("shim stack", "trackrod delta", "pushrod delta")
+    return ", ".join(f"{n} {v / MM:.3f} mm" for n, v in zip(names, p, strict=True) if v)
 
 
 def _unreachable(g: Geometry, targets: dict, p, why: str) -> InputError:

@@ -284,6 +284,8 @@ def test_inverse_setup_with_ride_height_on_the_pushrod_corner():
 def test_unreachable_camber_says_which_target_and_why():
     with pytest.raises(pin_susp.InputError, match=r"camber -12 not reachable: .*shim stack of -"):
         solve_setup(load_geometry(EXAMPLES / "camber_shim.yaml"), {"camber": -12.0})
+    with pytest.raises(pin_susp.InputError, match="roadwheel_angle 80 not reachable: .*locks up"):
+        solve_setup(load_geometry(EXAMPLES / "camber_shim.yaml"), {"roadwheel_angle": 80.0})
     with pytest.raises(pin_susp.InputError, match="a camber target needs a camber shim"):
         solve_setup(load_geometry(EXAMPLES / "double_wishbone.yaml"), {"camber": -2.0})
 
