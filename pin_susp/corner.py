@@ -18,13 +18,15 @@ from .closures import (
     ContactPatchPoint,
     DistanceClosure,
     FramePoint,
+    JointTarget,
     Kinematics,
     PointTarget,
 )
 from .double_wishbone import corner_tree
 from .errors import InputError
-from .geometry import DERIVED_POINTS, Geometry, hardpoint_names, load_geometry
-from .metrics import Pose, metric_columns, point_columns
+from .geometry import DERIVED_POINTS, Geometry, contact_patch, hardpoint_names, load_geometry, unit
+from .jet import Dual
+from .metrics import HUB_Z, RACK, Pose, metric_columns, point_columns
 from .solver import NewtonSolver, Solution
 from .sweep import Sweep, Target, load_sweep
 from .urdf import read_closures, tree_to_urdf
@@ -88,6 +90,12 @@ class Corner:
         self.mobility = self.model.nv - sum(c.size for c in self.closures)
         self.actuators = ("rack",) if geometry.steering == "rack" else ()
         self.design_positions = self.positions(self.q_design)
+        # The drivers of the derivative columns: wheel-centre z, and the rack.
+        self.drivers = (HUB_Z, RACK) if geometry.steering == "rack" else (HUB_Z,)
+        drive = [PointTarget(self.points["wheel_center"], np.array([0.0, 0.0, 1.0]))]
+        if geometry.steering == "rack":
+            drive.append(JointTarget(self.model, "rack_slide"))
+        self._drive = NewtonSolver(self.kin, self.closures, drive)
 
     def _add_anchor(self, name: str, link: str, offset: np.ndarray) -> FramePoint:
         parent = self.model.frames[self.model.getFrameId(link)]
@@ -99,6 +107,42 @@ class Corner:
         """World position (m) of every named point at configuration q."""
         pin.framesForwardKinematics(self.model, self.kin.data, q)
         return {name: self.points[name].position(self.kin).copy() for name in self.point_names}
+
+    def motion(self, qs: list) -> dict[str, Dual]:
+        """Every named point at each configuration, with its exact rates per driver.
+
+        name → Dual(position (n, 3) m, rates (k, n, 3) m/m) for the k drivers
+        of ``self.drivers``: hub z (wheel-centre z with the rack held) and rack
+        displacement (rack with wheel-centre z held). Each rate column is the
+        tangent of the solution manifold, J·dq = e_j, pushed through the frame
+        Jacobians; the contact patch follows by the chain rule (jet.Dual).
+        A None configuration (a step that did not converge) gives NaN.
+        """
+        n, k = len(qs), len(self.drivers)
+        frames = [name for name in self.point_names if name != "contact_patch_center"]
+        pos = {f: np.full((n, 3), np.nan) for f in frames}
+        rates = {f: np.full((k, n, 3), np.nan) for f in frames}
+        solver = self._drive
+        rhs = np.zeros((solver.nrows, k))
+        rhs[-k:] = np.eye(k)
+        for i, q in enumerate(qs):
+            if q is None:
+                continue
+            solver.evaluate(q)
+            try:
+                tangent = np.linalg.solve(solver.jacobian, rhs)
+            except np.linalg.LinAlgError:  # a toggle position: no unique tangent
+                tangent = np.full((self.model.nv, k), np.nan)
+            for f in frames:
+                point = self.points[f]
+                pos[f][i] = point.position(self.kin)
+                rates[f][:, i] = (point.jacobian(self.kin) @ tangent).T
+        points = {f: Dual(pos[f], rates[f]) for f in frames}
+        axis = unit(points["axle_outboard"] - points["axle_inboard"])
+        points["contact_patch_center"] = contact_patch(
+            points["wheel_center"], axis, self.geometry.wheel.radius
+        )
+        return points
 
     def body_of(self, point: str) -> str:
         return self.points[point].body
@@ -152,8 +196,7 @@ class Corner:
         return Results.from_solutions(self, solutions, sweep)
 
     def _pose(self, solution: Solution) -> Pose:
-        pos = self.positions(solution.q)
-        points = {k: v[None] for k, v in pos.items()}
+        points = self.motion([solution.q])
         design = {k: v[None] for k, v in self.design_positions.items()}
         columns = metric_columns(self.geometry, points, design)
         return Pose(
@@ -161,8 +204,9 @@ class Corner:
             converged=solution.converged,
             iterations=solution.iterations,
             max_residual=solution.max_residual * 1e3,
-            metrics={k: float(v[0]) for k, (v, _) in columns.items()},
-            points={k: v * 1e3 for k, v in pos.items()},
+            metrics={k: float(v[0]) for k, (v, _) in columns.items() if "deriv_" not in k},
+            points={k: p.val[0] * 1e3 for k, p in points.items()},
+            derivatives={k: float(v[0]) for k, (v, _) in columns.items() if "deriv_" in k},
         )
 
     def _check_targets(self, targets: list[Target], source: str) -> None:
@@ -222,15 +266,12 @@ class Results:
             "solver_iterations": "",
         }
         # A step that did not converge has no trustworthy pose: its cells stay empty.
-        points = {name: np.full((n, 3), np.nan) for name in corner.point_names}
-        for i, s in enumerate(solutions):
-            if s.converged:
-                for name, p in corner.positions(s.q).items():
-                    points[name][i] = p
+        points = corner.motion([s.q if s.converged else None for s in solutions])
         design = {k: v[None] for k, v in corner.design_positions.items()}
         for name, (values, unit) in metric_columns(corner.geometry, points, design).items():
             columns[name], units[name] = values, unit
-        for name, (values, unit) in point_columns(corner.point_names, points).items():
+        positions = {name: p.val for name, p in points.items()}
+        for name, (values, unit) in point_columns(corner.point_names, positions).items():
             columns[name], units[name] = values, unit
         meta = {
             "geometry": (corner.geometry.source, corner.geometry.sha256),

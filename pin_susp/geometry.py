@@ -171,11 +171,10 @@ def wheel_down(spin_axis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """d̂ = unit(−Ẑ − ((−Ẑ)·â)â) and the length of the vector before normalising.
 
     World down projected into the wheel plane; the contact patch is R·d̂ from
-    the wheel centre. Works on (3,) or (n, 3).
+    the wheel centre. Works on (3,) or (n, 3), and on jet.Dual points.
     """
     a = spin_axis
-    u = a * a[..., 2:3]
-    u[..., 2] -= 1.0
+    u = a * a[..., 2:3] - np.array([0.0, 0.0, 1.0])
     norm = np.linalg.norm(u, axis=-1, keepdims=True)
     return u / norm, norm
 

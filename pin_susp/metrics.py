@@ -2,11 +2,17 @@
 
 Each function takes a :class:`PointSet` (every named point as an (n, 3)
 array in metres, one row per step) and returns an (n,) array in SI (m,
-rad); NaN where the metric is undefined. The registry ``METRICS`` gives the
-column name, unit, label and the conversion to output units; it alone
-decides which columns a sweep writes and in what order. Definitions and
-signs follow spec/results.md: s = +1 left, −1 right; â = unit(axle_outboard −
-axle_inboard); k̂ = unit(UBJ − LBJ); WC = wheel centre, CP = contact patch.
+rad); NaN where the metric is undefined. The same code runs on
+:class:`~pin_susp.jet.Dual` points and then also returns exact derivatives
+(along the motion, or with respect to a hardpoint): so it indexes with
+``[..., k]`` and reduces over ``axis=-1``.
+
+The registry ``METRICS`` gives each column's name, unit, label, the
+conversion to output units and the drivers it has derivative columns for;
+it alone decides which columns a sweep writes and in what order.
+Definitions and signs follow spec/results.md: s = +1 left, −1 right; â =
+unit(axle_outboard − axle_inboard); k̂ = unit(UBJ − LBJ); WC = wheel centre,
+CP = contact patch.
 """
 
 from __future__ import annotations
@@ -17,281 +23,357 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .geometry import Geometry, unit
+from .jet import Dual, value
 
 STEERING_AXIS_FLAT = 1e-6  # |k_z| below this: the axis never meets the ground
+PARALLEL_PLANES = 1e-12  # |n₁ × n₂|² below this (unit normals): no instant axis
+HUB_Z, RACK = "hub_z", "rack_displacement"
+X, Y, Z = 0, 1, 2
 
 
 @dataclass
 class PointSet:
-    """Solved positions (m) of every named point, design positions, and the geometry.
+    """Solved positions (m) of every named point, design positions, and the geometry."""
 
-    ``rates`` optionally holds a velocity for each point (same shapes): the
-    ``d_<metric>`` functions return the metric's directional derivative
-    along it, exactly (the chain rule written out, no differencing).
-    """
-
-    points: dict[str, np.ndarray]
-    design: dict[str, np.ndarray]
+    points: dict
+    design: dict
     geometry: Geometry
-    rates: dict[str, np.ndarray] | None = None
 
     @property
     def s(self) -> float:
         return self.geometry.sign
 
-    def __getitem__(self, name: str) -> np.ndarray:
+    def __getitem__(self, name: str):
         return self.points[name]
 
-    def d(self, name: str) -> np.ndarray:
-        return self.rates[name]
-
-    def spin_axis(self) -> np.ndarray:
+    def spin_axis(self):
         return unit(self["axle_outboard"] - self["axle_inboard"])
 
-    def d_spin_axis(self) -> np.ndarray:
-        return _d_unit(
-            self["axle_outboard"] - self["axle_inboard"],
-            self.d("axle_outboard") - self.d("axle_inboard"),
-        )
-
-    def steering_axis(self) -> np.ndarray:
+    def steering_axis(self):
         return unit(self["upper_wishbone_outboard"] - self["lower_wishbone_outboard"])
 
-    def d_steering_axis(self) -> np.ndarray:
-        return _d_unit(
-            self["upper_wishbone_outboard"] - self["lower_wishbone_outboard"],
-            self.d("upper_wishbone_outboard") - self.d("lower_wishbone_outboard"),
-        )
-
-    def steering_axis_on_ground(self) -> np.ndarray:
+    def steering_axis_on_ground(self):
         """G = LBJ + t·K, K = UBJ − LBJ, t = (CP_z − LBJ_z)/K_z: the axis at CP height."""
-        lbj, k = self["lower_wishbone_outboard"], self["upper_wishbone_outboard"]
-        k = k - lbj
-        with np.errstate(divide="ignore", invalid="ignore"):
-            t = (self["contact_patch_center"][:, 2] - lbj[:, 2]) / k[:, 2]
-        t[np.abs(unit(k)[:, 2]) < STEERING_AXIS_FLAT] = np.nan
-        return lbj + t[:, None] * k
-
-    def d_steering_axis_on_ground(self) -> np.ndarray:
         lbj = self["lower_wishbone_outboard"]
         k = self["upper_wishbone_outboard"] - lbj
-        dlbj = self.d("lower_wishbone_outboard")
-        dk = self.d("upper_wishbone_outboard") - dlbj
-        h = self["contact_patch_center"][:, 2] - lbj[:, 2]
-        dh = self.d("contact_patch_center")[:, 2] - dlbj[:, 2]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            t = h / k[:, 2]
-            dt = (dh * k[:, 2] - h * dk[:, 2]) / k[:, 2] ** 2
-        return dlbj + dt[:, None] * k + t[:, None] * dk
+        flat = np.abs(unit(k)[..., Z]) < STEERING_AXIS_FLAT
+        kz = np.where(flat, np.nan, k[..., Z])
+        t = (self["contact_patch_center"][..., Z] - lbj[..., Z]) / kz
+        return lbj + t[..., None] * k
+
+    def instant_axis_point(self, axis: int):
+        """Where the wishbone planes' line of intersection crosses the plane through WC
+        normal to ``axis`` (Y: side view, X: front view); NaN when the planes are parallel.
+
+        Solved as two plane equations in the two other coordinates, relative to WC
+        (Cramer's rule; the determinant is a component of n₁ × n₂), so a near-parallel
+        pair gives a large but accurate point.
+        """
+        wc = self["wheel_center"]
+        normals, offsets = [], []
+        for arm in ("upper_wishbone", "lower_wishbone"):
+            front = self[f"{arm}_inboard_front"]
+            n = unit(np.cross(self[f"{arm}_inboard_rear"] - front, self[f"{arm}_outboard"] - front))
+            normals.append(n)
+            offsets.append(np.sum(n * (front - wc), axis=-1))
+        (n1, n2), (d1, d2) = normals, offsets
+        parallel = np.sum(np.cross(n1, n2) ** 2, axis=-1) < PARALLEL_PLANES
+        a, b = (Y, Z) if axis == X else (X, Z)
+        det = n1[..., a] * n2[..., b] - n1[..., b] * n2[..., a]
+        det = np.where(parallel | ~(np.abs(det) > 0.0), np.nan, det)
+        u = (d1 * n2[..., b] - d2 * n1[..., b]) / det
+        v = (n1[..., a] * d2 - n2[..., a] * d1) / det
+        return u + wc[..., a], v + wc[..., b]
 
 
-def _d_unit(v: np.ndarray, dv: np.ndarray) -> np.ndarray:
-    """d(v/|v|) = (dv − â(â·dv))/|v|, rows."""
-    n = np.linalg.norm(v, axis=-1, keepdims=True)
-    a = v / n
-    return (dv - a * np.sum(a * dv, axis=-1, keepdims=True)) / n
-
-
-def _d_atan2(y, x, dy, dx):
-    return (x * dy - y * dx) / (x * x + y * y)
-
-
-def camber(ps: PointSet) -> np.ndarray:
+def camber(ps: PointSet):
     """−atan2(â_z, s·â_y): negative = top of the wheel leans inboard."""
     a = ps.spin_axis()
-    return -np.arctan2(a[:, 2], ps.s * a[:, 1])
+    return -np.arctan2(a[..., Z], ps.s * a[..., Y])
 
 
-def d_camber(ps: PointSet) -> np.ndarray:
-    a, da = ps.spin_axis(), ps.d_spin_axis()
-    return -_d_atan2(a[:, 2], ps.s * a[:, 1], da[:, 2], ps.s * da[:, 1])
-
-
-def caster(ps: PointSet) -> np.ndarray:
+def caster(ps: PointSet):
     """atan2(−k_x, k_z): positive = top of the steering axis rearward."""
     k = ps.steering_axis()
-    return np.arctan2(-k[:, 0], k[:, 2])
+    return np.arctan2(-k[..., X], k[..., Z])
 
 
-def d_caster(ps: PointSet) -> np.ndarray:
-    k, dk = ps.steering_axis(), ps.d_steering_axis()
-    return _d_atan2(-k[:, 0], k[:, 2], -dk[:, 0], dk[:, 2])
-
-
-def kpi(ps: PointSet) -> np.ndarray:
+def kpi(ps: PointSet):
     """atan2(−s·k_y, k_z): positive = top of the steering axis inboard."""
     k = ps.steering_axis()
-    return np.arctan2(-ps.s * k[:, 1], k[:, 2])
+    return np.arctan2(-ps.s * k[..., Y], k[..., Z])
 
 
-def d_kpi(ps: PointSet) -> np.ndarray:
-    k, dk = ps.steering_axis(), ps.d_steering_axis()
-    return _d_atan2(-ps.s * k[:, 1], k[:, 2], -ps.s * dk[:, 1], dk[:, 2])
-
-
-def roadwheel_angle(ps: PointSet) -> np.ndarray:
+def roadwheel_angle(ps: PointSet):
     """atan2(â_x, s·â_y), the toe: positive = toe-in, on each side."""
     a = ps.spin_axis()
-    return np.arctan2(a[:, 0], ps.s * a[:, 1])
+    return np.arctan2(a[..., X], ps.s * a[..., Y])
 
 
-def d_roadwheel_angle(ps: PointSet) -> np.ndarray:
-    a, da = ps.spin_axis(), ps.d_spin_axis()
-    return _d_atan2(a[:, 0], ps.s * a[:, 1], da[:, 0], ps.s * da[:, 1])
-
-
-def _ground_direction(ps: PointSet) -> tuple[np.ndarray, np.ndarray]:
-    flat = np.array([1.0, 1.0, 0.0])
-    return ps.spin_axis() * flat, (ps.d_spin_axis() * flat if ps.rates is not None else None)
-
-
-def scrub_radius(ps: PointSet) -> np.ndarray:
+def scrub_radius(ps: PointSet):
     """−(G − CP)·ŵ, ŵ = unit(â_x, â_y, 0): positive = axis meets the ground inboard of CP."""
-    w = unit(_ground_direction(ps)[0])
-    return -np.sum((ps.steering_axis_on_ground() - ps["contact_patch_center"]) * w, axis=1)
+    w = unit(ps.spin_axis() * np.array([1.0, 1.0, 0.0]))
+    return -np.sum((ps.steering_axis_on_ground() - ps["contact_patch_center"]) * w, axis=-1)
 
 
-def d_scrub_radius(ps: PointSet) -> np.ndarray:
-    h, dh = _ground_direction(ps)
-    w, dw = unit(h), _d_unit(h, dh)
-    gap = ps.steering_axis_on_ground() - ps["contact_patch_center"]
-    dgap = ps.d_steering_axis_on_ground() - ps.d("contact_patch_center")
-    return -np.sum(dgap * w + gap * dw, axis=1)
-
-
-def mechanical_trail(ps: PointSet) -> np.ndarray:
+def mechanical_trail(ps: PointSet):
     """G_x − CP_x: positive = contact patch behind the axis ground point."""
-    return ps.steering_axis_on_ground()[:, 0] - ps["contact_patch_center"][:, 0]
+    return ps.steering_axis_on_ground()[..., X] - ps["contact_patch_center"][..., X]
 
 
-def d_mechanical_trail(ps: PointSet) -> np.ndarray:
-    return ps.d_steering_axis_on_ground()[:, 0] - ps.d("contact_patch_center")[:, 0]
-
-
-def wheel_travel(ps: PointSet) -> np.ndarray:
+def wheel_travel(ps: PointSet):
     """WC_z − WC_z,design: positive = bump."""
-    return ps["wheel_center"][:, 2] - ps.design["wheel_center"][:, 2]
+    return ps["wheel_center"][..., Z] - ps.design["wheel_center"][..., Z]
 
 
-def d_wheel_travel(ps: PointSet) -> np.ndarray:
-    return ps.d("wheel_center")[:, 2]
+def half_track(ps: PointSet):
+    """|CP_y| = s·CP_y."""
+    return ps.s * ps["contact_patch_center"][..., Y]
 
 
-def half_track(ps: PointSet) -> np.ndarray:
-    """|CP_y|."""
-    return np.abs(ps["contact_patch_center"][:, 1])
+def wheel_center_x(ps: PointSet):
+    """WC_x: fore-aft wheel-centre motion (its derivative is the wheel recession)."""
+    return ps["wheel_center"][..., X]
 
 
-def d_half_track(ps: PointSet) -> np.ndarray:
-    return np.sign(ps["contact_patch_center"][:, 1]) * ps.d("contact_patch_center")[:, 1]
-
-
-def damper_length(ps: PointSet) -> np.ndarray:
+def damper_length(ps: PointSet):
     """|strut_top − strut_bottom| (coilover)."""
-    return np.linalg.norm(ps["strut_top"] - ps["strut_bottom"], axis=1)
+    return np.linalg.norm(ps["strut_top"] - ps["strut_bottom"], axis=-1)
 
 
-def d_damper_length(ps: PointSet) -> np.ndarray:
-    u = unit(ps["strut_top"] - ps["strut_bottom"])
-    return np.sum(u * (ps.d("strut_top") - ps.d("strut_bottom")), axis=1)
-
-
-def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return np.sum(a * b, axis=1, keepdims=True)
-
-
-def _rocker_arms(ps: PointSet):
-    """û = unit(b − a), and w, w₀ = pushrod_inboard − a now and at design."""
-    a = ps["rocker_axis_a"]
-    u = unit(ps["rocker_axis_b"] - a)
-    w = ps["pushrod_inboard"] - a
-    w0 = ps.design["pushrod_inboard"] - ps.design["rocker_axis_a"]
-    return u, w, w0
-
-
-def rocker_angle(ps: PointSet) -> np.ndarray:
+def rocker_angle(ps: PointSet):
     """s·(rotation of pushrod_inboard about rocker_axis_a→b from design, right-hand rule)."""
-    u, w, w0 = _rocker_arms(ps)
-    arm, arm0 = w - u * _dot(u, w), w0 - u * _dot(u, w0)  # both normal to û
-    y = np.sum(u * np.cross(arm0, arm), axis=1)
-    return ps.s * np.arctan2(y, np.sum(arm0 * arm, axis=1))
+    u = unit(ps["rocker_axis_b"] - ps["rocker_axis_a"])
+    w = ps["pushrod_inboard"] - ps["rocker_axis_a"]
+    w0 = ps.design["pushrod_inboard"] - ps.design["rocker_axis_a"]
+    arm = w - u * np.sum(u * w, axis=-1, keepdims=True)  # both normal to û
+    arm0 = w0 - u * np.sum(u * w0, axis=-1, keepdims=True)
+    y = np.sum(u * np.cross(arm0, arm), axis=-1)
+    return ps.s * np.arctan2(y, np.sum(arm0 * arm, axis=-1))
 
 
-def d_rocker_angle(ps: PointSet) -> np.ndarray:
-    u, w, w0 = _rocker_arms(ps)
-    du = _d_unit(
-        ps["rocker_axis_b"] - ps["rocker_axis_a"], ps.d("rocker_axis_b") - ps.d("rocker_axis_a")
-    )
-    dw = ps.d("pushrod_inboard") - ps.d("rocker_axis_a")
-    arm, arm0 = w - u * _dot(u, w), w0 - u * _dot(u, w0)
-    darm = dw - u * _dot(u, dw) - du * _dot(u, w) - u * _dot(du, w)
-    darm0 = -du * _dot(u, w0) - u * _dot(du, w0)
-    cross = np.cross(arm0, arm)
-    y, x = np.sum(u * cross, axis=1), np.sum(arm0 * arm, axis=1)
-    dy = np.sum(du * cross + u * (np.cross(darm0, arm) + np.cross(arm0, darm)), axis=1)
-    dx = np.sum(darm0 * arm + arm0 * darm, axis=1)
-    return ps.s * _d_atan2(y, x, dy, dx)
+def svic_x(ps: PointSet):
+    """Side-view instant centre x: instant axis ∩ plane y = WC_y."""
+    return ps.instant_axis_point(Y)[0]
+
+
+def svic_z(ps: PointSet):
+    """Side-view instant centre z."""
+    return ps.instant_axis_point(Y)[1]
+
+
+def fvic_y(ps: PointSet):
+    """Front-view instant centre y: instant axis ∩ plane x = WC_x."""
+    return ps.instant_axis_point(X)[0]
+
+
+def fvic_z(ps: PointSet):
+    """Front-view instant centre z."""
+    return ps.instant_axis_point(X)[1]
+
+
+def svsa_length(ps: PointSet):
+    """SVIC_x − CP_x: positive = instant centre ahead of the contact patch."""
+    return svic_x(ps) - ps["contact_patch_center"][..., X]
+
+
+def fvsa_length(ps: PointSet):
+    """√(dy² + dz²)·(−s·sign(dy)), d = FVIC − CP: positive = FVIC inboard of the CP."""
+    y, z = ps.instant_axis_point(X)
+    cp = ps["contact_patch_center"]
+    dy, dz = y - cp[..., Y], z - cp[..., Z]
+    return np.sqrt(dy * dy + dz * dz) * (-ps.s * np.sign(dy))
+
+
+def svsa_angle(ps: PointSet):
+    """atan((SVIC_z − CP_z)/(SVIC_x − CP_x)), in (−90°, 90°)."""
+    x, z = ps.instant_axis_point(Y)
+    cp = ps["contact_patch_center"]
+    return np.arctan((z - cp[..., Z]) / (x - cp[..., X]))
+
+
+def _wheelbase_over_height(ps: PointSet):
+    """L/h, h = CG_z − CP_z."""
+    g = ps.geometry
+    return g.wheelbase / (g.cg_position[Z] - ps["contact_patch_center"][..., Z])
+
+
+def anti_dive(ps: PointSet):
+    """Front axle: 100·fbb·(L/h)·(SVIC_z − CP_z)/(CP_x − SVIC_x)."""
+    x, z = ps.instant_axis_point(Y)
+    cp = ps["contact_patch_center"]
+    tan = (z - cp[..., Z]) / (cp[..., X] - x)
+    return 100.0 * ps.geometry.front_brake_bias * _wheelbase_over_height(ps) * tan
+
+
+def anti_lift(ps: PointSet):
+    """Rear axle: 100·(1 − fbb)·(L/h)·(SVIC_z − CP_z)/(SVIC_x − CP_x)."""
+    x, z = ps.instant_axis_point(Y)
+    cp = ps["contact_patch_center"]
+    tan = (z - cp[..., Z]) / (x - cp[..., X])
+    return 100.0 * (1.0 - ps.geometry.front_brake_bias) * _wheelbase_over_height(ps) * tan
+
+
+def anti_squat(ps: PointSet):
+    """Driven axle: 100·(L/h)·tanθ, tanθ = (SVIC_z − WC_z)/(WC_x − SVIC_x) front,
+    (SVIC_z − WC_z)/(SVIC_x − WC_x) rear."""
+    x, z = ps.instant_axis_point(Y)
+    wc = ps["wheel_center"]
+    run = wc[..., X] - x if ps.geometry.axle_position == "front" else x - wc[..., X]
+    return 100.0 * _wheelbase_over_height(ps) * (z - wc[..., Z]) / run
 
 
 def _always(g: Geometry) -> bool:
     return True
 
 
+def _anti(axle: str, needs_bias: bool):
+    def applies(g: Geometry) -> bool:
+        have = g.axle_position == axle and g.wheelbase is not None and g.cg_position is not None
+        if needs_bias:
+            return have and g.front_brake_bias is not None
+        return have and g.driven_axle == axle
+
+    return applies
+
+
+def _anti_squat_applies(g: Geometry) -> bool:
+    return g.axle_position is not None and _anti(g.axle_position, False)(g)
+
+
 @dataclass(frozen=True)
 class Metric:
+    """A column: name, output unit, label, function; ``drivers`` it has derivatives for.
+
+    ``applies`` says whether the metric is defined for a corner; ``always_written``
+    columns appear (empty) even where it is not, as spec/results.md asks.
+    """
+
     name: str
-    unit: str  # output unit: "deg" or "mm"
+    unit: str  # "deg", "mm" or "%"
     label: str
     function: Callable[[PointSet], np.ndarray]
-    derivative: Callable[[PointSet], np.ndarray]  # along PointSet.rates
     applies: Callable[[Geometry], bool] = field(default=_always)
+    drivers: tuple[str, ...] = ()
+    always_written: bool = False
+    written: bool = True  # False: a point coordinate, already a column, for its derivative
 
     @property
     def scale(self) -> float:
         """SI → output unit."""
-        return {"deg": 180.0 / np.pi, "mm": 1e3}[self.unit]
+        return {"deg": 180.0 / np.pi, "mm": 1e3, "%": 1.0}[self.unit]
 
 
+BOTH = (HUB_Z, RACK)
 METRICS = (
-    Metric("camber", "deg", "Camber", camber, d_camber),
-    Metric("caster", "deg", "Caster", caster, d_caster),
-    Metric("kpi", "deg", "Kingpin inclination", kpi, d_kpi),
+    Metric("camber", "deg", "Camber", camber, drivers=BOTH),
+    Metric("caster", "deg", "Caster", caster, drivers=BOTH),
+    Metric("kpi", "deg", "Kingpin inclination", kpi, drivers=BOTH),
+    Metric("roadwheel_angle", "deg", "Roadwheel angle (toe, + in)", roadwheel_angle, drivers=BOTH),
+    Metric("scrub_radius", "mm", "Scrub radius", scrub_radius, drivers=BOTH),
+    Metric("mechanical_trail", "mm", "Mechanical trail", mechanical_trail, drivers=BOTH),
+    Metric("wheel_travel", "mm", "Wheel travel (+ bump)", wheel_travel),
+    Metric("half_track", "mm", "Half track", half_track, drivers=BOTH),
     Metric(
-        "roadwheel_angle", "deg", "Roadwheel angle (toe, + in)", roadwheel_angle, d_roadwheel_angle
+        "wheel_center_x", "mm", "Wheel centre x", wheel_center_x, drivers=(HUB_Z,), written=False
     ),
-    Metric("scrub_radius", "mm", "Scrub radius", scrub_radius, d_scrub_radius),
-    Metric("mechanical_trail", "mm", "Mechanical trail", mechanical_trail, d_mechanical_trail),
-    Metric("wheel_travel", "mm", "Wheel travel (+ bump)", wheel_travel, d_wheel_travel),
-    Metric("half_track", "mm", "Half track", half_track, d_half_track),
     Metric(
         "damper_length",
         "mm",
         "Damper length",
         damper_length,
-        d_damper_length,
         lambda g: g.spring == "coilover",
+        drivers=(HUB_Z,),
     ),
     Metric(
-        "rocker_angle", "deg", "Rocker angle", rocker_angle, d_rocker_angle, lambda g: g.has_pushrod
+        "rocker_angle",
+        "deg",
+        "Rocker angle",
+        rocker_angle,
+        lambda g: g.has_pushrod,
+        drivers=(HUB_Z,),
     ),
     Metric(
         "torsion_bar_twist",
         "deg",
         "Torsion bar twist",
         rocker_angle,
-        d_rocker_angle,
         lambda g: g.spring == "torsion_bar",
+        drivers=(HUB_Z,),
     ),
+    Metric("svic_x", "mm", "Side-view IC x", svic_x, always_written=True),
+    Metric("svic_z", "mm", "Side-view IC z", svic_z, always_written=True),
+    Metric("fvic_y", "mm", "Front-view IC y", fvic_y, always_written=True),
+    Metric("fvic_z", "mm", "Front-view IC z", fvic_z, always_written=True),
+    Metric("svsa_length", "mm", "Side-view swing arm length", svsa_length, always_written=True),
+    Metric("fvsa_length", "mm", "Front-view swing arm length", fvsa_length, always_written=True),
+    Metric("svsa_angle", "deg", "Side-view swing arm angle", svsa_angle, always_written=True),
+    Metric("anti_dive", "%", "Anti-dive", anti_dive, _anti("front", True), always_written=True),
+    Metric("anti_lift", "%", "Anti-lift", anti_lift, _anti("rear", True), always_written=True),
+    Metric("anti_squat", "%", "Anti-squat", anti_squat, _anti_squat_applies, always_written=True),
 )
 METRIC_BY_NAME = {m.name: m for m in METRICS}
 
 
-def metric_columns(
-    geometry: Geometry, points: dict[str, np.ndarray], design: dict[str, np.ndarray]
-) -> dict[str, tuple[np.ndarray, str]]:
-    """Every metric that applies to this corner, in output units: name → (values, unit)."""
+@dataclass(frozen=True)
+class Derivative:
+    """A derivative column: d metric / d driver, per mm of hub z or rack travel."""
+
+    metric: Metric
+    driver: str
+
+    @property
+    def name(self) -> str:
+        return f"deriv_{self.metric.name}_wrt_{self.driver}"
+
+    @property
+    def unit(self) -> str:
+        return f"{self.metric.unit}/mm"
+
+    @property
+    def label(self) -> str:
+        return f"d {self.metric.label} / d {'hub z' if self.driver == HUB_Z else 'rack'}"
+
+    @property
+    def scale(self) -> float:
+        """d(SI)/d(m) → output unit per mm."""
+        return self.metric.scale * 1e-3
+
+
+def derivative_columns(g: Geometry) -> list[Derivative]:
+    """Derivative columns of this corner: every applicable metric × its drivers."""
+    drivers = (HUB_Z, RACK) if g.steering == "rack" else (HUB_Z,)
+    return [Derivative(m, d) for d in drivers for m in METRICS if d in m.drivers and m.applies(g)]
+
+
+def metric_columns(geometry: Geometry, points: dict, design: dict) -> dict:
+    """Metric, derivative and motion-ratio columns in output units: name → (values, unit).
+
+    ``points`` are plain (n, 3) arrays, or jet.Duals whose rates have one leading
+    axis per driver of ``derivative_columns(geometry)`` (hub z, then rack); with
+    Duals the derivative columns are included.
+    """
     ps = PointSet(points, design, geometry)
-    return {m.name: (m.function(ps) * m.scale, m.unit) for m in METRICS if m.applies(geometry)}
+    n = np.shape(value(points["wheel_center"]))[:-1]
+    with np.errstate(invalid="ignore", divide="ignore"):  # undefined → NaN → empty cell
+        values = {m.name: m.function(ps) * m.scale for m in METRICS if m.applies(geometry)}
+    out = {}
+    for m in METRICS:
+        if m.name in values and m.written:
+            out[m.name] = (value(values[m.name]), m.unit)
+        elif m.always_written:
+            out[m.name] = (np.full(n, np.nan), m.unit)
+    if not isinstance(points["wheel_center"], Dual):
+        return out
+    drivers = (HUB_Z, RACK) if geometry.steering == "rack" else (HUB_Z,)
+    for d in derivative_columns(geometry):
+        rates = values[d.metric.name].der[drivers.index(d.driver)]
+        out[d.name] = (rates * 1e-3, d.unit)
+    if geometry.spring == "coilover":
+        out["motion_ratio"] = (-out["deriv_damper_length_wrt_hub_z"][0], "mm/mm")
+    elif geometry.spring == "torsion_bar":
+        out["motion_ratio"] = (out["deriv_torsion_bar_twist_wrt_hub_z"][0], "deg/mm")
+    return out
 
 
 def point_columns(names, points: dict[str, np.ndarray]) -> dict[str, tuple[np.ndarray, str]]:
@@ -305,7 +387,7 @@ def point_columns(names, points: dict[str, np.ndarray]) -> dict[str, tuple[np.nd
 
 @dataclass
 class Pose:
-    """One solved pose in output units: metrics (deg, mm) and points (mm)."""
+    """One solved pose in output units: metrics (deg, mm), points (mm), derivatives."""
 
     q: np.ndarray
     converged: bool
@@ -313,3 +395,4 @@ class Pose:
     max_residual: float  # mm
     metrics: dict[str, float]
     points: dict[str, np.ndarray]
+    derivatives: dict[str, float] = field(default_factory=dict)

@@ -28,6 +28,7 @@ import pinocchio as pin
 from .closures import DistanceClosure, JointTarget, PointTarget
 from .errors import InputError
 from .geometry import MM, Geometry
+from .jet import Dual
 from .metrics import METRIC_BY_NAME, PointSet
 from .solver import NewtonSolver
 
@@ -246,19 +247,28 @@ class SetupModel:
         """Static metrics at q₂ and their derivatives: point velocities through the metrics."""
         c = self.corner
         c.kin.update(q2)
-        names = c.point_names
-        pos = {n: np.repeat(c.points[n].position(c.kin)[None], 3, axis=0) for n in names}
-        rates = {n: (c.points[n].jacobian(c.kin) @ dq2).T for n in names}
-        design = {k: v[None] for k, v in c.design_positions.items()}
-        ps = PointSet(pos, design, c.geometry, rates)
+        # Each point as a Dual: position (1, 3), rates (3 parameters, 1, 3).
+        ps = PointSet(
+            {
+                n: Dual(
+                    c.points[n].position(c.kin)[None],
+                    (c.points[n].jacobian(c.kin) @ dq2).T[:, None],
+                )
+                for n in c.point_names
+            },
+            {k: v[None] for k, v in c.design_positions.items()},
+            c.geometry,
+        )
         metrics, derivatives = {}, {}
         for name in STATIC_METRICS:
             m = METRIC_BY_NAME[name]
-            metrics[name] = float(m.function(ps)[0] * m.scale)
-            derivatives[name] = m.derivative(ps) * m.scale * MM  # per mm of each parameter
+            v = m.function(ps) * m.scale
+            metrics[name] = float(v.val[0])
+            derivatives[name] = v.der[:, 0] * MM  # per mm of each parameter
+        cp = ps["contact_patch_center"]
         cp0 = c.design_positions["contact_patch_center"][2]
-        metrics["ride_height_change"] = -(pos["contact_patch_center"][0, 2] - cp0) / MM
-        derivatives["ride_height_change"] = -rates["contact_patch_center"][:, 2]
+        metrics["ride_height_change"] = -(cp.val[0, 2] - cp0) / MM
+        derivatives["ride_height_change"] = -cp.der[:, 0, 2]
         return SetupState(p / MM, metrics, derivatives)
 
 

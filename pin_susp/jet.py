@@ -1,0 +1,206 @@
+"""Forward-mode derivatives of the metric functions: dual numbers over numpy.
+
+A :class:`Dual` is a + ε·b with ε² = 0. Run a metric on points given as
+Duals (position, velocity) and it returns (value, exact derivative along
+that velocity); nest Duals (a Dual whose parts are Duals) and it returns
+exact mixed second derivatives too, e.g. the change of camber gain with a
+hardpoint. The derivative part may carry extra *leading* axes, one per
+direction, so many directions are pushed through at once.
+
+Metric code stays plain numpy: it must index with ``x[..., k]`` and reduce
+with ``axis=-1`` so that the leading direction axes pass through. Only the
+operations the metrics use are defined; anything else raises TypeError.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+class Dual:
+    __array_priority__ = 1000
+
+    def __init__(self, val, der):
+        self.val = val
+        self.der = der
+
+    # -- arithmetic -------------------------------------------------------
+    def __add__(self, other):
+        if isinstance(other, Dual):
+            return Dual(self.val + other.val, self.der + other.der)
+        return Dual(self.val + other, self.der)
+
+    __radd__ = __add__
+
+    def __neg__(self):
+        return Dual(-self.val, -self.der)
+
+    def __sub__(self, other):
+        return self + (-other)
+
+    def __rsub__(self, other):
+        return (-self) + other
+
+    def __mul__(self, other):
+        if isinstance(other, Dual):
+            return Dual(self.val * other.val, self.der * other.val + self.val * other.der)
+        return Dual(self.val * other, self.der * other)
+
+    __rmul__ = __mul__
+
+    def __truediv__(self, other):
+        if isinstance(other, Dual):
+            return self * other._reciprocal()
+        return Dual(self.val / other, self.der / other)
+
+    def __rtruediv__(self, other):
+        return self._reciprocal() * other
+
+    def _reciprocal(self):
+        r = 1.0 / self.val
+        return Dual(r, -self.der * (r * r))
+
+    def __pow__(self, p):
+        if p == 2:
+            return self * self
+        return Dual(self.val**p, self.der * (p * self.val ** (p - 1)))
+
+    def __getitem__(self, index):
+        if not (isinstance(index, tuple) and index and index[0] is Ellipsis):
+            raise TypeError("index a Dual as x[..., k] so that direction axes pass through")
+        return Dual(self.val[index], self.der[index])
+
+    @property
+    def shape(self):
+        return np.shape(value(self))
+
+    def __lt__(self, other):
+        return value(self) < value(other)
+
+    def __gt__(self, other):
+        return value(self) > value(other)
+
+    def __le__(self, other):
+        return value(self) <= value(other)
+
+    def __ge__(self, other):
+        return value(self) >= value(other)
+
+    # -- numpy protocol -----------------------------------------------------
+    def __array_ufunc__(self, ufunc, method, *inputs, **kwargs):
+        if method != "__call__" or kwargs:
+            return NotImplemented
+        rule = _UFUNCS.get(ufunc)
+        if rule is None:
+            raise TypeError(f"pin_susp.jet.Dual does not support numpy.{ufunc.__name__}")
+        return rule(*inputs)
+
+    def __array_function__(self, func, types, args, kwargs):
+        rule = _FUNCTIONS.get(func)
+        if rule is None:
+            raise TypeError(f"pin_susp.jet.Dual does not support {func.__name__}")
+        return rule(*args, **kwargs)
+
+
+def value(x):
+    """The plain value under any nesting of Duals."""
+    while isinstance(x, Dual):
+        x = x.val
+    return x
+
+
+def part(x, *path: str):
+    """A component of a (nested) Dual, e.g. part(m, "der", "val"); 0 for a constant."""
+    for name in path:
+        x = getattr(x, name) if isinstance(x, Dual) else 0.0 * x
+    return x
+
+
+def _split(x):
+    return (x.val, x.der) if isinstance(x, Dual) else (x, 0.0)
+
+
+def _arctan2(y, x):
+    yv, yd = _split(y)
+    xv, xd = _split(x)
+    return Dual(np.arctan2(yv, xv), (xv * yd - yv * xd) / (xv * xv + yv * yv))
+
+
+def _sqrt(x):
+    r = np.sqrt(x.val)
+    return Dual(r, x.der / (2.0 * r))
+
+
+def _sign(x):
+    return np.sign(x.val)
+
+
+def _absolute(x):
+    return Dual(np.abs(x.val), x.der * np.sign(value(x.val)))
+
+
+def _arctan(x):
+    return Dual(np.arctan(x.val), x.der / (1.0 + x.val * x.val))
+
+
+def _isnan(x):
+    return np.isnan(value(x))
+
+
+def _compare(op):
+    return lambda a, b: op(value(a), value(b))
+
+
+_UFUNCS = {
+    np.add: lambda a, b: a + b if isinstance(a, Dual) else b + a,
+    np.subtract: lambda a, b: a - b if isinstance(a, Dual) else -(b - a),
+    np.multiply: lambda a, b: a * b if isinstance(a, Dual) else b * a,
+    np.true_divide: lambda a, b: a / b if isinstance(a, Dual) else b.__rtruediv__(a),
+    np.negative: lambda a: -a,
+    np.square: lambda a: a * a,
+    np.sqrt: _sqrt,
+    np.arctan2: _arctan2,
+    np.arctan: _arctan,
+    np.absolute: _absolute,
+    np.sign: _sign,
+    np.isnan: _isnan,
+    np.isfinite: lambda a: np.isfinite(value(a)),
+    np.less: _compare(np.less),
+    np.greater: _compare(np.greater),
+    np.less_equal: _compare(np.less_equal),
+    np.greater_equal: _compare(np.greater_equal),
+}
+
+
+def _sum(x, axis=None, keepdims=False):
+    if axis is None or axis >= 0:
+        raise TypeError("sum a Dual over axis=-1 (or another negative axis)")
+    xv, xd = _split(x)
+    return Dual(np.sum(xv, axis=axis, keepdims=keepdims), np.sum(xd, axis=axis, keepdims=keepdims))
+
+
+def _cross(a, b):
+    av, ad = _split(a)
+    bv, bd = _split(b)
+    return Dual(np.cross(av, bv), np.cross(ad, bv) + np.cross(av, bd))
+
+
+def _norm(x, axis=None, keepdims=False):
+    if axis is None:
+        raise TypeError("take the norm of a Dual over axis=-1")
+    return np.sqrt(_sum(x * x, axis=axis, keepdims=keepdims))
+
+
+def _where(cond, a, b):
+    cond = value(cond)
+    av, ad = _split(a)
+    bv, bd = _split(b)
+    return Dual(np.where(cond, av, bv), np.where(cond, ad, bd))
+
+
+_FUNCTIONS = {
+    np.sum: _sum,
+    np.cross: _cross,
+    np.linalg.norm: _norm,
+    np.where: _where,
+}
