@@ -52,6 +52,9 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("pin-susp: interrupted, nothing written", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # output piped into `head` and the like
+        sys.stderr.close()
+        return 0
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -170,6 +173,29 @@ def _parser() -> argparse.ArgumentParser:
     )
     t.add_argument("--csv", metavar="OUT.csv", help="also write the sheet's rows as CSV")
     t.set_defaults(run=_setup)
+
+    h = sub.add_parser(
+        "sensitivity",
+        help="exact d(metric)/d(hardpoint coordinate), at design or along a sweep",
+        description="How much each hardpoint coordinate moves each metric and each derivative "
+        "column (camber gain, bump steer, ...): exact, by implicit differentiation of the "
+        "closure equations. Writes a long-format CSV (step_index, metric, hardpoint, axis, "
+        "value, unit) and prints the largest entries per metric.",
+    )
+    h.add_argument("geometry", metavar="GEOMETRY", help="geometry YAML (hardpoints in mm)")
+    h.add_argument(
+        "--sweep", metavar="SWEEP", help="at every step of this sweep (default: the design state)"
+    )
+    h.add_argument("-o", "--output", metavar="SENS.csv", help="long-format CSV")
+    h.add_argument(
+        "--top",
+        type=int,
+        default=3,
+        metavar="N",
+        help="entries per metric in the printed table (default 3)",
+    )
+    h.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
+    h.set_defaults(run=_sensitivity)
     return p
 
 
@@ -366,6 +392,63 @@ def _sheet_csv(rows, labels, path) -> None:
             cells += [format_cell(row.metrics[name]) for name, _, _ in SHEET_METRICS]
             f.write(",".join(cells) + "\n")
     print(f"wrote {path}")
+
+
+def _sensitivity(args) -> int:
+    from .sensitivity import STEP, hardpoint_sensitivities, largest
+
+    corner = Corner(load_geometry(args.geometry))
+    sweep = None
+    if args.sweep:
+        sweep = load_sweep(args.sweep)
+        corner.solver_for(sweep.targets, sweep.source)
+    progress = _progress_bar(sweep.steps if sweep else 1, args.quiet)
+    states = hardpoint_sensitivities(corner, sweep, progress)
+    if args.output:
+        _sensitivity_csv(states, corner, args.output)
+    if args.quiet or not states:
+        return 0
+    s = states[0]
+    where = "design state" if sweep is None else f"step {s.step} of {sweep.source}"
+    print(f"{corner.geometry.name}: hardpoint sensitivities at the {where}")
+    if corner.geometry.drawn is not None:
+        print("  (with respect to the as-set hardpoints: shim and adjusters applied)")
+    for name in s.values:
+        entries = largest(s, name, args.top)
+        if not entries:
+            continue
+        unit = s.units[name].removesuffix("/mm")
+        step = STEP.get(unit, 1.0)
+        print(f"  {name} = {s.metrics[name]:.6g} {unit}")
+        for hardpoint, axis, value in entries:
+            move = step / value
+            print(
+                f"    {hardpoint + ' ' + axis:34} {value:+.4g} {unit}/mm"
+                f"   (to change it by +{step:g} {unit}, move {move:+.3g} mm)"
+            )
+    if args.output:
+        print(
+            f"wrote {args.output}: {len(states)} state(s) x {len(s.values)} metrics x "
+            f"{3 * len(s.hardpoints)} hardpoint coordinates"
+        )
+    return 0
+
+
+def _sensitivity_csv(states, corner, path) -> None:
+    from .export import atomic_write, format_cell
+
+    with atomic_write(path) as f:
+        f.write(f"# pin_susp {__version__} hardpoint sensitivities of {corner.geometry.source}\n")
+        f.write("# value = d(metric)/d(hardpoint coordinate), per mm of the coordinate\n")
+        f.write("step_index,metric,hardpoint,axis,value,unit\n")
+        for s in states:
+            for name, values in s.values.items():
+                for i, hardpoint in enumerate(s.hardpoints):
+                    for a, axis in enumerate("xyz"):
+                        f.write(
+                            f"{s.step},{name},{hardpoint},{axis},"
+                            f"{format_cell(values[i, a])},{s.units[name]}\n"
+                        )
 
 
 if __name__ == "__main__":

@@ -51,40 +51,37 @@ class FramePoint:
 class ContactPatchPoint:
     """CP = WC + R·d̂(â): the lowest point of the tyre disc; not fixed to a body.
 
-    Its Jacobian is the chain rule through d̂: with u = −Ẑ + a_z·â and
-    dâ = ω × â, du = (dâ·Ẑ)·â + a_z·dâ and dd̂ = (I − d̂d̂ᵀ)·du / |u|.
+    Its Jacobian is the chain rule through â = unit(AO − AI) and d̂: with
+    u = −Ẑ + a_z·â, du = (dâ·Ẑ)·â + a_z·dâ and dd̂ = (I − d̂d̂ᵀ)·du / |u|.
     """
 
     body = "upright"
 
     def __init__(
-        self,
-        name: str,
-        center: FramePoint,
-        axle_in: FramePoint,
-        axle_out: FramePoint,
-        radius: float,
+        self, name: str, center: FramePoint, axle_in: FramePoint, axle_out: FramePoint, radius
     ):
         self.name = name
         self.center, self.axle_in, self.axle_out = center, axle_in, axle_out
         self.radius = radius
 
-    def _axis(self, kin: Kinematics) -> np.ndarray:
-        a = self.axle_out.position(kin) - self.axle_in.position(kin)
-        return a / np.linalg.norm(a)
-
     def position(self, kin: Kinematics) -> np.ndarray:
-        down, _ = wheel_down(self._axis(kin))
+        a = self.axle_out.position(kin) - self.axle_in.position(kin)
+        down, _ = wheel_down(a / np.linalg.norm(a))
         return self.center.position(kin) + self.radius * down
 
     def jacobian(self, kin: Kinematics) -> np.ndarray:
-        a = self._axis(kin)
+        v = self.axle_out.position(kin) - self.axle_in.position(kin)
+        n = np.linalg.norm(v)
+        a = v / n
         down, norm = wheel_down(a)
-        j = kin.frame_jacobian(self.center.frame_id)
-        da = -pin.skew(a) @ j[3:]  # ω × â, for each column
+        da = (
+            (np.eye(3) - np.outer(a, a))
+            @ (self.axle_out.jacobian(kin) - self.axle_in.jacobian(kin))
+            / n
+        )
         du = np.outer(a, da[2]) + a[2] * da
         dd = (np.eye(3) - np.outer(down, down)) @ du / norm
-        return j[:3] + self.radius * dd
+        return self.center.jacobian(kin) + self.radius * dd
 
 
 class BallClosure:

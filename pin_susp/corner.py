@@ -268,11 +268,11 @@ class Results:
         # A step that did not converge has no trustworthy pose: its cells stay empty.
         points = corner.motion([s.q if s.converged else None for s in solutions])
         design = {k: v[None] for k, v in corner.design_positions.items()}
-        for name, (values, unit) in metric_columns(corner.geometry, points, design).items():
-            columns[name], units[name] = values, unit
+        for name, (values, column_unit) in metric_columns(corner.geometry, points, design).items():
+            columns[name], units[name] = values, column_unit
         positions = {name: p.val for name, p in points.items()}
-        for name, (values, unit) in point_columns(corner.point_names, positions).items():
-            columns[name], units[name] = values, unit
+        for name, (values, column_unit) in point_columns(corner.point_names, positions).items():
+            columns[name], units[name] = values, column_unit
         meta = {
             "geometry": (corner.geometry.source, corner.geometry.sha256),
             "sweep": (sweep.source, sweep.sha256),

@@ -46,14 +46,21 @@ def corner_tree(g: Geometry) -> Tree:
     bodies = [
         Body("chassis"),
         Body("lower_wishbone", "chassis", _pivot("lower_wishbone", p)),
-        Body("upright", "lower_wishbone", Joint("lower_ball_joint", "ball", lbj)),
+        Body(
+            "upright",
+            "lower_wishbone",
+            Joint("lower_ball_joint", "ball", lbj, defined_by=("lower_wishbone_outboard",)),
+        ),
         Body("upper_wishbone", "chassis", _pivot("upper_wishbone", p)),
     ]
     if g.steering == "rack":
         bodies.append(Body("rack", "chassis", Joint("rack_slide", "prismatic", p[inner], Y)))
     if g.has_pushrod:
         a, b = p["rocker_axis_a"], p["rocker_axis_b"]
-        bodies.append(Body("rocker", "chassis", Joint("rocker_pivot", "revolute", a, unit(b - a))))
+        pivot = Joint(
+            "rocker_pivot", "revolute", a, unit(b - a), ("rocker_axis_a", "rocker_axis_b")
+        )
+        bodies.append(Body("rocker", "chassis", pivot))
 
     body_of = {
         "lower_wishbone_inboard_front": "chassis",
@@ -77,16 +84,22 @@ def corner_tree(g: Geometry) -> Tree:
     points = {name: (body, p[name]) for name, body in body_of.items()}
 
     closures = [
-        Closure("upper_ball_joint", "ball", (("upper_wishbone_outboard", ubj), ("upright", ubj))),
+        Closure(
+            "upper_ball_joint",
+            "ball",
+            (("upper_wishbone_outboard", ubj), ("upright", ubj)),
+            ("upper_wishbone_outboard", "upper_wishbone_outboard"),
+        ),
         Closure(
             "trackrod" if g.steering == "rack" else "toe_link",
             "distance",
             ((inner, p[inner]), (outer, p[outer])),
+            (inner, outer),
         ),
     ]
     if g.has_pushrod:
         ends = ("pushrod_outboard", "pushrod_inboard")
-        closures.append(Closure("pushrod", "distance", tuple((n, p[n]) for n in ends)))
+        closures.append(Closure("pushrod", "distance", tuple((n, p[n]) for n in ends), ends))
     return Tree(
         name=_xml_name(g.name),
         bodies=bodies,
@@ -112,7 +125,13 @@ def upright_mounts(g: Geometry) -> dict[str, str]:
 def _pivot(arm: str, p: dict[str, np.ndarray]) -> Joint:
     front = p[f"{arm}_inboard_front"]
     axis = unit(p[f"{arm}_inboard_rear"] - front)
-    return Joint(f"{arm}_pivot", "revolute", front, axis)
+    return Joint(
+        f"{arm}_pivot",
+        "revolute",
+        front,
+        axis,
+        (f"{arm}_inboard_front", f"{arm}_inboard_rear"),
+    )
 
 
 def _visuals(g: Geometry, p: dict[str, np.ndarray], body_of: dict[str, str]) -> list[Visual]:

@@ -37,6 +37,9 @@ class Joint:
     kind: str  # "revolute" | "prismatic" | "ball"
     origin: np.ndarray
     axis: np.ndarray | None = None
+    # The hardpoints that place it: (origin,) for a ball, (origin, axis end) for
+    # a revolute whose axis runs origin → axis end. Used for hardpoint sensitivities.
+    defined_by: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -57,6 +60,7 @@ class Closure:
     name: str
     kind: str
     anchors: tuple[tuple[str, np.ndarray], tuple[str, np.ndarray]]
+    points: tuple[str, str] = ()  # the named points the anchors sit at
 
 
 @dataclass(frozen=True)

@@ -168,8 +168,10 @@ def test_every_metric_derivative_matches_central_differences(side):
         exact = m.function(PointSet(dual, design, corner.geometry)).der[0]
         plus = {k: v + h * rates[k] for k, v in points.items()}
         minus = {k: v - h * rates[k] for k, v in points.items()}
-        fd = (m.function(PointSet(plus, design, corner.geometry))[0]
-              - m.function(PointSet(minus, design, corner.geometry))[0]) / (2 * h)
+        fd = (
+            m.function(PointSet(plus, design, corner.geometry))[0]
+            - m.function(PointSet(minus, design, corner.geometry))[0]
+        ) / (2 * h)
         assert exact == pytest.approx(fd, rel=1e-6, abs=1e-8), m.name
 
 
