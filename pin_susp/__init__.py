@@ -23,6 +23,7 @@ from .corner import Corner, Results  # noqa: E402
 from .errors import InputError, PinSuspError  # noqa: E402
 from .geometry import Geometry, load_geometry  # noqa: E402
 from .metrics import METRICS, Pose  # noqa: E402
+from .sensitivity import hardpoint_sensitivities  # noqa: E402
 from .setup import SetupModel, apply_setup, setup_sheet, solve_setup  # noqa: E402
 from .sweep import Sweep, Target, load_sweep  # noqa: E402
 
@@ -39,6 +40,7 @@ __all__ = [
     "Target",
     "load_geometry",
     "apply_setup",
+    "hardpoint_sensitivities",
     "load_sweep",
     "setup_sheet",
     "solve_setup",
