@@ -256,16 +256,22 @@ def _summary(results: Results, path) -> None:
         f"max residual {np.nanmax(results['solver_max_residual']):.1e} mm, "
         f"{np.median(results['solver_iterations']):g} iterations per step (median)"
     )
-    rows = [(m.name, m.unit) for m in METRICS if m.name in results.columns]
-    print(f"  {'metric':<18}{'unit':>5}{'first':>12}{'last':>12}{'min':>12}{'max':>12}")
-    for name, unit in rows:
+    names = [m.name for m in METRICS if m.written and m.name in results.columns]
+    names += [
+        n
+        for n in ("deriv_camber_wrt_hub_z", "deriv_roadwheel_angle_wrt_hub_z", "motion_ratio")
+        if n in results.columns
+    ]
+    print(f"  {'metric':<32}{'unit':>7}{'first':>13}{'last':>13}{'min':>13}{'max':>13}")
+    for name in names:
         v = results[name]
         if np.all(np.isnan(v)):
             continue
         print(
-            f"  {name:<18}{unit:>5}{v[0]:>12.4f}{v[-1]:>12.4f}"
-            f"{np.nanmin(v):>12.4f}{np.nanmax(v):>12.4f}"
+            f"  {name:<32}{results.units[name]:>7}{v[0]:>13.6g}{v[-1]:>13.6g}"
+            f"{np.nanmin(v):>13.6g}{np.nanmax(v):>13.6g}"
         )
+    print("  (every column, derivatives included, is in the CSV)")
 
 
 def _report_failures(results: Results) -> int:
