@@ -79,6 +79,7 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("sweep", metavar="SWEEP", help="sweep YAML (targets per step)")
     s.add_argument("-o", "--output", required=True, metavar="OUT.csv", help="results CSV")
     s.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
+    s.add_argument("--plot", metavar="OUT.png", help="also draw the standard kinematics report")
     s.set_defaults(run=_sweep)
 
     u = sub.add_parser(
@@ -196,6 +197,44 @@ def _parser() -> argparse.ArgumentParser:
     )
     h.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
     h.set_defaults(run=_sensitivity)
+
+    pl = sub.add_parser(
+        "plot",
+        help="standard kinematics report from results CSVs (one panel per metric)",
+        description="Camber, toe, caster, KPI, scrub, trail, half track (and instant centres, "
+        "anti geometry, motion ratio, camber gain and bump steer where present) against wheel "
+        "travel, or rack position for a steer sweep. Several CSVs compare designs.",
+    )
+    pl.add_argument("results", nargs="+", metavar="RESULTS.csv", help="pin-susp sweep output")
+    pl.add_argument(
+        "-o", "--output", required=True, metavar="OUT.png", help="image (png, pdf, svg)"
+    )
+    pl.set_defaults(run=_plot)
+
+    dr = sub.add_parser(
+        "draw",
+        help="front and side view drawing of a corner",
+        description="Draw GEOMETRY at its design (as-set) state in front and side view; a "
+        "shimmed corner shows its drawn geometry dashed.",
+    )
+    dr.add_argument("geometry", metavar="GEOMETRY", help="geometry YAML (hardpoints in mm)")
+    dr.add_argument(
+        "-o", "--output", required=True, metavar="OUT.png", help="image (png, pdf, svg)"
+    )
+    dr.set_defaults(run=_draw)
+
+    v = sub.add_parser(
+        "view",
+        help="3D view in meshcat (live, or a self-contained HTML replay)",
+        description="Open GEOMETRY in a meshcat scene served locally (works offline) and print "
+        "its URL; with SWEEP, play the solved motion as an animation. --html writes the scene "
+        "and animation as one HTML file that opens in a browser with no server.",
+    )
+    v.add_argument("geometry", metavar="GEOMETRY", help="geometry YAML (hardpoints in mm)")
+    v.add_argument("sweep", metavar="SWEEP", nargs="?", help="sweep YAML to animate")
+    v.add_argument("--html", metavar="OUT.html", help="write a self-contained replay and exit")
+    v.add_argument("--fps", type=float, default=10.0, help="animation frames per second")
+    v.set_defaults(run=_view)
     return p
 
 
@@ -214,8 +253,14 @@ def _sweep(args) -> int:
     corner.solver_for(sweep.targets, sweep.source)  # target errors before any work
     results = corner.run_sweep(sweep, progress=_progress_bar(sweep.steps, args.quiet))
     results.to_csv(args.output)
+    if args.plot:
+        from .plots import ResultsFile, report_figure, save_figure
+
+        save_figure(report_figure([ResultsFile(args.output)]), args.plot)
     if not args.quiet:
         _summary(results, args.output)
+        if args.plot:
+            print(f"wrote {args.plot}")
     return _report_failures(results)
 
 
@@ -240,13 +285,43 @@ def _demo(args) -> int:
     corner = Corner(load_geometry(geometry_path))
     sweep = load_sweep(sweep_path)
     results = corner.run_sweep(sweep, progress=_progress_bar(sweep.steps, False))
-    write_text(corner.urdf, out / "demo_corner.urdf")
-    results.to_csv(out / "demo_results.csv")
+    files = {
+        "results": out / "demo_results.csv",
+        "plots": out / "demo_report.png",
+        "drawing": out / "demo_drawing.png",
+        "3D replay": out / "demo_replay.html",
+        "URDF": out / "demo_corner.urdf",
+    }
+    write_text(corner.urdf, files["URDF"])
+    results.to_csv(files["results"])
+    _demo_pictures(corner, results, files)
     print(f"pin_susp demo: {corner.geometry.name}, {sweep.steps}-step bump + steer sweep")
-    _summary(results, out / "demo_results.csv")
-    print(f"  geometry {geometry_path}\n  sweep    {sweep_path}")
-    print(f"  URDF     {out / 'demo_corner.urdf'}")
+    _summary(results, files["results"])
+    for what, path in [("geometry", geometry_path), ("sweep", sweep_path), *files.items()]:
+        print(f"  {what:<10} {path}")
+    print(
+        f"open {files['3D replay']} in a browser to see the corner move; "
+        f"{files['plots']} has the standard plots"
+    )
     return _report_failures(results)
+
+
+def _demo_pictures(corner, results, files) -> None:
+    import contextlib
+    import io
+
+    from .plots import ResultsFile, drawing_figure, report_figure, save_figure
+    from .viz import CornerScene
+
+    save_figure(report_figure([ResultsFile(files["results"])]), files["plots"])
+    save_figure(drawing_figure(corner), files["drawing"])
+    with contextlib.redirect_stdout(io.StringIO()):  # meshcat announces its server
+        scene = CornerScene(corner)
+    try:
+        scene.animate(list(results.meta["q"]))
+        write_text(scene.html(), files["3D replay"])
+    finally:
+        scene.close()
 
 
 def _summary(results: Results, path) -> None:
@@ -455,6 +530,66 @@ def _sensitivity_csv(states, corner, path) -> None:
                             f"{s.step},{name},{hardpoint},{axis},"
                             f"{format_cell(values[i, a])},{s.units[name]}\n"
                         )
+
+
+def _plot(args) -> int:
+    from .plots import ResultsFile, report_figure, save_figure
+
+    files = [ResultsFile(path) for path in args.results]
+    save_figure(report_figure(files), args.output)
+    print(f"wrote {args.output}")
+    return 0
+
+
+def _draw(args) -> int:
+    from .plots import drawing_figure, save_figure
+
+    save_figure(drawing_figure(Corner(load_geometry(args.geometry))), args.output)
+    print(f"wrote {args.output}")
+    return 0
+
+
+def _view(args) -> int:
+    import contextlib
+    import io
+    import time
+
+    from .viz import CornerScene
+
+    corner = Corner(load_geometry(args.geometry))
+    qs = None
+    if args.sweep:
+        sweep = load_sweep(args.sweep)
+        corner.solver_for(sweep.targets, sweep.source)
+        results = corner.run_sweep(sweep, progress=_progress_bar(sweep.steps, False))
+        qs = [
+            q if ok else None
+            for q, ok in zip(results.meta["q"], results["solver_converged"], strict=True)
+        ]
+    quiet = io.StringIO()
+    with contextlib.redirect_stdout(quiet):  # meshcat announces its server on stdout
+        scene = CornerScene(corner)
+    try:
+        frames = scene.animate(qs, fps=args.fps) if qs is not None else 0
+        if args.html:
+            write_text(scene.html(), args.html)
+            print(f"wrote {args.html}" + (f" ({frames} frames)" if frames else ""))
+            return 0
+        print(
+            f"meshcat: {scene.viewer.url()}"
+            + (f"  ({frames} frames: press play in Open Controls > Animations)" if frames else "")
+        )
+        print("serving; press Ctrl+C to stop", flush=True)
+        while True:
+            time.sleep(0.5)
+    except KeyboardInterrupt:
+        print("stopped")
+        return 0
+    finally:
+        try:
+            scene.close()
+        except KeyboardInterrupt:  # a second Ctrl+C while the server stops
+            pass
 
 
 if __name__ == "__main__":

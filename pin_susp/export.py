@@ -20,8 +20,8 @@ from .errors import PinSuspError
 
 
 @contextmanager
-def atomic_write(path: str | Path):
-    """Open a text file for writing that appears at ``path`` only when complete."""
+def atomic_write(path: str | Path, binary: bool = False):
+    """Open a file for writing that appears at ``path`` only when complete."""
     path = Path(path)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -29,12 +29,19 @@ def atomic_write(path: str | Path):
     except OSError as exc:
         raise PinSuspError(f"{path}: cannot write here ({exc.strerror})") from None
     try:
-        with os.fdopen(fd, "w", newline="") as f:
+        with os.fdopen(fd, "wb") if binary else os.fdopen(fd, "w", newline="") as f:
             yield f
+        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes it private; files are not
         os.replace(tmp, path)
     except BaseException:
         os.unlink(tmp)
         raise
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
 
 
 def format_cell(value) -> str:

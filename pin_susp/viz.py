@@ -63,7 +63,6 @@ class CornerScene:
     def __init__(self, corner, viewer=None):
         import meshcat
         import meshcat.geometry as mg
-        from pinocchio.visualize import MeshcatVisualizer
 
         self.corner = corner
         self.viewer = viewer if viewer is not None else meshcat.Visualizer()
@@ -152,3 +151,10 @@ class CornerScene:
     def html(self) -> str:
         """The scene (and animation) as one self-contained HTML page."""
         return self.viewer.static_html()
+
+    def close(self) -> None:
+        """Stop the meshcat server this scene started."""
+        proc = getattr(self.viewer.window, "server_proc", None)
+        if proc is not None and proc.poll() is None:
+            proc.terminate()
+            proc.wait(timeout=10)
