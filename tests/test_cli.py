@@ -98,9 +98,16 @@ def test_unconverged_step_is_flagged_with_empty_cells_and_exit_1(tmp_path, capsy
 
 def test_demo_writes_results(tmp_path, capsys):
     assert main(["demo", "-o", str(tmp_path / "d")]) == 0
-    assert (tmp_path / "d" / "demo_results.csv").exists()
-    assert (tmp_path / "d" / "demo_corner.urdf").exists()
-    assert "41 converged" in capsys.readouterr().out
+    for name in (
+        "demo_results.csv",
+        "demo_corner.urdf",
+        "demo_report.png",
+        "demo_drawing.png",
+        "demo_replay.html",
+    ):
+        assert (tmp_path / "d" / name).stat().st_size > 1000, name
+    out = capsys.readouterr().out
+    assert "41 converged" in out and "demo_replay.html in a browser" in out
 
 
 def test_embedded_demo_files_are_the_examples():
