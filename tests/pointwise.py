@@ -1,15 +1,12 @@
-"""An independent formulation of a double-wishbone corner, for cross-checks.
+"""Independent computations for cross-checks.
 
-Unknowns are the coordinates of the moving hardpoints (and the rack
-displacement); constraints are rigid-body distances between hardpoints;
-scipy's least_squares solves them. It shares no code with pin_susp: the
-derived points, the shim assembly and the metrics are written again here
-from spec/geometry.md, spec/results.md and the reference article.
+``PointwiseCorner`` wraps pin_susp.pointwise — hardpoint coordinates as
+unknowns, rigid distances, scipy least_squares — which shares no kinematics
+with the Pinocchio path. The shim assembly and the metrics are written again
+here from the reference article and spec/results.md.
 """
 
 from __future__ import annotations
-
-import itertools
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -20,127 +17,28 @@ def _vec(v) -> np.ndarray:
 
 
 class PointwiseCorner:
-    """Hardpoints in mm, as in the file; solutions in mm."""
+    """pin_susp.pointwise (points as unknowns, scipy) with a mm interface for the tests."""
 
     def __init__(self, data: dict, hardpoints: dict | None = None):
-        hp = hardpoints or {k: _vec(v) for k, v in data["hardpoints"].items()}
-        config = data["config"]
-        steering = config.get("steering", {}).get("type", "rack")
-        actuation = data.get("actuation", {}).get("type", "direct")
-        mount = data.get("actuation", {}).get("mount", "lower_wishbone")
-        spring = data.get("spring", {}).get("type", "none")
-        self.inner, self.outer = (
-            ("trackrod_inboard", "trackrod_outboard")
-            if steering == "rack"
-            else ("toe_link_inboard", "toe_link_outboard")
-        )
-        bodies = {
-            "lower_wishbone": [
-                "lower_wishbone_inboard_front",
-                "lower_wishbone_inboard_rear",
-                "lower_wishbone_outboard",
-            ],
-            "upper_wishbone": [
-                "upper_wishbone_inboard_front",
-                "upper_wishbone_inboard_rear",
-                "upper_wishbone_outboard",
-            ],
-            "upright": [
-                "lower_wishbone_outboard",
-                "upper_wishbone_outboard",
-                self.outer,
-                "axle_inboard",
-                "axle_outboard",
-            ],
-        }
-        fixed = {n for n in hp if "inboard_front" in n or "inboard_rear" in n}
-        fixed |= {"strut_top", "rocker_axis_a", "rocker_axis_b", self.inner}
-        self.links = [(self.outer, self.inner)]
-        if actuation == "pushrod_rocker":
-            bodies[mount].append("pushrod_outboard")
-            bodies["rocker"] = ["rocker_axis_a", "rocker_axis_b", "pushrod_inboard"]
-            if spring == "coilover":
-                bodies["rocker"].append("strut_bottom")
-            self.links.append(("pushrod_outboard", "pushrod_inboard"))
-        elif spring == "coilover":
-            bodies[mount].append("strut_bottom")
-        self.moving = sorted({n for pts in bodies.values() for n in pts} - fixed)
-        self.column = {n: 3 * i for i, n in enumerate(self.moving)}
-        self.rack = 3 * len(self.moving)
-        self.pairs = [
-            (a, b, np.linalg.norm(hp[a] - hp[b]))
-            for pts in bodies.values()
-            for a, b in itertools.combinations(pts, 2)
-            if not (a in fixed and b in fixed)
-        ]
-        self.pairs += [(a, b, np.linalg.norm(hp[a] - hp[b])) for a, b in self.links]
-        self.hp = hp
-        self.s = 1.0 if data.get("side", "left") == "left" else -1.0
-        tire = config["wheel"]["tire"]
-        self.offset = config["wheel"].get("offset", 0.0)
-        self.width = tire["section_width"]
-        self.radius = tire["rim_diameter"] * 25.4 / 2 + tire["aspect_ratio"] * tire["section_width"]
-        self.x = np.concatenate([hp[n] for n in self.moving] + [[0.0]])
+        from pin_susp.geometry import load_geometry
+        from pin_susp.pointwise import PointwiseCorner as Points
 
-    def points(self, x) -> dict[str, np.ndarray]:
-        out = dict(self.hp)
-        out.update({n: x[c : c + 3] for n, c in self.column.items()})
-        out[self.inner] = self.hp[self.inner] + np.array([0.0, x[self.rack], 0.0])
-        a = out["axle_outboard"] - out["axle_inboard"]
-        a = a / np.linalg.norm(a)
-        wc = out["axle_outboard"] - self.offset * a
-        down = np.array([0.0, 0.0, -1.0]) + a[2] * a
-        down = down / np.linalg.norm(down)
-        out.update(
-            axle_midpoint=0.5 * (out["axle_inboard"] + out["axle_outboard"]),
-            wheel_center=wc,
-            wheel_inboard=wc - 0.5 * self.width * a,
-            wheel_outboard=wc + 0.5 * self.width * a,
-            contact_patch_center=wc + self.radius * down,
-        )
-        return out
-
-    def residual(self, x, wc_z, rack):
-        p = self.points(x)
-        res = [np.linalg.norm(p[a] - p[b]) - d for a, b, d in self.pairs]
-        res.append(p["wheel_center"][2] - wc_z)
-        res.append(x[self.rack] - rack)
-        return np.array(res)
-
-    def jacobian(self, x, wc_z, rack):
-        p = self.points(x)
-        J = np.zeros((len(self.pairs) + 2, len(x)))
-        for row, (a, b, _) in enumerate(self.pairs):
-            u = (p[a] - p[b]) / np.linalg.norm(p[a] - p[b])
-            for name, sign in ((a, 1.0), (b, -1.0)):
-                if name in self.column:
-                    J[row, self.column[name] : self.column[name] + 3] += sign * u
-                elif name == self.inner:
-                    J[row, self.rack] += sign * u[1]
-        v = p["axle_outboard"] - p["axle_inboard"]
-        n = np.linalg.norm(v)
-        a = v / n
-        da_dz = ((np.eye(3) - np.outer(a, a)) / n)[2]  # d â_z / d(AO − AI)
-        ao, ai = self.column["axle_outboard"], self.column["axle_inboard"]
-        J[-2, ao : ao + 3] = np.array([0, 0, 1.0]) - self.offset * da_dz
-        J[-2, ai : ai + 3] = self.offset * da_dz
-        J[-1, self.rack] = 1.0
-        return J
+        si = None if hardpoints is None else {k: v * 1e-3 for k, v in hardpoints.items()}
+        self.points_model = Points(load_geometry(data), si)
+        self.hp = {k: v * 1e3 for k, v in self.points_model.hp.items()}
 
     def solve(self, wc_z: float, rack: float, x0=None):
         """Wheel centre z (absolute, mm) and rack displacement (mm)."""
-        x0 = self.x if x0 is None else x0
-        sol = least_squares(
-            self.residual,
-            x0,
-            jac=self.jacobian,
-            args=(wc_z, rack),
-            method="lm",
-            xtol=1e-15,
-            ftol=1e-15,
-            gtol=1e-15,
-        )
-        return sol.x, float(np.max(np.abs(sol.fun)))
+        m = self.points_model
+        targets = [("wheel_center", np.array([0.0, 0.0, 1.0]), wc_z * 1e-3)]
+        if m.rack is not None:
+            tri_y = m.hp[m.inner][1]
+            targets.append((m.inner, np.array([0.0, 1.0, 0.0]), tri_y + rack * 1e-3))
+        x, residual = m.solve(targets, x0)
+        return x, residual * 1e3
+
+    def points(self, x) -> dict[str, np.ndarray]:
+        return {k: v * 1e3 for k, v in self.points_model.points(x).items()}
 
 
 def spec_metrics(p: dict[str, np.ndarray], s: float) -> dict[str, float]:

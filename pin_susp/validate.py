@@ -1,0 +1,188 @@
+"""Cross-validation: every step re-solved by engines that share no kinematics with ours.
+
+- ``mujoco``: the exported MJCF in MuJoCo — its own forward kinematics,
+  equality-constraint Jacobians (``efc_J``/``efc_pos``), site Jacobians and
+  ``mj_integratePos``, driven by Newton to the same targets;
+- ``pointwise``: hardpoints as unknowns, rigid distances, scipy least_squares.
+
+Each engine starts every step from the design state (no warm start), so a
+step is checked on its own. The metrics are then computed from each engine's
+points and compared with pin_susp's, metric by metric and point by point.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .closures import ContactPatchPoint
+from .metrics import metric_columns
+from .pointwise import PointwiseCorner
+
+TOLERANCE = 1e-6  # mm and deg
+# Instant centres of nearly parallel wishbones lie kilometres away, where a
+# difference of 1e-13 m in a ball joint moves them by micrometres: besides the
+# absolute tolerance, a column may differ by this fraction of its value.
+RELATIVE = 1e-9
+
+
+@dataclass
+class EngineReport:
+    """max |difference| to pin_susp per column, over every step the engine solved."""
+
+    engine: str
+    tolerance: float = TOLERANCE
+    differences: dict[str, float] = field(default_factory=dict)
+    units: dict[str, str] = field(default_factory=dict)
+    failed_steps: list[int] = field(default_factory=list)
+    disagree: set[str] = field(default_factory=set)
+    note: str = ""
+
+    @property
+    def worst(self) -> float:
+        return max(self.differences.values(), default=0.0)
+
+    @property
+    def agrees(self) -> bool:
+        return not self.note and not self.failed_steps and not self.disagree
+
+
+def compare(
+    corner, results, points_per_step: list[dict | None], engine: str, tolerance: float = TOLERANCE
+) -> EngineReport:
+    """Metric columns of an engine's points against pin_susp's results."""
+    report = EngineReport(engine, tolerance)
+    design = {k: v[None] for k, v in corner.design_positions.items()}
+    for i, points in enumerate(points_per_step):
+        if points is None:
+            report.failed_steps.append(i)
+            continue
+        if not results["solver_converged"][i]:
+            continue
+        columns = metric_columns(corner.geometry, {k: v[None] for k, v in points.items()}, design)
+        for name, (values, unit) in columns.items():
+            _record(report, name, unit, values[0], results[name][i])
+        for name in corner.point_names:
+            for a, axis in enumerate("xyz"):
+                _record(report, "points", "mm", points[name][a] * 1e3, results[f"{name}_{axis}"][i])
+    return report
+
+
+def _record(report, name, unit, theirs, ours) -> None:
+    if np.isnan(ours) and np.isnan(theirs):
+        return
+    diff = abs(ours - theirs) if not (np.isnan(ours) or np.isnan(theirs)) else np.inf
+    report.differences[name] = max(report.differences.get(name, 0.0), float(diff))
+    report.units[name] = unit
+    if not diff <= report.tolerance + RELATIVE * abs(ours):
+        report.disagree.add(name)
+
+
+def step_targets(corner, sweep) -> list[list[tuple[str, np.ndarray, float]]]:
+    """(point, unit direction, absolute value m) for every target of every step."""
+    values = corner.target_values(sweep.targets)
+    return [
+        [(t.point, t.unit_direction, float(values[i, k])) for k, t in enumerate(sweep.targets)]
+        for i in range(len(values))
+    ]
+
+
+def pointwise_points(corner, sweep) -> list[dict | None]:
+    model = PointwiseCorner(corner.geometry)
+    out = []
+    for targets in step_targets(corner, sweep):
+        x, residual = model.solve(targets)
+        out.append(model.points(x) if residual < 1e-12 else None)
+    return out
+
+
+class MujocoCorner:
+    """The exported MJCF in MuJoCo, solved to targets by Newton on its own Jacobians."""
+
+    def __init__(self, mjcf_text: str, corner):
+        import mujoco
+
+        self.mj = mujoco
+        self.model = mujoco.MjModel.from_xml_string(mjcf_text)
+        self.data = mujoco.MjData(self.model)
+        self.sites = {
+            name: _Site(self, name) for name in corner.point_names if name != "contact_patch_center"
+        }
+        self.sites["contact_patch_center"] = ContactPatchPoint(
+            "contact_patch_center",
+            self.sites["wheel_center"],
+            self.sites["axle_inboard"],
+            self.sites["axle_outboard"],
+            corner.geometry.wheel.radius,
+        )
+
+    def solve(self, targets, iterations: int = 30) -> dict | None:
+        m, d, mj = self.model, self.data, self.mj
+        d.qpos[:] = m.qpos0
+        for _ in range(iterations + 1):
+            mj.mj_forward(m, d)
+            eq = d.efc_type[: d.nefc] == mj.mjtConstraint.mjCNSTR_EQUALITY
+            rows = [d.efc_pos[: d.nefc][eq]]
+            jac = [d.efc_J.reshape(d.nefc, m.nv)[eq]] if d.nefc else []
+            for name, direction, value in targets:
+                site = self.sites[name]
+                rows.append([site.position(self) @ direction - value])
+                jac.append(direction @ site.jacobian(self))
+            r = np.concatenate(rows)
+            if np.max(np.abs(r)) < 1e-13:
+                return {name: s.position(self).copy() for name, s in self.sites.items()}
+            J = np.vstack(jac)
+            dv = np.linalg.lstsq(J, -r, rcond=None)[0]
+            mj.mj_integratePos(m, d.qpos, dv, 1.0)
+        return None
+
+
+class _Site:
+    """A MuJoCo site as a point: position and (3 × nv) Jacobian."""
+
+    def __init__(self, engine: MujocoCorner, name: str):
+        self.name = name
+        self.id = engine.mj.mj_name2id(engine.model, engine.mj.mjtObj.mjOBJ_SITE, name)
+        if self.id < 0:
+            raise ValueError(f"the MJCF has no site {name!r}")
+
+    def position(self, engine: MujocoCorner) -> np.ndarray:
+        return engine.data.site_xpos[self.id]
+
+    def jacobian(self, engine: MujocoCorner) -> np.ndarray:
+        jacp = np.zeros((3, engine.model.nv))
+        engine.mj.mj_jacSite(engine.model, engine.data, jacp, None, self.id)
+        return jacp
+
+
+def mujoco_points(corner, sweep, mjcf_text: str) -> list[dict | None]:
+    engine = MujocoCorner(mjcf_text, corner)
+    return [engine.solve(targets) for targets in step_targets(corner, sweep)]
+
+
+def validate(corner, sweep, mjcf_text: str | None = None, tolerance: float = TOLERANCE):
+    """Solve the sweep with pin_susp, then with each available engine; compare.
+
+    Returns (results, reports). ``mjcf_text`` defaults to the corner's own export.
+    """
+    from .mjcf import tree_to_mjcf
+
+    results = corner.run_sweep(sweep)
+    points = pointwise_points(corner, sweep)
+    reports = [compare(corner, results, points, "pointwise", tolerance)]
+    try:
+        import mujoco  # noqa: F401
+    except ImportError:
+        reports.append(
+            EngineReport(
+                "mujoco",
+                note="MuJoCo is not installed: "
+                "pip install 'pin_susp[validate]' (or pip install mujoco)",
+            )
+        )
+        return results, reports
+    text = mjcf_text if mjcf_text is not None else tree_to_mjcf(corner.tree)
+    points = mujoco_points(corner, sweep, text)
+    reports.append(compare(corner, results, points, "mujoco", tolerance))
+    return results, reports
