@@ -27,7 +27,7 @@ from .errors import InputError
 from .geometry import DERIVED_POINTS, Geometry, contact_patch, hardpoint_names, load_geometry, unit
 from .jet import Dual
 from .metrics import HUB_Z, RACK, Pose, metric_columns, point_columns
-from .solver import NewtonSolver, Solution
+from .solver import NewtonSolver, Predictor, Solution
 from .sweep import Sweep, Target, load_sweep
 from .urdf import read_closures, tree_to_urdf
 
@@ -96,6 +96,19 @@ class Corner:
         if geometry.steering == "rack":
             drive.append(JointTarget(self.model, "rack_slide"))
         self._drive = NewtonSolver(self.kin, self.closures, drive)
+        # Points grouped by the joint that carries them: (joint id, columns, offsets).
+        frames = [name for name in self.point_names if name != "contact_patch_center"]
+        groups = {}
+        for i, name in enumerate(frames):
+            frame = self.model.frames[self.points[name].frame_id]
+            if frame.parentJoint == 0:
+                offset = self.design_positions[name]
+            else:
+                offset = frame.placement.translation
+            groups.setdefault(frame.parentJoint, []).append((i, offset))
+        self._point_groups = [
+            (j, np.array([i for i, _ in g]), np.array([o for _, o in g])) for j, g in groups.items()
+        ]
 
     def _add_anchor(self, name: str, link: str, offset: np.ndarray) -> FramePoint:
         parent = self.model.frames[self.model.getFrameId(link)]
@@ -108,41 +121,81 @@ class Corner:
         pin.framesForwardKinematics(self.model, self.kin.data, q)
         return {name: self.points[name].position(self.kin).copy() for name in self.point_names}
 
-    def motion(self, qs: list) -> dict[str, Dual]:
+    def motion(self, qs: list, tangents: list | None = None) -> dict[str, Dual]:
         """Every named point at each configuration, with its exact rates per driver.
 
         name → Dual(position (n, 3) m, rates (k, n, 3) m/m) for the k drivers
         of ``self.drivers``: hub z (wheel-centre z with the rack held) and rack
         displacement (rack with wheel-centre z held). Each rate column is the
-        tangent of the solution manifold, J·dq = e_j, pushed through the frame
-        Jacobians; the contact patch follows by the chain rule (jet.Dual).
-        A None configuration (a step that did not converge) gives NaN.
+        tangent of the solution manifold, J·dq = e_j (given in ``tangents``
+        when the sweep's targets are these drivers, else solved here), pushed
+        through the joint Jacobians: a point p on joint j moves at v_j + ω_j × (p − o_j).
+        The contact patch follows by the chain rule (jet.Dual). A None
+        configuration (a step that did not converge) gives NaN.
         """
         n, k = len(qs), len(self.drivers)
         frames = [name for name in self.point_names if name != "contact_patch_center"]
-        pos = {f: np.full((n, 3), np.nan) for f in frames}
-        rates = {f: np.full((k, n, 3), np.nan) for f in frames}
-        solver = self._drive
-        rhs = np.zeros((solver.nrows, k))
-        rhs[-k:] = np.eye(k)
+        pos = np.full((n, len(frames), 3), np.nan)
+        rates = np.full((k, n, len(frames), 3), np.nan)
+        # per joint group: arms p − o (n, m, 3), origins o (n, 3), v and ω per driver (k, n, 3)
+        groups = [
+            (
+                j,
+                index,
+                local,
+                np.full((n, len(index), 3), np.nan),
+                np.full((n, 3), np.nan),
+                np.full((k, n, 3), np.nan),
+                np.full((k, n, 3), np.nan),
+            )
+            for j, index, local in self._point_groups
+        ]
+        model, data = self.model, self.kin.data
         for i, q in enumerate(qs):
             if q is None:
                 continue
-            solver.evaluate(q)
-            try:
-                tangent = np.linalg.solve(solver.jacobian, rhs)
-            except np.linalg.LinAlgError:  # a toggle position: no unique tangent
-                tangent = np.full((self.model.nv, k), np.nan)
-            for f in frames:
-                point = self.points[f]
-                pos[f][i] = point.position(self.kin)
-                rates[f][:, i] = (point.jacobian(self.kin) @ tangent).T
-        points = {f: Dual(pos[f], rates[f]) for f in frames}
+            tangent = None if tangents is None else tangents[i]
+            if tangent is None:
+                self._drive.evaluate(q)
+                tangent = self._drive.tangent()
+            else:
+                self.kin.update(q)
+            for joint, _, local, arms, origins, v, w in groups:
+                if joint == 0:  # the chassis: points fixed, no motion
+                    arms[i], origins[i], v[:, i], w[:, i] = local, 0.0, 0.0, 0.0
+                    continue
+                placement = data.oMi[joint]
+                arms[i] = local @ placement.rotation.T
+                origins[i] = placement.translation
+                J = pin.getJointJacobian(model, data, joint, pin.LOCAL_WORLD_ALIGNED)
+                v[:, i] = (J[:3] @ tangent).T
+                w[:, i] = (J[3:] @ tangent).T
+        # a point p on joint j moves at v + ω × (p − o): every step at once
+        for _, index, _, arms, origins, v, w in groups:
+            pos[:, index] = arms + origins[:, None]
+            rates[:, :, index] = v[:, :, None] + np.cross(w[:, :, None], arms[None])
+        points = {f: Dual(pos[:, i], rates[:, :, i]) for i, f in enumerate(frames)}
         axis = unit(points["axle_outboard"] - points["axle_inboard"])
         points["contact_patch_center"] = contact_patch(
             points["wheel_center"], axis, self.geometry.wheel.radius
         )
         return points
+
+    def drive_order(self, targets: list[Target]) -> list[int] | None:
+        """Which sweep target is which driver, when the targets are exactly the drivers
+        (wheel-centre z, the rack along y); None otherwise."""
+        order = []
+        for driver in self.drivers:
+            point, axis = (
+                ("wheel_center", "z")
+                if driver == HUB_Z
+                else (self.geometry.steering_points[0], "y")
+            )
+            match = [i for i, t in enumerate(targets) if t.point == point and t.direction == axis]
+            if len(match) != 1:
+                return None
+            order.append(match[0])
+        return order if len(targets) == len(order) else None
 
     def body_of(self, point: str) -> str:
         return self.points[point].body
@@ -185,15 +238,27 @@ class Corner:
         n = values.shape[0]
         q = self.q_design
         previous = self.target_values([t.at_design() for t in sweep.targets])[0]
-        solutions = []
+        predictor = Predictor(self.model)
+        order = self.drive_order(sweep.targets)
+        solutions, tangents = [], []
         for i in range(n):
-            solution = solver.solve(q, previous, values[i])
+            solution = None
+            guess = predictor.guess(values[i])
+            if guess is not None:  # one Newton iteration from a good guess, usually
+                solver.set_targets(values[i])
+                solution = solver.newton(guess)
+            if solution is None or not solution.converged:
+                solution = solver.solve(q, previous, values[i])
             solutions.append(solution)
+            tangent = None
             if solution.converged:
                 q, previous = solution.q, values[i]
+                tangent = solver.tangent()
+                predictor.add(q, previous, tangent)
+            tangents.append(None if order is None or tangent is None else tangent[:, order])
             if progress is not None:
                 progress(i + 1, n)
-        return Results.from_solutions(self, solutions, sweep)
+        return Results.from_solutions(self, solutions, sweep, tangents)
 
     def _pose(self, solution: Solution) -> Pose:
         points = self.motion([solution.q])
@@ -250,7 +315,9 @@ class Results:
         self.meta = meta
 
     @classmethod
-    def from_solutions(cls, corner: Corner, solutions: list[Solution], sweep: Sweep) -> Results:
+    def from_solutions(
+        cls, corner: Corner, solutions: list[Solution], sweep: Sweep, tangents=None
+    ) -> Results:
         n = len(solutions)
         ok = np.array([s.converged for s in solutions])
         columns = {
@@ -266,7 +333,7 @@ class Results:
             "solver_iterations": "",
         }
         # A step that did not converge has no trustworthy pose: its cells stay empty.
-        points = corner.motion([s.q if s.converged else None for s in solutions])
+        points = corner.motion([s.q if s.converged else None for s in solutions], tangents)
         design = {k: v[None] for k, v in corner.design_positions.items()}
         for name, (values, column_unit) in metric_columns(corner.geometry, points, design).items():
             columns[name], units[name] = values, column_unit

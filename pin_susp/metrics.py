@@ -38,6 +38,13 @@ class PointSet:
     points: dict
     design: dict
     geometry: Geometry
+    cache: dict = field(default_factory=dict, repr=False)
+
+    def _cached(self, key, compute):
+        """Shared constructions (axes, instant centres) are built once per point set."""
+        if key not in self.cache:
+            self.cache[key] = compute()
+        return self.cache[key]
 
     @property
     def s(self) -> float:
@@ -47,13 +54,18 @@ class PointSet:
         return self.points[name]
 
     def spin_axis(self):
-        return unit(self["axle_outboard"] - self["axle_inboard"])
+        return self._cached("spin", lambda: unit(self["axle_outboard"] - self["axle_inboard"]))
 
     def steering_axis(self):
-        return unit(self["upper_wishbone_outboard"] - self["lower_wishbone_outboard"])
+        return self._cached(
+            "steer", lambda: unit(self["upper_wishbone_outboard"] - self["lower_wishbone_outboard"])
+        )
 
     def steering_axis_on_ground(self):
         """G = LBJ + t·K, K = UBJ − LBJ, t = (CP_z − LBJ_z)/K_z: the axis at CP height."""
+        return self._cached("ground", self._steering_axis_on_ground)
+
+    def _steering_axis_on_ground(self):
         lbj = self["lower_wishbone_outboard"]
         k = self["upper_wishbone_outboard"] - lbj
         flat = np.abs(unit(k)[..., Z]) < STEERING_AXIS_FLAT
@@ -69,6 +81,9 @@ class PointSet:
         (Cramer's rule; the determinant is a component of n₁ × n₂), so a near-parallel
         pair gives a large but accurate point.
         """
+        return self._cached(("ic", axis), lambda: self._instant_axis_point(axis))
+
+    def _instant_axis_point(self, axis: int):
         wc = self["wheel_center"]
         normals, offsets = [], []
         for arm in ("upper_wishbone", "lower_wishbone"):

@@ -9,6 +9,14 @@ the step is wild (a toggle position, lock-up) it takes a damped
 least-squares step instead, with λ = μ·|r|² so that convergence stays
 quadratic near the solution. A step that does not converge is retried as
 two half steps (continuation) before it is reported as failed.
+
+Speed: rows of the common kinds (ball and distance closures, targets on
+frame points, held joints) are evaluated together — one Pinocchio call per
+frame they need, numpy on stacked arrays — and the small square system goes
+to LAPACK's dgesv directly. Other rows (the shim's, a contact-patch target)
+take their own ``residual``/``jacobian``. A sweep also predicts each step
+from the last two solutions and the tangent (see ``predict``), so that one
+Newton iteration usually suffices.
 """
 
 from __future__ import annotations
@@ -17,8 +25,17 @@ from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
+from scipy.linalg import lapack
 
-from .closures import Kinematics
+from .closures import (
+    WORLD,
+    BallClosure,
+    DistanceClosure,
+    FramePoint,
+    JointTarget,
+    Kinematics,
+    PointTarget,
+)
 
 TOLERANCE = 1e-13  # m: stop when max |residual| is below this (1e-10 mm)
 ACCEPT = 1e-12  # m: the contract, max |residual| <= 1e-9 mm at every accepted step
@@ -46,15 +63,23 @@ class NewtonSolver:
         self.nrows = sum(row.size for row in self.rows)
         self.residual = np.empty(self.nrows)
         self.jacobian = np.empty((self.nrows, kin.model.nv))
+        self.batch = _Batch(kin.model, self.rows)
+        self.target_rows = np.arange(self.nrows - len(self.targets), self.nrows)
 
     def evaluate(self, q: np.ndarray) -> None:
         """Fill self.residual and self.jacobian at q."""
         self.kin.update(q)
-        i = 0
-        for row in self.rows:
+        self.batch.fill(self.kin, q, self.residual, self.jacobian)
+        for i, row in self.batch.others:
             self.residual[i : i + row.size] = row.residual(self.kin)
             self.jacobian[i : i + row.size] = row.jacobian(self.kin)
-            i += row.size
+
+    def tangent(self) -> np.ndarray:
+        """dq per unit of each target value, at the last evaluated state: J·T = [0; I]."""
+        rhs = np.zeros((self.nrows, len(self.targets)))
+        rhs[self.target_rows, np.arange(len(self.targets))] = 1.0
+        _, _, T, info = lapack.dgesv(self.jacobian, rhs)
+        return T if info == 0 else np.full_like(rhs[: self.jacobian.shape[1]], np.nan)
 
     def newton(self, q: np.ndarray) -> Solution:
         """Iterate from q with the current target values."""
@@ -72,15 +97,12 @@ class NewtonSolver:
 
     def _step(self) -> np.ndarray:
         J, r = self.jacobian, self.residual
-        try:
-            if J.shape[0] == J.shape[1]:
-                dv = np.linalg.solve(J, -r)
-            else:  # consistent but redundant rows: Gauss-Newton
-                dv = np.linalg.lstsq(J, -r, rcond=None)[0]
-            if np.all(np.isfinite(dv)) and np.max(np.abs(dv)) <= MAX_STEP:
-                return dv
-        except np.linalg.LinAlgError:
-            pass
+        if J.shape[0] == J.shape[1]:
+            _, _, dv, info = lapack.dgesv(J, -r)
+        else:  # consistent but redundant rows: Gauss-Newton
+            dv, info = np.linalg.lstsq(J, -r, rcond=None)[0], 0
+        if info == 0 and np.all(np.isfinite(dv)) and np.max(np.abs(dv)) <= MAX_STEP:
+            return dv
         # Damped least squares: dv = −Jᵀ (J Jᵀ + λI)⁻¹ r, λ = μ|r|².
         lam = DAMPING * float(r @ r) + 1e-14
         dv = -J.T @ np.linalg.solve(J @ J.T + lam * np.eye(len(r)), r)
@@ -90,6 +112,7 @@ class NewtonSolver:
     def set_targets(self, values: np.ndarray) -> None:
         for target, value in zip(self.targets, values, strict=True):
             target.value = float(value)
+        self.batch.set_targets(self.targets)
 
     def solve(self, q: np.ndarray, start: np.ndarray, goal: np.ndarray) -> Solution:
         """Move the targets from ``start`` (solved at q) to ``goal``, halving on failure."""
@@ -120,3 +143,103 @@ class NewtonSolver:
             spent = full.iterations
         full.iterations = spent
         return full
+
+
+class Predictor:
+    """The next step's starting configuration from the last solutions and the tangent.
+
+    q(v) along the sweep is smooth in the target values v. From the last
+    solution q₁ (at v₁, with tangent T = dq/dv there) the first-order guess
+    is q₁ + T·Δv. When the step repeats the last one (a uniform sweep), the
+    parabola through q₀ and q₁ with slope T·Δv at q₁ gives q₀ + 2·T·Δv,
+    accurate to O(Δv³): one Newton iteration then meets the tolerance.
+    """
+
+    def __init__(self, model: pin.Model):
+        self.model = model
+        self.last = None  # (q, values, tangent)
+        self.before = None  # (q, values)
+
+    def add(self, q: np.ndarray, values: np.ndarray, tangent: np.ndarray) -> None:
+        if self.last is not None:
+            self.before = self.last[:2]
+        self.last = (q, values, tangent)
+
+    def guess(self, values: np.ndarray) -> np.ndarray | None:
+        if self.last is None or not np.all(np.isfinite(self.last[2])):
+            return None
+        q, v, T = self.last
+        step = values - v
+        if self.before is not None and np.max(np.abs(v - self.before[1] - step)) <= 1e-15:
+            return pin.integrate(self.model, self.before[0], 2.0 * (T @ step))
+        return pin.integrate(self.model, q, T @ step)
+
+
+class _Batch:
+    """The rows of common kinds, evaluated on preallocated frame data.
+
+    With a handful of rows, plain per-row numpy on preallocated arrays beats
+    fancy indexing: the cost is numpy's call overhead, so every row does as
+    few calls as it can (an axis-aligned target reads one coordinate).
+    """
+
+    def __init__(self, model: pin.Model, rows: list):
+        self.model = model
+        self.frames: list[int] = []
+        index = {}
+
+        def frame(point) -> int:
+            if point.frame_id not in index:
+                index[point.frame_id] = len(self.frames)
+                self.frames.append(point.frame_id)
+            return index[point.frame_id]
+
+        self.balls, self.distances, self.targets, self.joints, self.others = [], [], [], [], []
+        i = 0
+        for row in rows:
+            if isinstance(row, BallClosure) and _framed(row.a, row.b):
+                self.balls.append((slice(i, i + 3), frame(row.a), frame(row.b)))
+            elif isinstance(row, DistanceClosure) and _framed(row.a, row.b):
+                self.distances.append((i, frame(row.a), frame(row.b), row))
+            elif isinstance(row, PointTarget) and _framed(row.point):
+                d = row.direction
+                axis = int(np.argmax(np.abs(d))) if np.count_nonzero(d) == 1 else None
+                self.targets.append((i, frame(row.point), d, axis, row))
+            elif isinstance(row, JointTarget):
+                self.joints.append((i, row.index_q, row))
+            else:
+                self.others.append((i, row))
+            i += row.size
+        self.P = np.zeros((len(self.frames), 3))
+        self.J = np.zeros((len(self.frames), 3, model.nv))
+
+    def set_targets(self, _targets) -> None:
+        pass
+
+    def fill(self, kin: Kinematics, q: np.ndarray, r: np.ndarray, J: np.ndarray) -> None:
+        model, data, P, Jf = self.model, kin.data, self.P, self.J
+        for k, f in enumerate(self.frames):
+            P[k] = data.oMf[f].translation
+            Jf[k] = pin.getFrameJacobian(model, data, f, WORLD)[:3]
+        for rows, a, b in self.balls:
+            r[rows] = P[b] - P[a]
+            J[rows] = Jf[b] - Jf[a]
+        for i, a, b, row in self.distances:
+            d = P[b] - P[a]
+            n = float(np.sqrt(d @ d))
+            r[i] = n - row.length
+            J[i] = (d / n) @ (Jf[b] - Jf[a])
+        for i, f, d, axis, row in self.targets:
+            if axis is None:
+                r[i] = d @ P[f] - row.value
+                J[i] = d @ Jf[f]
+            else:
+                r[i] = d[axis] * P[f, axis] - row.value
+                J[i] = d[axis] * Jf[f, axis]
+        for i, k, row in self.joints:
+            r[i] = q[k] - row.value
+            J[i] = row.row[0]
+
+
+def _framed(*points) -> bool:
+    return all(type(p) is FramePoint for p in points)
