@@ -1,64 +1,247 @@
-"""Time the Newton sweep in-process: per-step solve and whole sweep with metrics.
+"""How fast pin_susp solves, against two baselines run in the same process.
 
-    python benchmarks/bench_sweep.py [--repeat N]
+    python benchmarks/bench_sweep.py [--repeat N] [--quick] [--json OUT.json]
 
-Prints the median, p10 and p90 over repetitions after a warm-up, the
-iterations per step and the worst residual. (Timing lives here, never in
-the tests.)
+For the example corner (combined bump + steer), the shimmed corner and the
+pushrod-rocker corner it prints:
+
+- per-step solve time: median, p10, p90 over every step of every repetition
+  (after a warm-up), Newton iterations per step, worst residual;
+- a 101-step sweep with every metric and exact derivative column, whole;
+- the same 101 steps solved by the independent point-based formulation with
+  scipy least_squares, (a) finite-difference and (b) analytic Jacobians, and
+  the ratios baseline / pin_susp per step;
+- per-step time for sweeps of 11, 101, 1 001 and 10 001 steps;
+- a 51 × 41 bump × steer grid solved by continuation along rows.
+
+Timing lives here, never in the tests (a test runs ``--quick`` and checks
+only iterations and residuals).
 """
 
 from __future__ import annotations
 
 import argparse
+import json
+import platform
 import time
 from pathlib import Path
 
 import numpy as np
+import pinocchio as pin
 
 import pin_susp
+from pin_susp.pointwise import PointwiseCorner
+from pin_susp.sweep import Sweep, Target
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+CORNERS = ("double_wishbone.yaml", "camber_shim.yaml", "pushrod_rocker.yaml")
 
 
-def percentiles(samples):
-    return np.percentile(samples, [50, 10, 90])
+def bump_steer(steps: int) -> Sweep:
+    """The example sweep (−40…60 mm bump with −10…10 mm rack) at any resolution."""
+    return Sweep(
+        [
+            Target("wheel_center", "z", np.linspace(-40, 60, steps)),
+            Target("trackrod_inboard", "y", np.linspace(-10, 10, steps)),
+        ],
+        "bump+steer",
+    )
+
+
+def percentiles(samples) -> dict:
+    p50, p10, p90 = np.percentile(samples, [50, 10, 90])
+    return {"median": p50, "p10": p10, "p90": p90}
+
+
+def per_step(corner, sweep, repeat: int) -> dict:
+    corner.solve_steps(sweep)  # warm-up
+    times, iterations, residual = [], [], 0.0
+    for _ in range(repeat):
+        solutions = corner.solve_steps(sweep, step_times=times)
+    iterations = [s.iterations for s in solutions]
+    residual = max(s.max_residual for s in solutions)
+    return {
+        "time_us": {k: v * 1e6 for k, v in percentiles(times).items()},
+        "iterations_median": float(np.median(iterations)),
+        "iterations_max": int(max(iterations)),
+        "iterations_first_step": int(iterations[0]),
+        "max_residual_mm": residual * 1e3,
+        "converged": all(s.converged for s in solutions),
+    }
+
+
+def whole_sweep(corner, sweep, repeat: int) -> dict:
+    corner.run_sweep(sweep)
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        results = corner.run_sweep(sweep)
+        times.append(time.perf_counter() - t0)
+    columns = len(results.columns)
+    derivatives = sum(1 for c in results.columns if c.startswith("deriv_"))
+    return {
+        "time_ms": {k: v * 1e3 for k, v in percentiles(times).items()},
+        "columns": columns,
+        "derivative_columns": derivatives,
+    }
+
+
+def baseline(corner, sweep, jacobian: str, repeat: int) -> dict:
+    """The point-based formulation, warm-started step to step like ours."""
+    from pin_susp.validate import step_targets
+
+    model = PointwiseCorner(corner.geometry)
+    targets = step_targets(corner, sweep)
+    times, worst = [], 0.0
+    for _ in range(repeat):
+        x = None
+        t0 = time.perf_counter()
+        for step in targets:
+            x, residual = model.solve(step, x, jacobian=jacobian)
+            worst = max(worst, residual)
+        times.append((time.perf_counter() - t0) / len(targets))
+    return {"time_us_per_step": float(np.median(times)) * 1e6, "max_residual_mm": worst * 1e3}
+
+
+def scaling(corner, sizes, repeat: int) -> dict:
+    out = {}
+    for n in sizes:
+        sweep = bump_steer(n)
+        corner.solve_steps(bump_steer(11))
+        times = []
+        for _ in range(max(1, repeat // max(1, n // 101))):
+            t0 = time.perf_counter()
+            corner.solve_steps(sweep)
+            times.append((time.perf_counter() - t0) / n)
+        out[str(n)] = float(np.median(times)) * 1e6
+    return out
+
+
+def grid(corner, bumps: int, racks: int) -> dict:
+    """bump × steer grid: each row a bump sweep at one rack position, started from the
+    previous row's first solution (continuation across rows)."""
+    t0 = time.perf_counter()
+    q_row = None
+    worst, solved = 0.0, 0
+    for rack in np.linspace(-10, 10, racks):
+        row = Sweep(
+            [
+                Target("wheel_center", "z", np.linspace(-40, 60, bumps)),
+                Target("trackrod_inboard", "y", np.full(bumps, rack)),
+            ],
+            "grid row",
+        )
+        solutions = corner.solve_steps(row, q_start=q_row)
+        q_row = solutions[0].q
+        worst = max(worst, max(s.max_residual for s in solutions))
+        solved += sum(s.converged for s in solutions)
+    total = time.perf_counter() - t0
+    return {
+        "points": bumps * racks,
+        "converged": solved,
+        "total_ms": total * 1e3,
+        "us_per_point": total / (bumps * racks) * 1e6,
+        "max_residual_mm": worst * 1e3,
+    }
+
+
+def run(repeat: int, quick: bool) -> dict:
+    report = {
+        "machine": {
+            "python": platform.python_version(),
+            "pin": pin.__version__,
+            "processor": platform.machine(),
+            "quick": quick,
+        },
+        "corners": {},
+    }
+    sizes = (11, 101) if quick else (11, 101, 1001, 10001)
+    for name in CORNERS:
+        corner = pin_susp.Corner(EXAMPLES / name)
+        sweep = bump_steer(41)
+        sweep101 = bump_steer(101)
+        entry = {
+            "per_step": per_step(corner, sweep, repeat),
+            "sweep_101": whole_sweep(corner, sweep101, max(3, repeat // 4)),
+        }
+        ours = np.median(_times(corner, sweep101, max(2, repeat // 8))) * 1e6
+        entry["baselines"] = {
+            "ours_us_per_step_101": ours,
+            "a_fd_jacobian": baseline(corner, sweep101, "2-point", 1),
+            "b_analytic_jacobian": baseline(corner, sweep101, "analytic", 1 if quick else 2),
+        }
+        for key in ("a_fd_jacobian", "b_analytic_jacobian"):
+            entry["baselines"][key]["ratio"] = entry["baselines"][key]["time_us_per_step"] / ours
+        entry["scaling_us_per_step"] = scaling(corner, sizes, repeat)
+        if name == "double_wishbone.yaml":
+            entry["grid"] = grid(corner, *((11, 9) if quick else (51, 41)))
+        report["corners"][name] = entry
+    return report
+
+
+def _times(corner, sweep, repeat):
+    corner.solve_steps(sweep)
+    out = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        corner.solve_steps(sweep)
+        out.append((time.perf_counter() - t0) / sweep.steps)
+    return out
+
+
+def show(report: dict) -> None:
+    print(
+        f"pin_susp benchmark — Python {report['machine']['python']}, pin "
+        f"{report['machine']['pin']}{' (quick)' if report['machine']['quick'] else ''}"
+    )
+    for name, e in report["corners"].items():
+        s, w, b = e["per_step"], e["sweep_101"], e["baselines"]
+        t = s["time_us"]
+        print(f"\n{name}")
+        print(
+            f"  per-step solve            median {t['median']:7.1f} us   p10 {t['p10']:6.1f}"
+            f"   p90 {t['p90']:6.1f}   (target <= 60 us)"
+        )
+        print(
+            f"  Newton iterations         median {s['iterations_median']:g}, max "
+            f"{s['iterations_max']} (first step, from design: {s['iterations_first_step']});"
+            f" max residual {s['max_residual_mm']:.1e} mm"
+        )
+        wt = w["time_ms"]
+        print(
+            f"  101-step sweep, all {w['columns']} columns ({w['derivative_columns']} exact "
+            f"derivatives): median {wt['median']:.2f} ms  p10 {wt['p10']:.2f}  p90 "
+            f"{wt['p90']:.2f}   (target <= 20 ms)"
+        )
+        print(
+            f"  baselines, 101 steps, per step: ours {b['ours_us_per_step_101']:.1f} us;"
+            f" (a) scipy + FD Jacobian {b['a_fd_jacobian']['time_us_per_step']:.0f} us "
+            f"= {b['a_fd_jacobian']['ratio']:.0f}x (target >= 50x);"
+            f" (b) scipy + analytic Jacobian {b['b_analytic_jacobian']['time_us_per_step']:.0f}"
+            f" us = {b['b_analytic_jacobian']['ratio']:.0f}x (target >= 15x)"
+        )
+        scale = ", ".join(f"{n}: {v:.1f}" for n, v in e["scaling_us_per_step"].items())
+        print(f"  scaling, us per step by sweep length: {scale}")
+        if "grid" in e:
+            g = e["grid"]
+            print(
+                f"  bump x steer grid {g['points']} points: {g['total_ms']:.1f} ms "
+                f"({g['us_per_point']:.1f} us/point), {g['converged']} converged, "
+                f"max residual {g['max_residual_mm']:.1e} mm"
+            )
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeat", type=int, default=30)
+    parser.add_argument("--repeat", type=int, default=40, help="repetitions per measurement")
+    parser.add_argument("--quick", action="store_true", help="few repetitions, small sizes")
+    parser.add_argument("--json", metavar="OUT.json", help="also write the figures as JSON")
     args = parser.parse_args()
-
-    corner = pin_susp.Corner(EXAMPLES / "double_wishbone.yaml")
-    sweep = pin_susp.load_sweep(EXAMPLES / "bump_steer.yaml")
-    solver = corner.solver_for(sweep.targets)
-    values = corner.target_values(sweep.targets)
-    start = corner.target_values([t.at_design() for t in sweep.targets])[0]
-    corner.run_sweep(sweep)  # warm-up
-
-    per_step, whole = [], []
-    for _ in range(args.repeat):
-        q, previous = corner.q_design, start
-        for v in values:
-            t0 = time.perf_counter()
-            solution = solver.solve(q, previous, v)
-            per_step.append(time.perf_counter() - t0)
-            q, previous = solution.q, v
-        t0 = time.perf_counter()
-        results = corner.run_sweep(sweep)
-        whole.append(time.perf_counter() - t0)
-
-    med, p10, p90 = percentiles(per_step) * 1e6
-    print(f"example corner, {sweep.steps}-step combined bump+steer sweep, {args.repeat} repeats")
-    print(f"  per-step solve      median {med:7.1f} us   p10 {p10:7.1f}   p90 {p90:7.1f}")
-    med, p10, p90 = percentiles(whole) * 1e3
-    print(f"  sweep with metrics  median {med:7.2f} ms   p10 {p10:7.2f}   p90 {p90:7.2f}")
-    its = results["solver_iterations"]
-    print(
-        f"  iterations per step median {np.median(its):g}, max {its.max()} "
-        f"(first step from design: {its[0]})"
-    )
-    print(f"  max residual        {results['solver_max_residual'].max():.2e} mm")
+    report = run(3 if args.quick else args.repeat, args.quick)
+    show(report)
+    if args.json:
+        Path(args.json).write_text(json.dumps(report, indent=2, default=float))
+        print(f"\nwrote {args.json}")
 
 
 if __name__ == "__main__":

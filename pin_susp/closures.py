@@ -28,6 +28,11 @@ class Kinematics:
         pin.computeJointJacobians(self.model, self.data, q)
         pin.updateFramePlacements(self.model, self.data)
 
+    def update_positions(self, q: np.ndarray) -> None:
+        """Frame placements only (no Jacobians): enough for residuals."""
+        self.q = q
+        pin.framesForwardKinematics(self.model, self.data, q)
+
     def frame_jacobian(self, frame_id: int) -> np.ndarray:
         """6×nv: linear velocity of the frame origin, then angular velocity, world axes."""
         return pin.getFrameJacobian(self.model, self.data, frame_id, WORLD)

@@ -7,6 +7,7 @@ description of the mechanism.
 
 from __future__ import annotations
 
+import time
 from pathlib import Path
 
 import numpy as np
@@ -121,15 +122,14 @@ class Corner:
         pin.framesForwardKinematics(self.model, self.kin.data, q)
         return {name: self.points[name].position(self.kin).copy() for name in self.point_names}
 
-    def motion(self, qs: list, tangents: list | None = None) -> dict[str, Dual]:
+    def motion(self, qs: list) -> dict[str, Dual]:
         """Every named point at each configuration, with its exact rates per driver.
 
         name → Dual(position (n, 3) m, rates (k, n, 3) m/m) for the k drivers
         of ``self.drivers``: hub z (wheel-centre z with the rack held) and rack
         displacement (rack with wheel-centre z held). Each rate column is the
-        tangent of the solution manifold, J·dq = e_j (given in ``tangents``
-        when the sweep's targets are these drivers, else solved here), pushed
-        through the joint Jacobians: a point p on joint j moves at v_j + ω_j × (p − o_j).
+        tangent of the solution manifold, J·dq = e_j, pushed through the joint
+        Jacobians: a point p on joint j moves at v_j + ω_j × (p − o_j).
         The contact patch follows by the chain rule (jet.Dual). A None
         configuration (a step that did not converge) gives NaN.
         """
@@ -154,12 +154,8 @@ class Corner:
         for i, q in enumerate(qs):
             if q is None:
                 continue
-            tangent = None if tangents is None else tangents[i]
-            if tangent is None:
-                self._drive.evaluate(q)
-                tangent = self._drive.tangent()
-            else:
-                self.kin.update(q)
+            self._drive.evaluate(q)
+            tangent = self._drive.tangent()
             for joint, _, local, arms, origins, v, w in groups:
                 if joint == 0:  # the chassis: points fixed, no motion
                     arms[i], origins[i], v[:, i], w[:, i] = local, 0.0, 0.0, 0.0
@@ -180,22 +176,6 @@ class Corner:
             points["wheel_center"], axis, self.geometry.wheel.radius
         )
         return points
-
-    def drive_order(self, targets: list[Target]) -> list[int] | None:
-        """Which sweep target is which driver, when the targets are exactly the drivers
-        (wheel-centre z, the rack along y); None otherwise."""
-        order = []
-        for driver in self.drivers:
-            point, axis = (
-                ("wheel_center", "z")
-                if driver == HUB_Z
-                else (self.geometry.steering_points[0], "y")
-            )
-            match = [i for i, t in enumerate(targets) if t.point == point and t.direction == axis]
-            if len(match) != 1:
-                return None
-            order.append(match[0])
-        return order if len(targets) == len(order) else None
 
     def body_of(self, point: str) -> str:
         return self.points[point].body
@@ -230,18 +210,32 @@ class Corner:
         return self._pose(solution)
 
     def run_sweep(self, sweep: Sweep | str | dict, progress=None) -> Results:
-        """Solve every step of a sweep, warm-starting each from the last good one."""
+        """Solve every step of a sweep and compute every column (metrics, derivatives)."""
         if not isinstance(sweep, Sweep):
             sweep = load_sweep(sweep)
+        return Results.from_solutions(self, self.solve_steps(sweep, progress), sweep)
+
+    def solve_steps(
+        self, sweep: Sweep, progress=None, q_start: np.ndarray | None = None, step_times=None
+    ) -> list[Solution]:
+        """Solve the sweep's steps in order, each from a prediction off the last ones.
+
+        ``q_start``: a solved configuration of the sweep's first step's predecessor
+        (default: the design state); ``step_times``: a list that receives each
+        step's solve time in seconds (for benchmarks).
+        """
         solver = self.solver_for(sweep.targets, sweep.source)
         values = self.target_values(sweep.targets)
         n = values.shape[0]
-        q = self.q_design
+        q = self.q_design if q_start is None else q_start
         previous = self.target_values([t.at_design() for t in sweep.targets])[0]
+        if q_start is not None:
+            previous = self._values_at(solver, q_start)
         predictor = Predictor(self.model)
-        order = self.drive_order(sweep.targets)
-        solutions, tangents = [], []
+        solutions = []
+        clock = time.perf_counter
         for i in range(n):
+            started = clock()
             solution = None
             guess = predictor.guess(values[i])
             if guess is not None:  # one Newton iteration from a good guess, usually
@@ -249,16 +243,21 @@ class Corner:
                 solution = solver.newton(guess)
             if solution is None or not solution.converged:
                 solution = solver.solve(q, previous, values[i])
-            solutions.append(solution)
-            tangent = None
             if solution.converged:
                 q, previous = solution.q, values[i]
-                tangent = solver.tangent()
-                predictor.add(q, previous, tangent)
-            tangents.append(None if order is None or tangent is None else tangent[:, order])
+                # J of the last Newton iterate: close enough to predict, not for derivatives
+                predictor.add(q, previous, solver.tangent())
+            if step_times is not None:
+                step_times.append(clock() - started)
+            solutions.append(solution)
             if progress is not None:
                 progress(i + 1, n)
-        return Results.from_solutions(self, solutions, sweep, tangents)
+        return solutions
+
+    def _values_at(self, solver: NewtonSolver, q: np.ndarray) -> np.ndarray:
+        """The target values that q satisfies."""
+        self.kin.update_positions(q)
+        return np.array([t.point.position(self.kin) @ t.direction for t in solver.targets])
 
     def _pose(self, solution: Solution) -> Pose:
         points = self.motion([solution.q])
@@ -315,9 +314,7 @@ class Results:
         self.meta = meta
 
     @classmethod
-    def from_solutions(
-        cls, corner: Corner, solutions: list[Solution], sweep: Sweep, tangents=None
-    ) -> Results:
+    def from_solutions(cls, corner: Corner, solutions: list[Solution], sweep: Sweep) -> Results:
         n = len(solutions)
         ok = np.array([s.converged for s in solutions])
         columns = {
@@ -333,7 +330,7 @@ class Results:
             "solver_iterations": "",
         }
         # A step that did not converge has no trustworthy pose: its cells stay empty.
-        points = corner.motion([s.q if s.converged else None for s in solutions], tangents)
+        points = corner.motion([s.q if s.converged else None for s in solutions])
         design = {k: v[None] for k, v in corner.design_positions.items()}
         for name, (values, column_unit) in metric_columns(corner.geometry, points, design).items():
             columns[name], units[name] = values, column_unit

@@ -103,32 +103,66 @@ class PointwiseCorner:
         return np.array(rows)
 
     def jacobian(self, x: np.ndarray, targets) -> np.ndarray:
-        """Distance rows by hand; target rows (derived points) by central differences."""
+        """Analytic: distance rows, and targets on hardpoints or on points fixed to the
+        upright (through â = unit(AO − AI)); a contact-patch target by central
+        differences."""
         p = self.points(x)
         J = np.zeros((len(self.pairs) + len(targets), len(x)))
         for row, (a, b, _) in enumerate(self.pairs):
             u = (p[a] - p[b]) / np.linalg.norm(p[a] - p[b])
-            for name, sign in ((a, 1.0), (b, -1.0)):
-                if name in self.column:
-                    J[row, self.column[name] : self.column[name] + 3] += sign * u
-                elif name == self.inner and self.rack is not None:
-                    J[row, self.rack] += sign * u[1]
-        h = 1e-7
-        for i in range(len(x)):
-            e = np.zeros(len(x))
-            e[i] = h
-            plus, minus = self.points(x + e), self.points(x - e)
-            for k, (name, d, _) in enumerate(targets):
-                J[len(self.pairs) + k, i] = (plus[name] - minus[name]) @ d / (2 * h)
+            self._add(J[row], a, u)
+            self._add(J[row], b, -u)
+        for k, (name, d, _) in enumerate(targets):
+            row = J[len(self.pairs) + k]
+            if name in self.hp:
+                self._add(row, name, d)
+            elif name != "contact_patch_center":
+                for end, gradient in self._derived(name, p).items():
+                    self._add(row, end, gradient.T @ d)
+            else:
+                h = 1e-7
+                for i in range(len(x)):
+                    e = np.zeros(len(x))
+                    e[i] = h
+                    row[i] = (self.points(x + e)[name] - self.points(x - e)[name]) @ d / (2 * h)
         return J
 
-    def solve(self, targets, x0: np.ndarray | None = None) -> tuple[np.ndarray, float]:
-        """Hold each (point, unit direction, absolute value m); returns x and max |residual|."""
+    def _add(self, row: np.ndarray, name: str, gradient: np.ndarray) -> None:
+        """Add d(row)/d(point) = gradient to the row's columns of that point."""
+        if name in self.column:
+            row[self.column[name] : self.column[name] + 3] += gradient
+        elif name == self.inner and self.rack is not None:
+            row[self.rack] += gradient[1]
+
+    def _derived(self, name: str, p) -> dict[str, np.ndarray]:
+        """d(derived point)/d(axle_inboard), d/d(axle_outboard) as 3×3 matrices."""
+        wheel = self.geometry.wheel
+        v = p["axle_outboard"] - p["axle_inboard"]
+        a = v / np.linalg.norm(v)
+        D = (np.eye(3) - np.outer(a, a)) / np.linalg.norm(v)  # dâ/d(AO − AI)
+        along = {
+            "axle_midpoint": None,
+            "wheel_center": 0.0,
+            "wheel_inboard": -0.5 * wheel.section_width,
+            "wheel_outboard": 0.5 * wheel.section_width,
+        }[name]
+        if along is None:
+            return {"axle_inboard": 0.5 * np.eye(3), "axle_outboard": 0.5 * np.eye(3)}
+        k = along - wheel.offset  # the point is AO + k·â
+        return {"axle_outboard": np.eye(3) + k * D, "axle_inboard": -k * D}
+
+    def solve(
+        self, targets, x0: np.ndarray | None = None, jacobian: str = "analytic"
+    ) -> tuple[np.ndarray, float]:
+        """Hold each (point, unit direction, absolute value m); returns x and max |residual|.
+
+        ``jacobian="2-point"`` lets scipy difference the residuals instead.
+        """
         x0 = self.x0 if x0 is None else x0
         sol = least_squares(
             self.residual,
             x0,
-            jac=self.jacobian,
+            jac=self.jacobian if jacobian == "analytic" else jacobian,
             args=(targets,),
             method="lm",
             xtol=1e-15,

@@ -66,13 +66,17 @@ class NewtonSolver:
         self.batch = _Batch(kin.model, self.rows)
         self.target_rows = np.arange(self.nrows - len(self.targets), self.nrows)
 
-    def evaluate(self, q: np.ndarray) -> None:
-        """Fill self.residual and self.jacobian at q."""
-        self.kin.update(q)
-        self.batch.fill(self.kin, q, self.residual, self.jacobian)
+    def evaluate(self, q: np.ndarray, jacobian: bool = True) -> None:
+        """Fill self.residual, and self.jacobian unless ``jacobian`` is False, at q."""
+        if jacobian:
+            self.kin.update(q)
+        else:
+            self.kin.update_positions(q)
+        self.batch.fill(self.kin, q, self.residual, self.jacobian if jacobian else None)
         for i, row in self.batch.others:
             self.residual[i : i + row.size] = row.residual(self.kin)
-            self.jacobian[i : i + row.size] = row.jacobian(self.kin)
+            if jacobian:
+                self.jacobian[i : i + row.size] = row.jacobian(self.kin)
 
     def tangent(self) -> np.ndarray:
         """dq per unit of each target value, at the last evaluated state: J·T = [0; I]."""
@@ -83,17 +87,21 @@ class NewtonSolver:
 
     def newton(self, q: np.ndarray) -> Solution:
         """Iterate from q with the current target values."""
-        model = self.kin.model
+        model, r = self.kin.model, self.residual
         q = q.copy()
+        full = True  # after a step, look at the residual alone first: often it has converged
         for iteration in range(MAX_ITERATIONS + 1):
-            self.evaluate(q)
-            error = float(np.max(np.abs(self.residual)))
+            self.evaluate(q, jacobian=full)
+            error = max(r.max(), -r.min())
             if error <= TOLERANCE:
-                return Solution(q, True, iteration, error)
+                return Solution(q, True, iteration, float(error))
             if iteration == MAX_ITERATIONS or not np.isfinite(error):
                 break
+            if not full:
+                self.evaluate(q)
             q = pin.integrate(model, q, self._step())
-        return Solution(q, error <= ACCEPT, iteration, error)
+            full = False
+        return Solution(q, bool(error <= ACCEPT), iteration, float(error))
 
     def _step(self) -> np.ndarray:
         J, r = self.jacobian, self.residual
@@ -101,7 +109,7 @@ class NewtonSolver:
             _, _, dv, info = lapack.dgesv(J, -r)
         else:  # consistent but redundant rows: Gauss-Newton
             dv, info = np.linalg.lstsq(J, -r, rcond=None)[0], 0
-        if info == 0 and np.all(np.isfinite(dv)) and np.max(np.abs(dv)) <= MAX_STEP:
+        if info == 0 and max(dv.max(), -dv.min()) <= MAX_STEP:  # False for NaN too
             return dv
         # Damped least squares: dv = −Jᵀ (J Jᵀ + λI)⁻¹ r, λ = μ|r|².
         lam = DAMPING * float(r @ r) + 1e-14
@@ -216,29 +224,36 @@ class _Batch:
     def set_targets(self, _targets) -> None:
         pass
 
-    def fill(self, kin: Kinematics, q: np.ndarray, r: np.ndarray, J: np.ndarray) -> None:
+    def fill(self, kin: Kinematics, q: np.ndarray, r: np.ndarray, J: np.ndarray | None) -> None:
+        """Residual rows, and their Jacobian rows unless J is None."""
         model, data, P, Jf = self.model, kin.data, self.P, self.J
         for k, f in enumerate(self.frames):
             P[k] = data.oMf[f].translation
-            Jf[k] = pin.getFrameJacobian(model, data, f, WORLD)[:3]
+            if J is not None:
+                Jf[k] = pin.getFrameJacobian(model, data, f, WORLD)[:3]
         for rows, a, b in self.balls:
             r[rows] = P[b] - P[a]
-            J[rows] = Jf[b] - Jf[a]
+            if J is not None:
+                J[rows] = Jf[b] - Jf[a]
         for i, a, b, row in self.distances:
             d = P[b] - P[a]
             n = float(np.sqrt(d @ d))
             r[i] = n - row.length
-            J[i] = (d / n) @ (Jf[b] - Jf[a])
+            if J is not None:
+                J[i] = (d / n) @ (Jf[b] - Jf[a])
         for i, f, d, axis, row in self.targets:
             if axis is None:
                 r[i] = d @ P[f] - row.value
-                J[i] = d @ Jf[f]
+                if J is not None:
+                    J[i] = d @ Jf[f]
             else:
                 r[i] = d[axis] * P[f, axis] - row.value
-                J[i] = d[axis] * Jf[f, axis]
+                if J is not None:
+                    J[i] = d[axis] * Jf[f, axis]
         for i, k, row in self.joints:
             r[i] = q[k] - row.value
-            J[i] = row.row[0]
+            if J is not None:
+                J[i] = row.row[0]
 
 
 def _framed(*points) -> bool:
