@@ -122,14 +122,15 @@ class Corner:
         pin.framesForwardKinematics(self.model, self.kin.data, q)
         return {name: self.points[name].position(self.kin).copy() for name in self.point_names}
 
-    def motion(self, qs: list) -> dict[str, Dual]:
+    def motion(self, qs: list, tangents: list | None = None) -> dict[str, Dual]:
         """Every named point at each configuration, with its exact rates per driver.
 
         name → Dual(position (n, 3) m, rates (k, n, 3) m/m) for the k drivers
         of ``self.drivers``: hub z (wheel-centre z with the rack held) and rack
         displacement (rack with wheel-centre z held). Each rate column is the
-        tangent of the solution manifold, J·dq = e_j, pushed through the joint
-        Jacobians: a point p on joint j moves at v_j + ω_j × (p − o_j).
+        tangent of the solution manifold, J·dq = e_j (from ``tangents`` where
+        the sweep's solve already has it, else solved here), pushed through the
+        joint Jacobians: a point p on joint j moves at v_j + ω_j × (p − o_j).
         The contact patch follows by the chain rule (jet.Dual). A None
         configuration (a step that did not converge) gives NaN.
         """
@@ -137,45 +138,60 @@ class Corner:
         frames = [name for name in self.point_names if name != "contact_patch_center"]
         pos = np.full((n, len(frames), 3), np.nan)
         rates = np.full((k, n, len(frames), 3), np.nan)
-        # per joint group: arms p − o (n, m, 3), origins o (n, 3), v and ω per driver (k, n, 3)
-        groups = [
-            (
-                j,
-                index,
-                local,
-                np.full((n, len(index), 3), np.nan),
-                np.full((n, 3), np.nan),
-                np.full((k, n, 3), np.nan),
-                np.full((k, n, 3), np.nan),
-            )
-            for j, index, local in self._point_groups
-        ]
+        moving = [(j, index, local) for j, index, local in self._point_groups if j != 0]
+        # per moving joint and step: rotation, origin, and its twist (v; ω) per driver
+        rotation = np.full((len(moving), n, 3, 3), np.nan)
+        origin = np.full((len(moving), n, 3), np.nan)
+        twist = np.full((len(moving), n, 6, k), np.nan)
         model, data = self.model, self.kin.data
         for i, q in enumerate(qs):
             if q is None:
                 continue
-            self._drive.evaluate(q)
-            tangent = self._drive.tangent()
-            for joint, _, local, arms, origins, v, w in groups:
-                if joint == 0:  # the chassis: points fixed, no motion
-                    arms[i], origins[i], v[:, i], w[:, i] = local, 0.0, 0.0, 0.0
-                    continue
-                placement = data.oMi[joint]
-                arms[i] = local @ placement.rotation.T
-                origins[i] = placement.translation
-                J = pin.getJointJacobian(model, data, joint, pin.LOCAL_WORLD_ALIGNED)
-                v[:, i] = (J[:3] @ tangent).T
-                w[:, i] = (J[3:] @ tangent).T
-        # a point p on joint j moves at v + ω × (p − o): every step at once
-        for _, index, _, arms, origins, v, w in groups:
-            pos[:, index] = arms + origins[:, None]
+            if tangents is not None and tangents[i] is not None:
+                tangent = tangents[i]
+                self.kin.update(q)
+            else:
+                self._drive.evaluate(q)
+                tangent = self._drive.tangent()
+            oMi = data.oMi
+            for g, (joint, _, _) in enumerate(moving):
+                placement = oMi[joint]
+                rotation[g, i] = placement.rotation
+                origin[g, i] = placement.translation
+                twist[g, i] = (
+                    pin.getJointJacobian(model, data, joint, pin.LOCAL_WORLD_ALIGNED) @ tangent
+                )
+        # every step at once: p = o + R·l, and p moves at v + ω × (p − o)
+        for j, index, local in self._point_groups:
+            if j == 0:  # the chassis: fixed points
+                pos[:, index] = local
+                rates[:, :, index] = 0.0
+        for g, (_, index, local) in enumerate(moving):
+            arms = np.einsum("nij,mj->nmi", rotation[g], local)
+            pos[:, index] = arms + origin[g][:, None]
+            v = np.moveaxis(twist[g, :, :3], -1, 0)  # (k, n, 3)
+            w = np.moveaxis(twist[g, :, 3:], -1, 0)
             rates[:, :, index] = v[:, :, None] + np.cross(w[:, :, None], arms[None])
+        unsolved = np.array([q is None for q in qs])
+        pos[unsolved] = np.nan
+        rates[:, unsolved] = np.nan
         points = {f: Dual(pos[:, i], rates[:, :, i]) for i, f in enumerate(frames)}
         axis = unit(points["axle_outboard"] - points["axle_inboard"])
         points["contact_patch_center"] = contact_patch(
             points["wheel_center"], axis, self.geometry.wheel.radius
         )
         return points
+
+    def drive_order(self, targets: list[Target]) -> list[int] | None:
+        """Which target is which driver, when the targets are exactly the drivers
+        (wheel-centre z, then the rack along y, in any order); None otherwise."""
+        wanted = [("wheel_center", "z")]
+        if self.geometry.steering == "rack":
+            wanted.append((self.geometry.steering_points[0], "y"))
+        have = [(t.point, t.direction) for t in targets]
+        if len(have) != len(wanted) or set(have) != set(wanted):
+            return None
+        return [have.index(w) for w in wanted]
 
     def body_of(self, point: str) -> str:
         return self.points[point].body
@@ -213,18 +229,29 @@ class Corner:
         """Solve every step of a sweep and compute every column (metrics, derivatives)."""
         if not isinstance(sweep, Sweep):
             sweep = load_sweep(sweep)
-        return Results.from_solutions(self, self.solve_steps(sweep, progress), sweep)
+        tangents = []
+        solutions = self.solve_steps(sweep, progress, tangents=tangents)
+        return Results.from_solutions(self, solutions, sweep, tangents or None)
 
     def solve_steps(
-        self, sweep: Sweep, progress=None, q_start: np.ndarray | None = None, step_times=None
+        self,
+        sweep: Sweep,
+        progress=None,
+        q_start: np.ndarray | None = None,
+        step_times=None,
+        tangents: list | None = None,
     ) -> list[Solution]:
         """Solve the sweep's steps in order, each from a prediction off the last ones.
 
         ``q_start``: a solved configuration of the sweep's first step's predecessor
         (default: the design state); ``step_times``: a list that receives each
-        step's solve time in seconds (for benchmarks).
+        step's solve time in seconds (for benchmarks); ``tangents``: a list that
+        receives the exact drivers' tangent of each step, when the sweep's
+        targets are the drivers (wheel-centre z, rack) — it stays empty otherwise.
         """
         solver = self.solver_for(sweep.targets, sweep.source)
+        order = self.drive_order(sweep.targets) if tangents is not None else None
+        solver.keep_jacobian = order is not None
         values = self.target_values(sweep.targets)
         n = values.shape[0]
         q = self.q_design if q_start is None else q_start
@@ -243,10 +270,14 @@ class Corner:
                 solution = solver.newton(guess)
             if solution is None or not solution.converged:
                 solution = solver.solve(q, previous, values[i])
+            tangent = None
             if solution.converged:
                 q, previous = solution.q, values[i]
-                # J of the last Newton iterate: close enough to predict, not for derivatives
-                predictor.add(q, previous, solver.tangent())
+                # exact when keep_jacobian; else J of the last iterate: good enough to predict
+                tangent = solver.tangent()
+                predictor.add(q, previous, tangent)
+            if order is not None:
+                tangents.append(None if tangent is None else tangent[:, order])
             if step_times is not None:
                 step_times.append(clock() - started)
             solutions.append(solution)
@@ -314,7 +345,9 @@ class Results:
         self.meta = meta
 
     @classmethod
-    def from_solutions(cls, corner: Corner, solutions: list[Solution], sweep: Sweep) -> Results:
+    def from_solutions(
+        cls, corner: Corner, solutions: list[Solution], sweep: Sweep, tangents=None
+    ) -> Results:
         n = len(solutions)
         ok = np.array([s.converged for s in solutions])
         columns = {
@@ -330,7 +363,7 @@ class Results:
             "solver_iterations": "",
         }
         # A step that did not converge has no trustworthy pose: its cells stay empty.
-        points = corner.motion([s.q if s.converged else None for s in solutions])
+        points = corner.motion([s.q if s.converged else None for s in solutions], tangents)
         design = {k: v[None] for k, v in corner.design_positions.items()}
         for name, (values, column_unit) in metric_columns(corner.geometry, points, design).items():
             columns[name], units[name] = values, column_unit

@@ -65,6 +65,9 @@ class NewtonSolver:
         self.jacobian = np.empty((self.nrows, kin.model.nv))
         self.batch = _Batch(kin.model, self.rows)
         self.target_rows = np.arange(self.nrows - len(self.targets), self.nrows)
+        # True: Newton ends on a full evaluation, so self.jacobian belongs to the solution
+        # (its tangent is exact); False: it checks the last iterate's residual alone.
+        self.keep_jacobian = False
 
     def evaluate(self, q: np.ndarray, jacobian: bool = True) -> None:
         """Fill self.residual, and self.jacobian unless ``jacobian`` is False, at q."""
@@ -100,7 +103,7 @@ class NewtonSolver:
             if not full:
                 self.evaluate(q)
             q = pin.integrate(model, q, self._step())
-            full = False
+            full = self.keep_jacobian
         return Solution(q, bool(error <= ACCEPT), iteration, float(error))
 
     def _step(self) -> np.ndarray:
@@ -169,17 +172,21 @@ class Predictor:
         self.before = None  # (q, values)
 
     def add(self, q: np.ndarray, values: np.ndarray, tangent: np.ndarray) -> None:
-        if self.last is not None:
-            self.before = self.last[:2]
+        if not np.isfinite(tangent).all():  # a singular state: no prediction from here
+            self.last = self.before = None
+            return
+        self.before = self.last
         self.last = (q, values, tangent)
 
     def guess(self, values: np.ndarray) -> np.ndarray | None:
-        if self.last is None or not np.all(np.isfinite(self.last[2])):
+        if self.last is None:
             return None
         q, v, T = self.last
         step = values - v
-        if self.before is not None and np.max(np.abs(v - self.before[1] - step)) <= 1e-15:
-            return pin.integrate(self.model, self.before[0], 2.0 * (T @ step))
+        if self.before is not None:
+            repeat = v - self.before[1] - step
+            if max(repeat.max(), -repeat.min()) <= 1e-15:
+                return pin.integrate(self.model, self.before[0], 2.0 * (T @ step))
         return pin.integrate(self.model, q, T @ step)
 
 
@@ -227,8 +234,9 @@ class _Batch:
     def fill(self, kin: Kinematics, q: np.ndarray, r: np.ndarray, J: np.ndarray | None) -> None:
         """Residual rows, and their Jacobian rows unless J is None."""
         model, data, P, Jf = self.model, kin.data, self.P, self.J
+        oMf = data.oMf
         for k, f in enumerate(self.frames):
-            P[k] = data.oMf[f].translation
+            P[k] = oMf[f].translation
             if J is not None:
                 Jf[k] = pin.getFrameJacobian(model, data, f, WORLD)[:3]
         for rows, a, b in self.balls:
