@@ -8,7 +8,7 @@ STAMP := $(VENV)/.installed
 DEMO_DIR ?= demo_output
 GEOMETRIES := $(shell grep -l '^hardpoints:' examples/*.yaml)
 
-.PHONY: demo test urdf lint format clean
+.PHONY: demo test bench urdf lint format clean
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -22,6 +22,10 @@ demo: $(STAMP)
 # pytest exits 5 when it collects no test: that is a failure here too.
 test: $(STAMP)
 	$(BIN)/python -m pytest -q
+
+# Speed figures against baselines run in the same process (see README, Performance).
+bench: $(STAMP)
+	$(BIN)/python benchmarks/bench_sweep.py --json benchmarks/last_run.json
 
 # Regenerate urdf/ from examples/ (a test fails when they differ).
 urdf: $(STAMP)

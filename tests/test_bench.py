@@ -1,0 +1,43 @@
+"""The benchmark runs, and the solver's effort stays within bounds (no timing asserted)."""
+
+import json
+import subprocess
+import sys
+
+from conftest import ROOT
+
+
+def test_benchmark_quick_mode_runs_with_few_iterations_and_tiny_residuals(tmp_path):
+    out = tmp_path / "bench.json"
+    proc = subprocess.run(
+        [
+            sys.executable,
+            str(ROOT / "benchmarks" / "bench_sweep.py"),
+            "--quick",
+            "--json",
+            str(out),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert "baselines" in proc.stdout and "x (target" in proc.stdout
+    report = json.loads(out.read_text())
+    assert set(report["corners"]) == {
+        "double_wishbone.yaml",
+        "camber_shim.yaml",
+        "pushrod_rocker.yaml",
+    }
+    for entry in report["corners"].values():
+        step = entry["per_step"]
+        assert step["converged"]
+        assert step["max_residual_mm"] <= 1e-9
+        assert step["iterations_median"] <= 2  # the predictor leaves one Newton step, mostly
+        assert step["iterations_max"] <= 5
+        assert step["iterations_first_step"] <= 5
+        for baseline in ("a_fd_jacobian", "b_analytic_jacobian"):
+            assert entry["baselines"][baseline]["max_residual_mm"] <= 1e-9
+        assert entry["sweep_101"]["derivative_columns"] >= 15
+    grid = report["corners"]["double_wishbone.yaml"]["grid"]
+    assert grid["converged"] == grid["points"] and grid["max_residual_mm"] <= 1e-9
