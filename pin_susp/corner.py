@@ -259,12 +259,15 @@ class Corner:
         if q_start is not None:
             previous = self._values_at(solver, q_start)
         predictor = Predictor(self.model)
+        # which steps repeat the one before (a uniform sweep): worked out once for all
+        steps = np.diff(np.vstack([previous, values]), axis=0)
+        repeats = np.r_[False, np.abs(np.diff(steps, axis=0)).max(axis=1) <= 1e-15]
         solutions = []
         clock = time.perf_counter
         for i in range(n):
             started = clock()
             solution = None
-            guess = predictor.guess(values[i])
+            guess = predictor.guess(values[i], bool(repeats[i]) and predictor.before is not None)
             if guess is not None:  # one Newton iteration from a good guess, usually
                 solver.set_targets(values[i])
                 solution = solver.newton(guess)

@@ -68,6 +68,8 @@ class NewtonSolver:
         # True: Newton ends on a full evaluation, so self.jacobian belongs to the solution
         # (its tangent is exact); False: it checks the last iterate's residual alone.
         self.keep_jacobian = False
+        self._unit_rhs = np.zeros((self.nrows, len(self.targets)))
+        self._unit_rhs[self.target_rows, np.arange(len(self.targets))] = 1.0
 
     def evaluate(self, q: np.ndarray, jacobian: bool = True) -> None:
         """Fill self.residual, and self.jacobian unless ``jacobian`` is False, at q."""
@@ -83,10 +85,8 @@ class NewtonSolver:
 
     def tangent(self) -> np.ndarray:
         """dq per unit of each target value, at the last evaluated state: J·T = [0; I]."""
-        rhs = np.zeros((self.nrows, len(self.targets)))
-        rhs[self.target_rows, np.arange(len(self.targets))] = 1.0
-        _, _, T, info = lapack.dgesv(self.jacobian, rhs)
-        return T if info == 0 else np.full_like(rhs[: self.jacobian.shape[1]], np.nan)
+        _, _, T, info = lapack.dgesv(self.jacobian, self._unit_rhs)
+        return T if info == 0 else np.full((self.jacobian.shape[1], len(self.targets)), np.nan)
 
     def newton(self, q: np.ndarray) -> Solution:
         """Iterate from q with the current target values."""
@@ -95,9 +95,9 @@ class NewtonSolver:
         full = True  # after a step, look at the residual alone first: often it has converged
         for iteration in range(MAX_ITERATIONS + 1):
             self.evaluate(q, jacobian=full)
+            if r @ r <= TOLERANCE * TOLERANCE:  # |r|₂ bounds max |r|: one cheap call
+                return Solution(q, True, iteration, float(np.abs(r).max()))
             error = max(r.max(), -r.min())
-            if error <= TOLERANCE:
-                return Solution(q, True, iteration, float(error))
             if iteration == MAX_ITERATIONS or not np.isfinite(error):
                 break
             if not full:
@@ -178,14 +178,17 @@ class Predictor:
         self.before = self.last
         self.last = (q, values, tangent)
 
-    def guess(self, values: np.ndarray) -> np.ndarray | None:
+    def guess(self, values: np.ndarray, repeats: bool | None = None) -> np.ndarray | None:
+        """``repeats``: whether this step repeats the last one (worked out here if None)."""
         if self.last is None:
             return None
         q, v, T = self.last
         step = values - v
         if self.before is not None:
-            repeat = v - self.before[1] - step
-            if max(repeat.max(), -repeat.min()) <= 1e-15:
+            if repeats is None:
+                repeat = v - self.before[1] - step
+                repeats = max(repeat.max(), -repeat.min()) <= 1e-15
+            if repeats:
                 return pin.integrate(self.model, self.before[0], 2.0 * (T @ step))
         return pin.integrate(self.model, q, T @ step)
 
