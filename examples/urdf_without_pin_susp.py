@@ -32,13 +32,17 @@ def load(path):
             offset = np.array([float(x) for x in f.get("xyz").split()])
             placement = link.placement * pin.SE3(np.eye(3), offset)
             name = f"{el.get('name')}/{i}"
-            frames.append(model.addFrame(pin.Frame(name, link.parentJoint, placement,
-                                                   pin.OP_FRAME)))
+            frames.append(
+                model.addFrame(pin.Frame(name, link.parentJoint, placement, pin.OP_FRAME))
+            )
         closures.append((el.get("name"), el.get("type"), frames))
     data = model.createData()
     pin.framesForwardKinematics(model, data, pin.neutral(model))
-    lengths = {name: np.linalg.norm(data.oMf[b].translation - data.oMf[a].translation)
-               for name, kind, (a, b) in closures if kind == "distance"}
+    lengths = {
+        name: np.linalg.norm(data.oMf[b].translation - data.oMf[a].translation)
+        for name, kind, (a, b) in closures
+        if kind == "distance"
+    }
     return model, closures, lengths
 
 
@@ -56,8 +60,10 @@ def solve_pose(model, closures, lengths, wheel_center_dz=0.02, rack=0.0):
         rows, jac = [], []
         for name, kind, (a, b) in closures:
             d = data.oMf[b].translation - data.oMf[a].translation
-            J = (pin.getFrameJacobian(model, data, b, WORLD)[:3]
-                 - pin.getFrameJacobian(model, data, a, WORLD)[:3])
+            J = (
+                pin.getFrameJacobian(model, data, b, WORLD)[:3]
+                - pin.getFrameJacobian(model, data, a, WORLD)[:3]
+            )
             if kind == "ball":
                 rows.extend(d)
                 jac.extend(J)
@@ -94,14 +100,21 @@ def main(path):
     ao = data.oMf[model.getFrameId("axle_outboard")].translation
     a = (ao - ai) / np.linalg.norm(ao - ai)
     print(f"{Path(path).name}: {len(closures)} loop closures, {model.nv} joints")
-    print(f"wheel centre 20 mm up: camber {-np.degrees(np.arctan2(a[2], a[1])):.4f} deg, "
-          f"toe {np.degrees(np.arctan2(a[0], a[1])):.4f} deg")
+    print(
+        f"wheel centre 20 mm up: camber {-np.degrees(np.arctan2(a[2], a[1])):.4f} deg, "
+        f"toe {np.degrees(np.arctan2(a[0], a[1])):.4f} deg"
+    )
     for n in names:
         p = data.oMf[model.getFrameId(n)].translation
-        print(f"  {n:26} {np.round(p * 1e3, 3)} mm; yourdfpy differs by "
-              f"{np.max(np.abs(frames[n] - p)) * 1e3:.1e} mm")
+        print(
+            f"  {n:26} {np.round(p * 1e3, 3)} mm; yourdfpy differs by "
+            f"{np.max(np.abs(frames[n] - p)) * 1e3:.1e} mm"
+        )
 
 
 if __name__ == "__main__":
-    main(sys.argv[1] if len(sys.argv) > 1
-         else Path(__file__).resolve().parent.parent / "urdf" / "double_wishbone.urdf")
+    main(
+        sys.argv[1]
+        if len(sys.argv) > 1
+        else Path(__file__).resolve().parent.parent / "urdf" / "double_wishbone.urdf"
+    )

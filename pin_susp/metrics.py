@@ -328,6 +328,16 @@ METRICS = (
     Metric("anti_squat", "%", "Anti-squat", anti_squat, _anti_squat_applies, always_written=True),
 )
 METRIC_BY_NAME = {m.name: m for m in METRICS}
+# The standard kinematics set: the setup sheet's static values, the report's first panels.
+STANDARD = (
+    "camber",
+    "roadwheel_angle",
+    "caster",
+    "kpi",
+    "scrub_radius",
+    "mechanical_trail",
+    "half_track",
+)
 
 
 @dataclass(frozen=True)

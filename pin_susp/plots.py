@@ -19,17 +19,8 @@ import numpy as np  # noqa: E402
 
 from .errors import InputError  # noqa: E402
 from .export import atomic_write  # noqa: E402
-from .metrics import HUB_Z, METRIC_BY_NAME, RACK, Derivative  # noqa: E402
+from .metrics import HUB_Z, METRIC_BY_NAME, RACK, STANDARD, Derivative  # noqa: E402
 
-CORE = (
-    "camber",
-    "roadwheel_angle",
-    "caster",
-    "kpi",
-    "scrub_radius",
-    "mechanical_trail",
-    "half_track",
-)
 EXTRA = (
     "svic_z",
     "fvic_z",
@@ -110,7 +101,7 @@ def x_axis(results: ResultsFile) -> tuple[str, str]:
 
 def panels(results: list[ResultsFile], xname: str) -> list[str]:
     driver = HUB_Z if xname == "wheel_travel" else RACK
-    names = list(CORE) + list(EXTRA)
+    names = list(STANDARD) + list(EXTRA)
     names += [f"deriv_{m}_wrt_{driver}" for m in DERIVED]
     return [n for n in names if any(n in r.columns and np.any(np.isfinite(r[n])) for r in results)]
 
@@ -155,30 +146,28 @@ def drawing_figure(corner):
         p = {k: v * 1e3 for k, v in c.design_positions.items()}
         colours = dict(c.tree.materials)
         for v in c.tree.visuals:
-            if v.shape != "rod" or v.material == "tyre":
-                continue
-            a, b = v.start * 1e3, v.end * 1e3
-            colour = colours[v.material][:3]
-            front.plot([a[1], b[1]], [a[2], b[2]], style, color=colour, alpha=alpha, lw=2)
-            side.plot([a[0], b[0]], [a[2], b[2]], style, color=colour, alpha=alpha, lw=2)
+            if v.shape == "rod" and v.material != "tyre":
+                _both(
+                    front,
+                    side,
+                    v.start,
+                    v.end,
+                    style,
+                    color=colours[v.material][:3],
+                    alpha=alpha,
+                    lw=2,
+                )
         for name, (a, b) in segments(c, c.design_positions).items():
-            a, b = a * 1e3, b * 1e3
-            colour = "goldenrod" if name == "steering_axis" else "0.4"
-            front.plot(
-                [a[1], b[1]],
-                [a[2], b[2]],
-                ":" if name == "steering_axis" else style,
-                color=colour,
+            axis = name == "steering_axis"
+            _both(
+                front,
+                side,
+                a,
+                b,
+                ":" if axis else style,
                 alpha=alpha,
                 lw=1.5,
-            )
-            side.plot(
-                [a[0], b[0]],
-                [a[2], b[2]],
-                ":" if name == "steering_axis" else style,
-                color=colour,
-                alpha=alpha,
-                lw=1.5,
+                color="goldenrod" if axis else "0.4",
             )
         _tyre(front, side, c, p, alpha, style)
         pts = np.array([p[n] for n in c.geometry.hardpoints])
@@ -201,6 +190,13 @@ def drawing_figure(corner):
     fig.suptitle(f"{corner.geometry.name}{note}")
     fig.tight_layout()
     return fig
+
+
+def _both(front, side, a, b, style, **kwargs) -> None:
+    """A segment (m) in front view (y, z) and side view (x, z), in mm."""
+    a, b = a * 1e3, b * 1e3
+    front.plot([a[1], b[1]], [a[2], b[2]], style, **kwargs)
+    side.plot([a[0], b[0]], [a[2], b[2]], style, **kwargs)
 
 
 def _tyre(front, side, c, p, alpha, style) -> None:

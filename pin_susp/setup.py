@@ -29,7 +29,7 @@ from .closures import DistanceClosure, JointTarget, PointTarget
 from .errors import InputError
 from .geometry import MM, Geometry
 from .jet import Dual
-from .metrics import METRIC_BY_NAME, PointSet
+from .metrics import METRIC_BY_NAME, STANDARD, PointSet
 from .solver import NewtonSolver
 
 PARAMETERS = ("shim_thickness", "trackrod_length", "pushrod_length")
@@ -38,15 +38,6 @@ PARAMETER_KEYS = {
     "trackrod_length": "config.setup.trackrod_length_delta",
     "pushrod_length": "config.setup.pushrod_length_delta",
 }
-STATIC_METRICS = (
-    "camber",
-    "roadwheel_angle",
-    "caster",
-    "kpi",
-    "scrub_radius",
-    "mechanical_trail",
-    "half_track",
-)
 Z = np.array([0.0, 0.0, 1.0])
 
 
@@ -260,7 +251,7 @@ class SetupModel:
             c.geometry,
         )
         metrics, derivatives = {}, {}
-        for name in STATIC_METRICS:
+        for name in STANDARD:
             m = METRIC_BY_NAME[name]
             v = m.function(ps) * m.scale
             metrics[name] = float(v.val[0])

@@ -31,6 +31,17 @@ def translated(geometry: dict, v) -> dict:
     return g
 
 
+def sweep_csv(tmp_path: Path, geometry: str, sweep: str, name: str = "results.csv") -> Path:
+    """`pin-susp sweep` on two example files, quietly; the CSV's path."""
+    from pin_susp.cli import main
+
+    out = tmp_path / name
+    assert (
+        main(["sweep", str(EXAMPLES / geometry), str(EXAMPLES / sweep), "-o", str(out), "-q"]) == 0
+    )
+    return out
+
+
 @pytest.fixture(scope="session")
 def corner():
     import pin_susp

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 import yaml
-from conftest import EXAMPLES, example
+from conftest import EXAMPLES, example, sweep_csv
 
 import pin_susp
 from pin_susp.cli import main
@@ -21,20 +21,7 @@ def write(path: Path, data) -> Path:
 
 
 def test_sweep_writes_the_spec_columns(tmp_path):
-    out = tmp_path / "res.csv"
-    assert (
-        main(
-            [
-                "sweep",
-                str(EXAMPLES / "double_wishbone.yaml"),
-                str(EXAMPLES / "bump_steer.yaml"),
-                "-o",
-                str(out),
-                "-q",
-            ]
-        )
-        == 0
-    )
+    out = sweep_csv(tmp_path, "double_wishbone.yaml", "bump_steer.yaml")
     lines = out.read_text().splitlines()
     comments = [line for line in lines if line.startswith("#")]
     assert comments[0].startswith("# pin_susp ")

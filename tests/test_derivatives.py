@@ -4,7 +4,7 @@ import copy
 
 import numpy as np
 import pytest
-from conftest import EXAMPLES, example, mirrored
+from conftest import EXAMPLES, example, mirrored, sweep_csv
 
 import pin_susp
 from pin_susp.cli import main
@@ -90,20 +90,7 @@ def test_instant_centres_match_an_independent_plane_intersection(geometry):
 
 
 def test_parallel_wishbone_planes_leave_instant_centres_empty(tmp_path):
-    out = tmp_path / "r.csv"
-    assert (
-        main(
-            [
-                "sweep",
-                str(EXAMPLES / "double_wishbone.yaml"),
-                str(EXAMPLES / "bump_steer.yaml"),
-                "-o",
-                str(out),
-                "-q",
-            ]
-        )
-        == 0
-    )
+    out = sweep_csv(tmp_path, "double_wishbone.yaml", "bump_steer.yaml")
     lines = [ln for ln in out.read_text().splitlines() if not ln.startswith("#")]
     header = lines[0].split(",")
     first = dict(zip(header, lines[1].split(","), strict=True))

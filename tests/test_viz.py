@@ -9,7 +9,7 @@ import sys
 
 import numpy as np
 import pytest
-from conftest import EXAMPLES
+from conftest import EXAMPLES, sweep_csv
 
 import pin_susp
 from pin_susp.cli import main
@@ -129,14 +129,6 @@ def test_view_command_serves_and_stops_on_ctrl_c():
             proc.kill()
     assert proc.returncode == 0, err
     assert "stopped" in out and "Traceback" not in err
-
-
-def sweep_csv(tmp_path, geometry, sweep, name):
-    out = tmp_path / name
-    assert (
-        main(["sweep", str(EXAMPLES / geometry), str(EXAMPLES / sweep), "-o", str(out), "-q"]) == 0
-    )
-    return out
 
 
 def test_report_has_one_labelled_panel_per_metric_and_a_line_per_file(tmp_path):
