@@ -63,7 +63,7 @@ def _parser() -> argparse.ArgumentParser:
         description="Suspension kinematics on Pinocchio: a corner from a YAML file of "
         "hardpoints (mm, ISO 8855), solved exactly through bump and steer sweeps.",
         epilog="Start with `pin-susp demo`. Formats: docs/geometry.md, docs/sweep.md, "
-        "docs/results.md.",
+        "docs/results.md, docs/urdf.md.",
     )
     p.add_argument("--version", action="version", version=f"pin_susp {__version__}")
     sub = p.add_subparsers(title="commands", metavar="COMMAND", required=True)

@@ -134,7 +134,7 @@ def report_figure(results: list[ResultsFile]):
 
 def drawing_figure(corner):
     """Front view (y–z) and side view (x–z) of the corner at its (as-set) design state."""
-    from .viz import segments
+    from .viz import LINKS, segments
 
     fig, (front, side) = plt.subplots(1, 2, figsize=(14, 6))
     corners = [(corner, 1.0, "-")]
@@ -167,7 +167,7 @@ def drawing_figure(corner):
                 ":" if axis else style,
                 alpha=alpha,
                 lw=1.5,
-                color="goldenrod" if axis else "0.4",
+                color="goldenrod" if axis else f"#{LINKS[name][1]:06x}",
             )
         _tyre(front, side, c, p, alpha, style)
         pts = np.array([p[n] for n in c.geometry.hardpoints])
