@@ -194,11 +194,12 @@ class Predictor:
 
 
 class _Batch:
-    """The rows of common kinds, evaluated on preallocated frame data.
+    """The rows of common kinds, evaluated from each needed frame read once.
 
-    With a handful of rows, plain per-row numpy on preallocated arrays beats
-    fancy indexing: the cost is numpy's call overhead, so every row does as
-    few calls as it can (an axis-aligned target reads one coordinate).
+    With a handful of rows, plain per-row numpy beats stacking and fancy
+    indexing (tried: slower): the cost is numpy's and the bindings' per-call
+    overhead, so every row does as few calls as it can (an axis-aligned
+    target reads one coordinate).
     """
 
     def __init__(self, model: pin.Model, rows: list):
@@ -228,20 +229,17 @@ class _Batch:
             else:
                 self.others.append((i, row))
             i += row.size
-        self.P = np.zeros((len(self.frames), 3))
-        self.J = np.zeros((len(self.frames), 3, model.nv))
 
     def set_targets(self, _targets) -> None:
         pass
 
     def fill(self, kin: Kinematics, q: np.ndarray, r: np.ndarray, J: np.ndarray | None) -> None:
         """Residual rows, and their Jacobian rows unless J is None."""
-        model, data, P, Jf = self.model, kin.data, self.P, self.J
+        model, data = self.model, kin.data
         oMf = data.oMf
-        for k, f in enumerate(self.frames):
-            P[k] = oMf[f].translation
-            if J is not None:
-                Jf[k] = pin.getFrameJacobian(model, data, f, WORLD)[:3]
+        P = [oMf[f].translation for f in self.frames]  # fresh arrays: no copy needed
+        if J is not None:
+            Jf = [pin.getFrameJacobian(model, data, f, WORLD)[:3] for f in self.frames]
         for rows, a, b in self.balls:
             r[rows] = P[b] - P[a]
             if J is not None:
@@ -258,9 +256,9 @@ class _Batch:
                 if J is not None:
                     J[i] = d @ Jf[f]
             else:
-                r[i] = d[axis] * P[f, axis] - row.value
+                r[i] = d[axis] * P[f][axis] - row.value
                 if J is not None:
-                    J[i] = d[axis] * Jf[f, axis]
+                    J[i] = d[axis] * Jf[f][axis]
         for i, k, row in self.joints:
             r[i] = q[k] - row.value
             if J is not None:
