@@ -109,13 +109,6 @@ def value(x):
     return x
 
 
-def part(x, *path: str):
-    """A component of a (nested) Dual, e.g. part(m, "der", "val"); 0 for a constant."""
-    for name in path:
-        x = getattr(x, name) if isinstance(x, Dual) else 0.0 * x
-    return x
-
-
 def _split(x):
     return (x.val, x.der) if isinstance(x, Dual) else (x, 0.0)
 

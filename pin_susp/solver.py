@@ -123,7 +123,6 @@ class NewtonSolver:
     def set_targets(self, values: np.ndarray) -> None:
         for target, value in zip(self.targets, values, strict=True):
             target.value = float(value)
-        self.batch.set_targets(self.targets)
 
     def solve(self, q: np.ndarray, start: np.ndarray, goal: np.ndarray) -> Solution:
         """Move the targets from ``start`` (solved at q) to ``goal``, halving on failure."""
@@ -229,9 +228,6 @@ class _Batch:
             else:
                 self.others.append((i, row))
             i += row.size
-
-    def set_targets(self, _targets) -> None:
-        pass
 
     def fill(self, kin: Kinematics, q: np.ndarray, r: np.ndarray, J: np.ndarray | None) -> None:
         """Residual rows, and their Jacobian rows unless J is None."""
