@@ -278,7 +278,7 @@ class Corner:
                 q, previous = solution.q, values[i]
                 # exact when keep_jacobian; else J of the last iterate: good enough to predict
                 tangent = solver.tangent()
-                predictor.add(q, previous, tangent)
+                predictor.add(q, previous, tangent, exact=solver.keep_jacobian)
             if order is not None:
                 tangents.append(None if tangent is None else tangent[:, order])
             if step_times is not None:

@@ -162,7 +162,11 @@ class Predictor:
     solution q₁ (at v₁, with tangent T = dq/dv there) the first-order guess
     is q₁ + T·Δv. When the step repeats the last one (a uniform sweep), the
     parabola through q₀ and q₁ with slope T·Δv at q₁ gives q₀ + 2·T·Δv,
-    accurate to O(Δv³): one Newton iteration then meets the tolerance.
+    accurate to O(Δv³): one Newton iteration then meets the tolerance. When
+    both tangents are exact (J at each solution), the cubic Hermite curve
+    through q₀, q₁ with slopes T₀·Δv, T₁·Δv, extended one step, gives
+    5·q₀ − 4·q₁ + (2·T₀ + 4·T₁)·Δv, accurate to O(Δv⁴).
+    (q is a vector space here: every joint has one degree of freedom.)
     """
 
     def __init__(self, model: pin.Model):
@@ -170,25 +174,30 @@ class Predictor:
         self.last = None  # (q, values, tangent)
         self.before = None  # (q, values)
 
-    def add(self, q: np.ndarray, values: np.ndarray, tangent: np.ndarray) -> None:
+    def add(
+        self, q: np.ndarray, values: np.ndarray, tangent: np.ndarray, exact: bool = False
+    ) -> None:
         if not np.isfinite(tangent).all():  # a singular state: no prediction from here
             self.last = self.before = None
             return
         self.before = self.last
-        self.last = (q, values, tangent)
+        self.last = (q, values, tangent, exact)
 
     def guess(self, values: np.ndarray, repeats: bool | None = None) -> np.ndarray | None:
         """``repeats``: whether this step repeats the last one (worked out here if None)."""
         if self.last is None:
             return None
-        q, v, T = self.last
+        q, v, T, exact = self.last
         step = values - v
         if self.before is not None:
             if repeats is None:
                 repeat = v - self.before[1] - step
                 repeats = max(repeat.max(), -repeat.min()) <= 1e-15
             if repeats:
-                return pin.integrate(self.model, self.before[0], 2.0 * (T @ step))
+                q0, _, T0, exact0 = self.before
+                if exact and exact0:
+                    return 5.0 * q0 - 4.0 * q + (2.0 * T0 + 4.0 * T) @ step
+                return pin.integrate(self.model, q0, 2.0 * (T @ step))
         return pin.integrate(self.model, q, T @ step)
 
 
