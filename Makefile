@@ -21,7 +21,9 @@ demo: $(STAMP)
 
 # pytest exits 5 when it collects no test: that is a failure here too.
 test: $(STAMP)
-	$(BIN)/python -m pytest -q
+	@$(BIN)/python -m pytest -q; status=$$?; \
+	if [ $$status -eq 5 ]; then echo "make test: pytest collected no tests" >&2; fi; \
+	exit $$status
 
 # Speed figures against baselines run in the same process (see README, Performance).
 bench: $(STAMP)
