@@ -10,6 +10,7 @@ from pointwise import PointwiseCorner, shim_assembly, spec_metrics
 import pin_susp
 from pin_susp.cli import main
 from pin_susp.geometry import load_geometry
+from pin_susp.metrics import STANDARD
 from pin_susp.setup import SetupModel, apply_setup, setup_values, solve_setup, with_setup
 from pin_susp.shim import ShimAssembly
 
@@ -242,15 +243,7 @@ def test_setup_model_state_is_the_forward_as_set_state():
     g = load_geometry(data)
     state = SetupModel(g).state(setup_values(g))
     forward = static(data)
-    for name in (
-        "camber",
-        "roadwheel_angle",
-        "caster",
-        "kpi",
-        "scrub_radius",
-        "mechanical_trail",
-        "half_track",
-    ):
+    for name in STANDARD:
         assert state.metrics[name] == pytest.approx(forward.metrics[name], abs=1e-10)
     assert state.metrics["ride_height_change"] == pytest.approx(
         pin_susp.Corner(data).geometry.ride_height_change / MM, abs=1e-10
