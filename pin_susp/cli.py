@@ -75,7 +75,7 @@ def _parser() -> argparse.ArgumentParser:
         "metrics (camber, toe, caster, KPI, scrub, trail, ...) and every point to CSV. "
         "Exit code 1 if any step did not converge (its row is flagged).",
     )
-    s.add_argument("geometry", metavar="GEOMETRY", help="geometry YAML (hardpoints in mm)")
+    _geometry_argument(s)
     s.add_argument("sweep", metavar="SWEEP", help="sweep YAML (targets per step)")
     s.add_argument("-o", "--output", required=True, metavar="OUT.csv", help="results CSV")
     s.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
@@ -88,7 +88,7 @@ def _parser() -> argparse.ArgumentParser:
         description="Write the URDF of GEOMETRY: the kinematic tree in metres, every "
         "hardpoint as a link, loop closures as <pin_susp:loop_closure> elements.",
     )
-    u.add_argument("geometry", metavar="GEOMETRY", help="geometry YAML (hardpoints in mm)")
+    _geometry_argument(u)
     u.add_argument(
         "-o", "--output", metavar="OUT.urdf", help="file to write (default: standard output)"
     )
@@ -107,7 +107,7 @@ def _parser() -> argparse.ArgumentParser:
         "site, ball closures as <connect>, distance closures as a rod on a universal joint "
         "closed by a <connect>. Loads in MuJoCo and in Pinocchio's MJCF parser.",
     )
-    mj.add_argument("geometry", metavar="GEOMETRY", help="geometry YAML (hardpoints in mm)")
+    _geometry_argument(mj)
     mj.add_argument("-o", "--output", required=True, metavar="OUT.xml", help="file to write")
     mj.set_defaults(run=_mjcf)
 
@@ -120,7 +120,7 @@ def _parser() -> argparse.ArgumentParser:
         "engine; exit 1 where one exceeds the tolerance. MuJoCo is optional: "
         "pip install 'pin_susp[validate]'.",
     )
-    va.add_argument("geometry", metavar="GEOMETRY", help="geometry YAML (hardpoints in mm)")
+    _geometry_argument(va)
     va.add_argument("sweep", metavar="SWEEP", help="sweep YAML")
     va.add_argument(
         "--mjcf",
@@ -161,7 +161,7 @@ def _parser() -> argparse.ArgumentParser:
         "--sensitivities; pin-susp setup examples/camber_shim.yaml --camber -2.5 --toe 0.1 "
         "-o set.yaml",
     )
-    t.add_argument("geometry", metavar="GEOMETRY", help="geometry YAML (hardpoints in mm)")
+    _geometry_argument(t)
     t.add_argument(
         "--shim",
         type=_numbers,
@@ -225,7 +225,7 @@ def _parser() -> argparse.ArgumentParser:
         "closure equations. Writes a long-format CSV (step_index, metric, hardpoint, axis, "
         "value, unit) and prints the largest entries per metric.",
     )
-    h.add_argument("geometry", metavar="GEOMETRY", help="geometry YAML (hardpoints in mm)")
+    _geometry_argument(h)
     h.add_argument(
         "--sweep", metavar="SWEEP", help="at every step of this sweep (default: the design state)"
     )
@@ -259,7 +259,7 @@ def _parser() -> argparse.ArgumentParser:
         description="Draw GEOMETRY at its design (as-set) state in front and side view; a "
         "shimmed corner shows its drawn geometry dashed.",
     )
-    dr.add_argument("geometry", metavar="GEOMETRY", help="geometry YAML (hardpoints in mm)")
+    _geometry_argument(dr)
     dr.add_argument(
         "-o", "--output", required=True, metavar="OUT.png", help="image (png, pdf, svg)"
     )
@@ -272,12 +272,16 @@ def _parser() -> argparse.ArgumentParser:
         "its URL; with SWEEP, play the solved motion as an animation. --html writes the scene "
         "and animation as one HTML file that opens in a browser with no server.",
     )
-    v.add_argument("geometry", metavar="GEOMETRY", help="geometry YAML (hardpoints in mm)")
+    _geometry_argument(v)
     v.add_argument("sweep", metavar="SWEEP", nargs="?", help="sweep YAML to animate")
     v.add_argument("--html", metavar="OUT.html", help="write a self-contained replay and exit")
     v.add_argument("--fps", type=float, default=10.0, help="animation frames per second")
     v.set_defaults(run=_view)
     return p
+
+
+def _geometry_argument(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("geometry", metavar="GEOMETRY", help="geometry YAML (hardpoints in mm)")
 
 
 def _numbers(text: str) -> list[float]:

@@ -82,7 +82,6 @@ class HardpointSensitivity:
                 for j in range(1, corner.model.njoints)
             ]
         )
-        self.real_q = self.real  # all joints are one-dof: idx_q = idx_v
         self.frames = [n for n in corner.point_names if n != "contact_patch_center"]
         self.points = {n: FramePoint(n, m.getFrameId(n), corner.body_of(n)) for n in self.frames}
         self.points["contact_patch_center"] = ContactPatchPoint(
@@ -179,7 +178,7 @@ class HardpointSensitivity:
                 targets.append(Target("trackrod_inboard", "y", 0.0))
         m, kin = self.model, self.kin
         qa = pin.neutral(m)
-        qa[self.real_q] = q
+        qa[self.real] = q  # every joint has one dof: its q index is its v index
         kin.update(qa)
         n_h = self.B.shape[1]
         virt = np.setdiff1d(np.arange(m.nv), self.real)

@@ -91,7 +91,6 @@ class CornerScene:
         self.show()
 
     def _robot(self, corner, name, colour):
-        import pinocchio as pin
         from pinocchio.visualize import MeshcatVisualizer
 
         visual = pin.buildGeomFromUrdfString(corner.model, corner.urdf, pin.GeometryType.VISUAL)
