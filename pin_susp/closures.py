@@ -8,6 +8,8 @@ tangent space of the joint configuration (``pin.integrate``).
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pinocchio as pin
 
@@ -118,6 +120,89 @@ class DistanceClosure:
     def jacobian(self, kin: Kinematics) -> np.ndarray:
         d = self.b.position(kin) - self.a.position(kin)
         return (d / np.linalg.norm(d)) @ (self.b.jacobian(kin) - self.a.jacobian(kin))[None]
+
+
+def chirality(a, b, c, d) -> float:
+    """Signed volume of the tetrahedron a, b, c, d over the product of its edge
+    lengths from a: the sine-like measure of which side of the plane (a, b, c)
+    the point d lies on. Works on plain 3-sequences (floats, fast)."""
+    u = (b[0] - a[0], b[1] - a[1], b[2] - a[2])
+    v = (c[0] - a[0], c[1] - a[1], c[2] - a[2])
+    w = (d[0] - a[0], d[1] - a[1], d[2] - a[2])
+    det = (
+        u[0] * (v[1] * w[2] - v[2] * w[1])
+        - u[1] * (v[0] * w[2] - v[2] * w[0])
+        + u[2] * (v[0] * w[1] - v[1] * w[0])
+    )
+    scale = math.sqrt((u[0] ** 2 + u[1] ** 2 + u[2] ** 2) * (v[0] ** 2 + v[1] ** 2 + v[2] ** 2))
+    scale *= math.sqrt(w[0] ** 2 + w[1] ** 2 + w[2] ** 2)
+    return det / scale if scale > 0.0 else 0.0
+
+
+class LoopBranch:
+    """Which assembly of a closed loop a pose is on: the sign of its chirality.
+
+    A loop closed by a ball or a distance has two assemblies for one input —
+    the circle a point sweeps about its last joint axis meets the sphere (or
+    point) it must reach twice, mirror images through a plane. Four points
+    spanning that plane and the moving point (``points``, declared by the
+    mechanism with its closure) have a signed volume whose sign tells the two
+    apart; it is fixed at the design state. Crossing zero is passing the
+    loop's toggle (lock-up): a Newton step that lands on the other sign has
+    found the other assembly, however small its residual.
+    """
+
+    # |chirality| at design below this: the loop sits at its toggle, no side to keep
+    DEGENERATE = 1e-6
+
+    def __init__(self, name: str, points: list, kin: Kinematics):
+        self.name = name
+        self.points = points
+        value = self.chirality(kin)
+        self.sign = math.copysign(1.0, value)
+        self.degenerate = abs(value) < self.DEGENERATE
+
+    def chirality(self, kin: Kinematics) -> float:
+        return chirality(*(p.position(kin).tolist() for p in self.points))
+
+    def holds(self, kin: Kinematics) -> bool:
+        """True when the pose in ``kin`` is on the design assembly of this loop."""
+        return self.degenerate or self.chirality(kin) * self.sign > 0.0
+
+
+class BranchGuard:
+    """Every loop's branch checked at once, each moving frame read once (a hot path:
+    it runs at every accepted Newton solution)."""
+
+    def __init__(self, loops: list[LoopBranch], kin: Kinematics):
+        self.loops = [loop for loop in loops if not loop.degenerate]
+        model = kin.model
+        fixed = {}  # frames on the chassis: their positions never change
+        moving = []
+        for loop in self.loops:
+            for p in loop.points:
+                if model.frames[p.frame_id].parentJoint == 0:
+                    fixed[p.frame_id] = p.position(kin).tolist()
+                elif p.frame_id not in moving:
+                    moving.append(p.frame_id)
+        self.moving = moving
+        self.fixed = fixed
+        self.ids = [
+            ([p.frame_id for p in loop.points], loop.sign, loop.name) for loop in self.loops
+        ]
+
+    def left(self, kin: Kinematics) -> str | None:
+        """The name of the first loop off its design branch, or None."""
+        if not self.loops:
+            return None
+        oMf = kin.data.oMf
+        at = dict(self.fixed)
+        for f in self.moving:
+            at[f] = oMf[f].translation.tolist()
+        for frames, sign, name in self.ids:
+            if chirality(*(at[f] for f in frames)) * sign <= 0.0:
+                return name
+        return None
 
 
 class PointTarget:

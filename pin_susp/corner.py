@@ -21,6 +21,7 @@ from .closures import (
     FramePoint,
     JointTarget,
     Kinematics,
+    LoopBranch,
     PointTarget,
 )
 from .double_wishbone import corner_tree
@@ -88,6 +89,11 @@ class Corner:
             else:
                 length = float(np.linalg.norm(b.position(self.kin) - a.position(self.kin)))
                 self.closures.append(DistanceClosure(spec.name, a, b, length))
+        self.branches = [
+            LoopBranch(c.name, [self.points[n] for n in c.branch], self.kin)
+            for c in self.tree.closures
+            if c.branch
+        ]
         self.mobility = self.model.nv - sum(c.size for c in self.closures)
         self.actuators = ("rack",) if geometry.steering == "rack" else ()
         self.design_positions = self.positions(self.q_design)
@@ -96,7 +102,7 @@ class Corner:
         drive = [PointTarget(self.points["wheel_center"], np.array([0.0, 0.0, 1.0]))]
         if geometry.steering == "rack":
             drive.append(JointTarget(self.model, "rack_slide"))
-        self._drive = NewtonSolver(self.kin, self.closures, drive)
+        self._drive = NewtonSolver(self.kin, self.closures, drive, self.branches)
         # Points grouped by the joint that carries them: (joint id, columns, offsets).
         frames = [name for name in self.point_names if name != "contact_patch_center"]
         groups = {}
@@ -185,10 +191,10 @@ class Corner:
     def drive_order(self, targets: list[Target]) -> list[int] | None:
         """Which target is which driver, when the targets are exactly the drivers
         (wheel-centre z, then the rack along y, in any order); None otherwise."""
-        wanted = [("wheel_center", "z")]
+        wanted = [Target("wheel_center", "z").key]
         if self.geometry.steering == "rack":
-            wanted.append((self.geometry.steering_points[0], "y"))
-        have = [(t.point, t.direction) for t in targets]
+            wanted.append(Target(self.geometry.steering_points[0], "y").key)
+        have = [t.key for t in targets]
         if len(have) != len(wanted) or set(have) != set(wanted):
             return None
         return [have.index(w) for w in wanted]
@@ -199,10 +205,20 @@ class Corner:
     def solver_for(self, targets: list[Target], source: str = "<targets>") -> NewtonSolver:
         """Check targets against this mechanism and build the Newton solver."""
         self._check_targets(targets, source)
-        rows = []
-        for t in targets:
-            rows.append(PointTarget(self.points[t.point], t.unit_direction))
-        return NewtonSolver(self.kin, self.closures, rows)
+        rows = [PointTarget(self.points[t.point], t.unit_direction) for t in targets]
+        solver = NewtonSolver(self.kin, self.closures, rows, self.branches)
+        # The targets must fix the pose: with the closures, a square Jacobian of full rank.
+        solver.evaluate(self.q_design)
+        if np.linalg.cond(solver.jacobian) > 1e10:
+            held = ", ".join(f"{t.point} along {_along(t)}" for t in targets)
+            raise InputError(
+                source,
+                "targets",
+                f"{held} do not fix the pose of this mechanism at its design state (the "
+                "targets' rows are dependent: a target along a direction its point cannot "
+                "move in, e.g. the rack along x, or a design sitting at a lock-up)",
+            )
+        return solver
 
     def target_values(self, targets: list[Target]) -> np.ndarray:
         """Absolute target values (m), one row per step, one column per target."""
@@ -377,6 +393,7 @@ class Results:
             "geometry": (corner.geometry.source, corner.geometry.sha256),
             "sweep": (sweep.source, sweep.sha256),
             "q": np.array([s.q for s in solutions]),
+            "why": [s.why for s in solutions],  # '' where converged
         }
         return cls(columns, units, meta)
 
@@ -394,3 +411,9 @@ class Results:
         from .export import write_csv
 
         write_csv(self, path)
+
+
+def _along(t: Target) -> str:
+    if isinstance(t.direction, str):
+        return t.direction
+    return "[" + ", ".join(f"{x:.3g}" for x in t.unit_direction) + "]"

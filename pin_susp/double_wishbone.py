@@ -83,23 +83,42 @@ def corner_tree(g: Geometry) -> Tree:
         body_of["strut_bottom"] = "rocker" if g.has_pushrod else g.actuation_mount
     points = {name: (body, p[name]) for name, body in body_of.items()}
 
+    # Each loop's branch: the UBJ's circle about the upper pivot meets the upright's
+    # sphere about the LBJ on either side of the plane (pivot axis, LBJ); the
+    # steering arm's circle about the kingpin meets the trackrod's sphere on either
+    # side of the plane (kingpin, trackrod inboard); likewise the rocker.
     closures = [
         Closure(
             "upper_ball_joint",
             "ball",
             (("upper_wishbone_outboard", ubj), ("upright", ubj)),
             ("upper_wishbone_outboard", "upper_wishbone_outboard"),
+            branch=(
+                "upper_wishbone_inboard_front",
+                "upper_wishbone_inboard_rear",
+                "lower_wishbone_outboard",
+                "upper_wishbone_outboard",
+            ),
         ),
         Closure(
             "trackrod" if g.steering == "rack" else "toe_link",
             "distance",
             ((inner, p[inner]), (outer, p[outer])),
             (inner, outer),
+            branch=("lower_wishbone_outboard", "upper_wishbone_outboard", inner, outer),
         ),
     ]
     if g.has_pushrod:
         ends = ("pushrod_outboard", "pushrod_inboard")
-        closures.append(Closure("pushrod", "distance", tuple((n, p[n]) for n in ends), ends))
+        closures.append(
+            Closure(
+                "pushrod",
+                "distance",
+                tuple((n, p[n]) for n in ends),
+                ends,
+                branch=("rocker_axis_a", "rocker_axis_b", "pushrod_outboard", "pushrod_inboard"),
+            )
+        )
     return Tree(
         name=_xml_name(g.name),
         bodies=bodies,

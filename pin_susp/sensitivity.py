@@ -370,15 +370,20 @@ def _anchor_name(closure, i: int) -> str:
     return f"anchor__{closure.name}__{i}__{closure.points[i]}"
 
 
-def hardpoint_sensitivities(corner, sweep=None, progress=None) -> list[Sensitivity]:
-    """Sensitivities at the design state, or at every converged step of ``sweep``."""
+def hardpoint_sensitivities(corner, sweep=None, progress=None, with_results: bool = False):
+    """Sensitivities at the design state, or at every converged step of ``sweep``.
+
+    A list of Sensitivity; with ``with_results``, (that list, the sweep's
+    Results or None) so that a caller can name the steps that have none.
+    """
     from dataclasses import replace
 
     from .sweep import load_sweep
 
     model = HardpointSensitivity(corner)
     if sweep is None:
-        return [model.at(corner.q_design)]
+        states = [model.at(corner.q_design)]
+        return (states, None) if with_results else states
     if not hasattr(sweep, "targets"):
         sweep = load_sweep(sweep)
     results = corner.run_sweep(sweep)
@@ -390,7 +395,7 @@ def hardpoint_sensitivities(corner, sweep=None, progress=None) -> list[Sensitivi
             out.append(model.at(results.meta["q"][i], targets, step=i))
         if progress is not None:
             progress(i + 1, n)
-    return out
+    return (out, results) if with_results else out
 
 
 # How much of a change is worth talking about, per unit, for the terminal table.

@@ -25,7 +25,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import pinocchio as pin
 
-from .closures import DistanceClosure, JointTarget, PointTarget
+from .closures import DistanceClosure, JointTarget, LoopBranch, PointTarget, chirality
 from .errors import InputError
 from .geometry import MM, Geometry
 from .jet import Dual
@@ -52,6 +52,7 @@ def apply_setup(g: Geometry) -> Geometry:
         from .shim import ShimAssembly
 
         hardpoints.update(ShimAssembly(g).shimmed_hardpoints())
+        _check_branches(g, hardpoints, PARAMETER_KEYS["shim_thickness"])
     as_set = replace(g, hardpoints=hardpoints, drawn=g)
     if g.trackrod_length_delta != 0.0 or g.pushrod_length_delta != 0.0:
         hardpoints.update(_adjusted_hardpoints(as_set))
@@ -59,6 +60,24 @@ def apply_setup(g: Geometry) -> Geometry:
     cp_drawn = g.design_points()["contact_patch_center"][2]
     cp_set = as_set.design_points()["contact_patch_center"][2]
     return replace(as_set, ride_height_change=-(cp_set - cp_drawn))
+
+
+def _check_branches(drawn: Geometry, hardpoints: dict[str, np.ndarray], key: str) -> None:
+    """The set-up corner must be the drawn mechanism: every loop on its drawn branch."""
+    from .double_wishbone import corner_tree
+
+    for loop in corner_tree(drawn).closures:
+        if not loop.branch:
+            continue
+        before = chirality(*(drawn.hardpoints[n] for n in loop.branch))
+        after = chirality(*(hardpoints[n] for n in loop.branch))
+        if abs(before) >= LoopBranch.DEGENERATE and before * after <= 0.0:
+            raise InputError(
+                drawn.source,
+                key,
+                f"the corner assembles this way only with the {loop.name} loop flipped over "
+                "(another assembly branch): beyond the linkage's reach",
+            )
 
 
 def _adjusted_hardpoints(g: Geometry) -> dict[str, np.ndarray]:
@@ -77,15 +96,15 @@ def _adjusted_hardpoints(g: Geometry) -> dict[str, np.ndarray]:
         else c
         for c in corner.closures
     ]
-    solver = NewtonSolver(corner.kin, closures, _holds(corner, corner.q_design))
+    solver = NewtonSolver(corner.kin, closures, _holds(corner, corner.q_design), corner.branches)
     solution = solver.newton(corner.q_design)
     if not solution.converged:
         key = "trackrod_length_delta" if g.pushrod_length_delta == 0.0 else "pushrod_length_delta"
         raise InputError(
             g.source,
             f"config.setup.{key}",
-            f"the corner does not assemble with these lengths (residual "
-            f"{solution.max_residual * 1e3:.3g} mm): beyond the linkage's reach",
+            f"the corner does not assemble with these lengths ({solution.why}): "
+            "beyond the linkage's reach",
         )
     positions = corner.positions(solution.q)
     return {name: positions[name] for name in g.hardpoints}
@@ -181,7 +200,7 @@ class SetupModel:
             for j in ("rack_slide", "rocker_pivot")
             if c.model.existJointName(j)
         ]
-        s1 = NewtonSolver(kin, [self.ball, link0], holds1)
+        s1 = NewtonSolver(kin, [self.ball, link0], holds1, c.branches)
         q1 = self._solve(
             s1,
             c.q_design,
@@ -206,7 +225,7 @@ class SetupModel:
         if pushrod_q1 is not None:
             pr = self.links["pushrod"]
             closures.append(DistanceClosure("pushrod", pr.a, pr.b, length1 + p[2]))
-        s2 = NewtonSolver(kin, closures, _holds(c, q1))
+        s2 = NewtonSolver(kin, closures, _holds(c, q1), c.branches)
         key = PARAMETER_KEYS["pushrod_length" if p[2] else "trackrod_length"]
         q2 = self._solve(s2, q1, key, "the corner does not assemble with these lengths")
         s2.evaluate(q2)
@@ -227,10 +246,7 @@ class SetupModel:
         solution = solver.newton(q0)
         if not solution.converged:
             raise InputError(
-                self.drawn.source,
-                key,
-                f"{what} (residual {solution.max_residual * 1e3:.3g} mm): "
-                "beyond the linkage's reach",
+                self.drawn.source, key, f"{what} ({solution.why}): beyond the linkage's reach"
             )
         return solution.q
 
@@ -387,9 +403,14 @@ def setup_sheet(
     model = SetupModel(drawn)
     p0 = setup_values(drawn)
     rows = [model.state(p0)]
-    for index, values in enumerate((shim, trackrod, pushrod)):
+    for index, (flag, values) in enumerate(
+        (("--shim", shim), ("--trackrod", trackrod), ("--pushrod", pushrod))
+    ):
         for value in values:
             p = p0.copy()
             p[index] = value * MM
-            rows.append(model.state(p))
+            try:
+                rows.append(model.state(p))
+            except InputError as exc:  # the listed value is at fault, not the file
+                raise InputError(flag, "", f"{value:g} mm: {exc.problem}") from None
     return rows

@@ -30,6 +30,7 @@ from scipy.linalg import lapack
 from .closures import (
     WORLD,
     BallClosure,
+    BranchGuard,
     DistanceClosure,
     FramePoint,
     JointTarget,
@@ -51,13 +52,30 @@ class Solution:
     converged: bool
     iterations: int
     max_residual: float  # m
+    # The loop whose design assembly branch the pose left (its residual may be tiny).
+    branch: str | None = None
+
+    @property
+    def why(self) -> str:
+        """Why a step did not converge, in a user's words ('' when it did)."""
+        if self.converged:
+            return ""
+        if self.branch is not None:
+            return f"left the design assembly branch of {self.branch}"
+        return f"residual {self.max_residual * 1e3:.3g} mm"
 
 
 class NewtonSolver:
-    """Solves r(q) = 0 for the stacked rows of ``closures`` and ``targets``."""
+    """Solves r(q) = 0 for the stacked rows of ``closures`` and ``targets``.
 
-    def __init__(self, kin: Kinematics, closures: list, targets: list):
+    ``branches`` (closures.LoopBranch): a converged pose off the design
+    assembly of any of these loops is refused — not converged, ``branch``
+    naming the loop — so that continuation halves the step and retries.
+    """
+
+    def __init__(self, kin: Kinematics, closures: list, targets: list, branches=()):
         self.kin = kin
+        self.branches = BranchGuard(list(branches), kin)
         self.rows = list(closures) + list(targets)
         self.targets = list(targets)
         self.nrows = sum(row.size for row in self.rows)
@@ -96,7 +114,7 @@ class NewtonSolver:
         for iteration in range(MAX_ITERATIONS + 1):
             self.evaluate(q, jacobian=full)
             if r @ r <= TOLERANCE * TOLERANCE:  # |r|₂ bounds max |r|: one cheap call
-                return Solution(q, True, iteration, float(np.abs(r).max()))
+                return self._accept(q, iteration, float(np.abs(r).max()))
             error = max(r.max(), -r.min())
             if iteration == MAX_ITERATIONS or not np.isfinite(error):
                 break
@@ -104,7 +122,17 @@ class NewtonSolver:
                 self.evaluate(q)
             q = pin.integrate(model, q, self._step())
             full = self.keep_jacobian
-        return Solution(q, bool(error <= ACCEPT), iteration, float(error))
+        if error <= ACCEPT:
+            return self._accept(q, iteration, float(error))
+        return Solution(q, False, iteration, float(error))
+
+    def _accept(self, q: np.ndarray, iteration: int, error: float) -> Solution:
+        """A pose that meets the residual: converged if on every loop's design branch
+        (the frames in self.kin are those of q: the last evaluation was at q)."""
+        flipped = self.branches.left(self.kin)
+        if flipped is not None:
+            return Solution(q, False, iteration, error, branch=flipped)
+        return Solution(q, True, iteration, error)
 
     def _step(self) -> np.ndarray:
         J, r = self.jacobian, self.residual
