@@ -1,14 +1,27 @@
-"""Writing results and URDFs: whole files or nothing.
+"""Writing outputs: whole files or nothing, and never onto the wrong thing.
 
-Every writer goes through :func:`atomic_write`, which writes a temporary
-file beside the target and renames it into place, so an interrupted or
-failed run never leaves a half-written file.
+Every output goes through :func:`atomic_write`, the one place that renames:
+
+- a regular file, or a new path, is written to a temporary file beside it
+  and renamed into place, so an interrupted or failed run never leaves a
+  half-written file;
+- a symlink is followed: its target is replaced the same way, the link stays;
+- a character device or a FIFO (``/dev/null``, ``/dev/stdout``, a pipe) is
+  written as a stream: renaming over it would replace the device;
+- a directory, ``''`` or ``.`` is refused by :func:`check_output` before any
+  work starts.
+
+A command with several outputs writes them inside :func:`all_or_none`: each
+file goes to its temporary name, and the renames happen together at the end,
+so a failure part-way leaves none of them.
 """
 
 from __future__ import annotations
 
+import contextvars
 import json
 import os
+import stat
 import tempfile
 from contextlib import contextmanager
 from pathlib import Path
@@ -18,24 +31,143 @@ import numpy as np
 from . import __version__
 from .errors import PinSuspError
 
+# The renames a running all_or_none() block has put off: (temporary, final) pairs.
+_PENDING: contextvars.ContextVar[list | None] = contextvars.ContextVar("pending", default=None)
+
+
+def check_output(path: str | Path, what: str = "output") -> Path:
+    """Refuse an output path that cannot be written as a file, before any work.
+
+    Returns the path to write: a symlink's target, or the path itself.
+    """
+    text = os.fspath(path)
+    if text.strip() == "":
+        raise PinSuspError(f"the {what} path is empty: give a file name")
+    try:
+        return _checked(Path(text), text, what)
+    except OSError as exc:
+        raise PinSuspError(f"{text}: cannot write here ({exc.strerror})") from None
+
+
+def _checked(path: Path, text: str, what: str) -> Path:
+    if len(path.name.encode()) > _name_max(_existing_ancestor(path.parent)):
+        raise PinSuspError(f"{text}: the file name is too long for this file system")
+    if text.endswith(os.sep) or path.is_dir():
+        raise PinSuspError(f"{text}: is a directory; the {what} needs a file name")
+    target = _target(path)
+    if _is_stream(target):
+        return target
+    folder = _existing_ancestor(target.parent)
+    if not folder.is_dir():
+        raise PinSuspError(f"{text}: cannot write here ({folder} is not a directory)")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise PinSuspError(f"{text}: cannot write here (no permission in {folder})")
+    if target.exists() and not target.is_file():
+        raise PinSuspError(f"{text}: exists and is not a regular file, a device or a pipe")
+    return target
+
+
+def _target(path: Path) -> Path:
+    """A symlink's final target (followed however deep), else the path itself."""
+    return Path(os.path.realpath(path)) if path.is_symlink() else path
+
+
+def _is_stream(path: Path) -> bool:
+    try:
+        mode = path.stat().st_mode
+    except OSError:
+        return False
+    return stat.S_ISCHR(mode) or stat.S_ISFIFO(mode)
+
+
+def _existing_ancestor(folder: Path) -> Path:
+    folder = folder if str(folder) else Path(".")
+    while not folder.exists() and folder != folder.parent:
+        folder = folder.parent
+    return folder
+
+
+def _name_max(folder: Path) -> int:
+    try:
+        return os.pathconf(folder, "PC_NAME_MAX")
+    except (OSError, ValueError):
+        return 255
+
 
 @contextmanager
 def atomic_write(path: str | Path, binary: bool = False):
     """Open a file for writing that appears at ``path`` only when complete."""
-    path = Path(path)
+    target = check_output(path)
+    mode = "wb" if binary else "w"
+    newline = None if binary else ""
+    if _is_stream(target):
+        with open(target, mode, newline=newline) as f:
+            yield f
+        return
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+        target.parent.mkdir(parents=True, exist_ok=True)
+        # A short temporary name: the final name may be as long as the file system allows.
+        fd, tmp = tempfile.mkstemp(prefix=".pin_susp-", suffix=".tmp", dir=target.parent)
     except OSError as exc:
         raise PinSuspError(f"{path}: cannot write here ({exc.strerror})") from None
     try:
-        with os.fdopen(fd, "wb") if binary else os.fdopen(fd, "w", newline="") as f:
+        with os.fdopen(fd, mode, newline=newline) as f:
             yield f
-        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes it private; files are not
-        os.replace(tmp, path)
+        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes it private; outputs are not
     except BaseException:
         os.unlink(tmp)
         raise
+    pending = _PENDING.get()
+    if pending is None:
+        _rename(tmp, target)
+    else:
+        pending.append((tmp, target))
+
+
+@contextmanager
+def all_or_none():
+    """Outputs written inside appear together at the end, or not at all."""
+    pending: list = []
+    token = _PENDING.set(pending)
+    try:
+        yield
+    except BaseException:
+        for tmp, _ in pending:
+            _unlink(tmp)
+        raise
+    finally:
+        _PENDING.reset(token)
+    for i, (tmp, target) in enumerate(pending):
+        try:
+            _rename(tmp, target)
+        except BaseException:
+            for later, _ in pending[i + 1 :]:
+                _unlink(later)
+            raise
+
+
+def staged(path: str | Path) -> Path:
+    """Where the contents of ``path`` are now: its temporary file inside all_or_none()."""
+    target = _target(Path(path))
+    for tmp, final in _PENDING.get() or ():
+        if final == target:
+            return Path(tmp)
+    return target
+
+
+def _rename(tmp: str, target: Path) -> None:
+    try:
+        os.replace(tmp, target)
+    except OSError as exc:
+        _unlink(tmp)
+        raise PinSuspError(f"{target}: cannot write here ({exc.strerror})") from None
+
+
+def _unlink(path: str) -> None:
+    try:
+        os.unlink(path)
+    except FileNotFoundError:
+        pass
 
 
 def _umask() -> int:

@@ -16,17 +16,21 @@ world coordinates at the design state; this module writes it as URDF
 
 from __future__ import annotations
 
+import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 
 import numpy as np
 import pinocchio as pin
 
+from .errors import PinSuspError
+
 NAMESPACE = "https://github.com/pin-susp/pin_susp/urdf"
 BALL_AXES = (("z", (0.0, 0.0, 1.0)), ("y", (0.0, 1.0, 0.0)), ("x", (1.0, 0.0, 0.0)))
 # Joint ranges only matter to tools that clamp; wide enough for any sweep.
 REVOLUTE_LIMIT = np.pi
 PRISMATIC_LIMIT = 0.5  # m
+ROD_MIN_LENGTH = 1e-9  # m
 
 
 @dataclass(frozen=True)
@@ -61,6 +65,9 @@ class Closure:
     kind: str
     anchors: tuple[tuple[str, np.ndarray], tuple[str, np.ndarray]]
     points: tuple[str, str] = ()  # the named points the anchors sit at
+    # Four named points whose chirality tells this loop's two assemblies apart
+    # (closures.LoopBranch): the pose keeps the sign it has at design.
+    branch: tuple[str, str, str, str] | tuple[()] = ()
 
 
 @dataclass(frozen=True)
@@ -83,6 +90,15 @@ class Tree:
     closures: list[Closure]
     visuals: list[Visual] = field(default_factory=list)
     materials: dict[str, tuple[float, float, float, float]] = field(default_factory=dict)
+
+    def __post_init__(self):
+        # A rod between coincident points (a strut bottom on the rocker axis) has
+        # no direction to draw along: it is left out rather than drawn as NaN.
+        self.visuals = [
+            v
+            for v in self.visuals
+            if v.shape != "rod" or np.linalg.norm(v.end - v.start) > ROD_MIN_LENGTH
+        ]
 
 
 def tree_to_urdf(tree: Tree, comment: str = "") -> str:
@@ -210,5 +226,12 @@ def _visual(link, v: Visual, link_origin: np.ndarray):
 
 
 def _fmt(values) -> str:
-    """Shortest text that reads back to the same floats (and -0 as 0)."""
-    return " ".join(repr(float(x) + 0.0) for x in values)
+    """Shortest text that reads back to the same floats (and -0 as 0).
+
+    A non-finite number would make the file unreadable to other tools (urdfdom
+    rejects it): it is a bug upstream, never written.
+    """
+    values = [float(x) + 0.0 for x in values]
+    if not all(math.isfinite(x) for x in values):
+        raise PinSuspError(f"refusing to write a non-finite number ({values}) into a model file")
+    return " ".join(map(repr, values))

@@ -11,6 +11,11 @@ displaying the pose there.
 
 from __future__ import annotations
 
+import os
+import signal
+import subprocess
+import sys
+
 import numpy as np
 import pinocchio as pin
 
@@ -43,6 +48,54 @@ def segments(corner, positions: dict[str, np.ndarray]) -> dict[str, tuple[np.nda
     return out
 
 
+# meshcat's own server, with its web server bound to loopback (meshcat 0.3.2's
+# listens on every interface; its ZMQ socket is on 127.0.0.1 already).
+_SERVER = """
+import sys
+import tornado.web
+listen = tornado.web.Application.listen
+tornado.web.Application.listen = lambda app, port, address="127.0.0.1", **kw: listen(
+    app, port, address, **kw
+)
+sys.argv = ["meshcat-server"]
+from meshcat.servers.zmqserver import main
+main()
+"""
+
+
+def start_server() -> tuple[subprocess.Popen, str]:
+    """A meshcat server on 127.0.0.1 that ends with this process (even on SIGKILL).
+
+    Returns the process and its ZMQ URL.
+    """
+    from meshcat.servers.zmqserver import match_zmq_url
+
+    proc = subprocess.Popen(
+        [sys.executable, "-u", "-c", _SERVER],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        start_new_session=True,  # a Ctrl+C is ours to handle: we stop it in close()
+        preexec_fn=_die_with_parent,
+    )
+    line = ""
+    while "zmq_url" not in line:
+        line = proc.stdout.readline().decode("utf-8", "replace")
+        if not line and proc.poll() is not None:
+            raise RuntimeError(f"the meshcat server exited at start (code {proc.returncode})")
+    proc.stdout.readline()  # its web URL: the viewer asks for it over ZMQ
+    return proc, match_zmq_url(line.strip())
+
+
+def _die_with_parent() -> None:
+    """In the child: SIGTERM when the parent dies (Linux prctl PR_SET_PDEATHSIG)."""
+    if sys.platform.startswith("linux"):
+        import ctypes
+
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGTERM)
+        if os.getppid() == 1:  # the parent died before prctl: go now
+            os._exit(0)
+
+
 def _rod_transform(p0: np.ndarray, p1: np.ndarray) -> np.ndarray:
     """Place meshcat's unit cylinder (along its y axis) from p0 to p1."""
     d = p1 - p0
@@ -65,7 +118,11 @@ class CornerScene:
         import meshcat.geometry as mg
 
         self.corner = corner
-        self.viewer = viewer if viewer is not None else meshcat.Visualizer()
+        self.server = None
+        if viewer is None:
+            self.server, zmq_url = start_server()
+            viewer = meshcat.Visualizer(zmq_url=zmq_url)
+        self.viewer = viewer
         self.viewer[ROOT].delete()
         self.robots = []
         drawn = corner.geometry.drawn
@@ -153,7 +210,11 @@ class CornerScene:
 
     def close(self) -> None:
         """Stop the meshcat server this scene started."""
-        proc = getattr(self.viewer.window, "server_proc", None)
+        proc = self.server
         if proc is not None and proc.poll() is None:
             proc.terminate()
-            proc.wait(timeout=10)
+            try:
+                proc.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait()
