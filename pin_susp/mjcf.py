@@ -16,6 +16,7 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 
+from .errors import PinSuspError
 from .geometry import unit
 from .urdf import BALL_AXES, Tree, _fmt
 
@@ -139,3 +140,79 @@ def tree_to_mjcf(tree: Tree, comment: str = "") -> str:
     ET.indent(root)
     head = f"<!-- {comment} -->\n" if comment else ""
     return head + ET.tostring(root, encoding="unicode") + "\n"
+
+
+# what identifies the MJCF of a corner: its named elements, by kind, in this order
+KINDS = ("site", "body", "joint", "equality constraint")
+
+
+def check_mjcf(text: str, tree: Tree, source: str = "MJCF") -> None:
+    """Raise PinSuspError unless ``text`` is the MJCF :func:`tree_to_mjcf` writes for ``tree``.
+
+    The text must be XML with a ``<mujoco>`` root holding the same named
+    sites, bodies, joints and equality constraints (sites on the same bodies,
+    joints of the same types); positions are not compared, so the MJCF of a
+    corner whose hardpoints moved since the export passes, and the comparison
+    of the solutions shows the difference.
+    """
+    problem = _mjcf_problem(text, tree)
+    if problem:
+        raise PinSuspError(f"{source}: {problem}")
+
+
+def _mjcf_problem(text: str, tree: Tree) -> str | None:
+    if not text.strip():
+        return "is empty: expected the MJCF written by pin-susp mjcf"
+    if "\x00" in text or "\ufffd" in text:
+        return "is not a text file: expected the MJCF (XML) written by pin-susp mjcf"
+    try:
+        root = ET.fromstring(text)
+    except ET.ParseError as exc:
+        return f"is not valid XML ({exc})"
+    if root.tag != "mujoco":
+        what = " (a URDF?)" if root.tag == "robot" else ""
+        return f"is not MJCF{what}: its root element is <{root.tag}>, not <mujoco>"
+    ours, theirs = _elements(ET.fromstring(tree_to_mjcf(tree))), _elements(root)
+    differences = []
+    for kind in KINDS:
+        mine, yours = ours[kind], theirs[kind]
+        differences += [f"missing {kind} {_name(n)}" for n in mine if n not in yours]
+        differences += [
+            f"has a {kind} {_name(n)} this corner does not have" for n in yours if n not in mine
+        ]
+        differences += [
+            f"{kind} {_name(n)} is {' '.join(yours[n])}, not {' '.join(mine[n])}"
+            for n in mine
+            if n in yours and yours[n] != mine[n]
+        ]
+    if not differences:
+        return None
+    more = f" (and {len(differences) - 1} more differences)" if len(differences) > 1 else ""
+    return (
+        f"is not the MJCF of this corner ({tree.name}): {differences[0]}{more}; "
+        "write it with pin-susp mjcf GEOMETRY -o FILE"
+    )
+
+
+def _name(name: str) -> str:
+    return name or "(unnamed)"
+
+
+def _elements(root: ET.Element) -> dict[str, dict[str, tuple[str, ...]]]:
+    """Named elements by kind, each with what must match: a site's body, a joint's type."""
+    found: dict[str, dict[str, tuple[str, ...]]] = {kind: {} for kind in KINDS}
+    for body in root.iter("body"):
+        found["body"].setdefault(body.get("name", ""), ())
+        for child in body:
+            if child.tag == "site":
+                found["site"].setdefault(child.get("name", ""), ("on body", body.get("name", "")))
+            elif child.tag == "joint":
+                found["joint"].setdefault(
+                    child.get("name", ""), ("of type", child.get("type", "hinge"))
+                )
+    for site in root.findall("./worldbody/site"):
+        found["site"].setdefault(site.get("name", ""), ("on body", "world"))
+    for equality in root.iter("equality"):
+        for child in equality:
+            found["equality constraint"].setdefault(child.get("name", ""), (child.tag,))
+    return found

@@ -17,7 +17,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .errors import InputError  # noqa: E402
+from .errors import InputError, PinSuspError  # noqa: E402
 from .export import atomic_write  # noqa: E402
 from .metrics import HUB_Z, METRIC_BY_NAME, RACK, STANDARD, Derivative  # noqa: E402
 
@@ -35,48 +35,101 @@ DERIVED = ("camber", "roadwheel_angle")  # their derivative columns get panels
 
 
 class ResultsFile:
-    """A results CSV read back: columns as float arrays (empty cells → NaN), units."""
+    """A results CSV read back: columns as float arrays (empty cells → NaN), units.
 
-    def __init__(self, path: str | Path):
+    Anything that is not a results CSV pin_susp could have written (binary,
+    empty, no rows, ragged rows, a corrupt ``# units:`` line, no numbers at
+    all) is an :class:`InputError` naming the file; empty cells and empty
+    columns are fine (a failed step, an undefined metric) and are not drawn.
+    """
+
+    def __init__(self, path: str | Path, name: str | Path | None = None):
+        """``name``: what messages and the legend call the file (default: ``path``)."""
         self.path = Path(path)
-        self.label = self.path.stem
+        self.source = source = str(path if name is None else name)
+        self.label = Path(source).stem
         try:
-            lines = self.path.read_text().splitlines()
+            raw = self.path.read_bytes()
         except OSError as exc:
-            raise InputError(str(path), "", f"cannot be read ({exc.strerror})") from None
-        comments = [ln for ln in lines if ln.startswith("#")]
-        rows = [ln.split(",") for ln in lines if ln and not ln.startswith("#")]
-        if not rows or "step_index" not in rows[0]:
-            raise InputError(str(path), "", "not a pin_susp results CSV (no step_index column)")
-        header, body = rows[0], rows[1:]
+            raise InputError(source, "", f"cannot be read ({exc.strerror})") from None
+        if not raw.strip():
+            raise InputError(source, "", "is empty: not a pin_susp results CSV")
+        try:
+            text = raw.decode("utf-8")
+        except UnicodeDecodeError:
+            text = None
+        if text is None or "\x00" in text:
+            raise InputError(source, "", "is not a text file: not a pin_susp results CSV")
+        comments, rows = [], []
+        for number, line in enumerate(text.splitlines(), start=1):
+            if line.startswith("#"):
+                comments.append(line)
+            elif line.strip():
+                rows.append((number, line.split(",")))
+        if not rows or "step_index" not in rows[0][1]:
+            raise InputError(source, "", "not a pin_susp results CSV (no step_index column)")
+        (_, header), body = rows[0], rows[1:]
+        if not body:
+            raise InputError(source, "", "no data rows (only a header)")
+        seen: set[str] = set()
+        twice = next((n for n in header if n in seen or seen.add(n)), None)
+        if twice is not None:
+            raise InputError(source, twice, "this column appears twice in the header")
+        for number, row in body:
+            if len(row) != len(header):
+                raise InputError(
+                    source,
+                    f"line {number}",
+                    f"{len(row)} cells, but the header has {len(header)} columns "
+                    "(a damaged or hand-edited file)",
+                )
         self.units = {}
         for line in comments:
-            if line.startswith("# units: "):
-                self.units = json.loads(line.removeprefix("# units: "))
+            if line.startswith("# units:"):
+                self.units = _units(source, line.removeprefix("# units:"))
         self.columns = {}
         for j, name in enumerate(header):
-            cells = [r[j] if j < len(r) else "" for r in body]
             try:
-                self.columns[name] = np.array(
-                    [
-                        np.nan
-                        if c == ""
-                        else 1.0
-                        if c == "True"
-                        else 0.0
-                        if c == "False"
-                        else float(c)
-                        for c in cells
-                    ]
-                )
+                self.columns[name] = np.array([_cell(row[j]) for _, row in body])
             except ValueError:
-                raise InputError(str(path), name, "has a cell that is not a number") from None
+                raise InputError(source, name, "has a cell that is not a number") from None
         for needed in ("wheel_travel", "camber"):
             if needed not in self.columns:
-                raise InputError(str(path), needed, "missing column: not a sweep results CSV")
+                raise InputError(source, needed, "missing column: not a sweep results CSV")
+        if not any(np.any(np.isfinite(c)) for c in self.columns.values()):
+            raise InputError(source, "", "no numbers in it: every data cell is empty")
+        if not np.any(np.isfinite(self.columns["wheel_travel"])):
+            converged = self.columns.get("solver_converged")
+            if converged is not None and not np.any(converged == 1.0):
+                raise InputError(source, "", "no step of this sweep converged: nothing to plot")
+            raise InputError(source, "wheel_travel", "no values: every cell is empty")
 
     def __getitem__(self, name):
         return self.columns[name]
+
+
+def _cell(text: str) -> float:
+    """A CSV cell as written by pin_susp: a number, empty (NaN), True or False."""
+    text = text.strip()
+    if text == "":
+        return np.nan
+    if text in ("True", "False"):
+        return float(text == "True")
+    return float(text)
+
+
+def _units(source: str, text: str) -> dict[str, str]:
+    """The ``# units:`` comment: a JSON object of column → unit."""
+    try:
+        units = json.loads(text)
+    except ValueError as exc:
+        raise InputError(source, "# units", f"not valid JSON ({exc})") from None
+    if not isinstance(units, dict):
+        raise InputError(source, "# units", f"expected a JSON object, got {type(units).__name__}")
+    bad = next((k for k, v in units.items() if not isinstance(v, str)), None)
+    if bad is not None:
+        raise InputError(source, f"# units: {bad}", f"expected a unit string, got {units[bad]!r}")
+    return units
 
 
 def label(name: str) -> str:
@@ -93,10 +146,15 @@ def label(name: str) -> str:
 
 def x_axis(results: ResultsFile) -> tuple[str, str]:
     """Wheel travel when the wheel moves, else the rack position (a steer sweep)."""
-    travel = results["wheel_travel"]
-    if np.nanmax(travel) - np.nanmin(travel) > 1e-6 or "trackrod_inboard_y" not in results.columns:
+    rack = results.columns.get("trackrod_inboard_y")
+    if _varies(results["wheel_travel"]) or rack is None or not _varies(rack):
         return "wheel_travel", "Wheel travel (+ bump) [mm]"
     return "trackrod_inboard_y", "Rack position (trackrod_inboard y) [mm]"
+
+
+def _varies(column: np.ndarray) -> bool:
+    finite = column[np.isfinite(column)]
+    return finite.size > 1 and float(np.ptp(finite)) > 1e-6
 
 
 def panels(results: list[ResultsFile], xname: str) -> list[str]:
@@ -108,8 +166,21 @@ def panels(results: list[ResultsFile], xname: str) -> list[str]:
 
 def report_figure(results: list[ResultsFile]):
     """One panel per metric against wheel travel (or rack), one line per results file."""
+    if not results:
+        raise PinSuspError("no results file to plot")
     xname, xlabel = x_axis(results[0])
+    for r in results[1:]:
+        if xname not in r.columns or not np.any(np.isfinite(r[xname])):
+            raise InputError(
+                r.source,
+                xname,
+                f"no values, but {results[0].label} is plotted against it: "
+                "plot results of the same kind of sweep together",
+            )
     names = panels(results, xname)
+    if not names:
+        files = ", ".join(r.source for r in results)
+        raise InputError(files, "", "no metric column has a value to plot")
     ncols = 4
     nrows = -(-len(names) // ncols)
     fig, axes = plt.subplots(nrows, ncols, figsize=(4.4 * ncols, 3.1 * nrows), squeeze=False)
@@ -117,7 +188,8 @@ def report_figure(results: list[ResultsFile]):
         unit = next((r.units.get(name, "") for r in results if name in r.columns), "")
         for r in results:
             if name in r.columns:
-                ax.plot(r[xname], r[name], label=r.label, linewidth=1.6)
+                # a lone point (one row, or one step between failed ones) shows as a dot
+                ax.plot(r[xname], r[name], label=r.label, linewidth=1.6, marker=_marker(r, name))
         ax.set_title(label(name), fontsize=10)
         ax.set_ylabel(f"{name} [{unit}]" if unit else name, fontsize=8)
         ax.set_xlabel(xlabel, fontsize=8)
@@ -130,6 +202,12 @@ def report_figure(results: list[ResultsFile]):
     fig.suptitle("pin_susp kinematics: " + ", ".join(r.label for r in results), fontsize=12)
     fig.tight_layout()
     return fig
+
+
+def _marker(r: ResultsFile, name: str) -> str | None:
+    finite = np.isfinite(r[name])
+    lone = finite & ~np.r_[False, finite[:-1]] & ~np.r_[finite[1:], False]
+    return "o" if np.any(lone) else None
 
 
 def drawing_figure(corner):
@@ -223,9 +301,44 @@ def _tyre(front, side, c, p, alpha, style) -> None:
     )
 
 
+def check_image_path(path: str | Path) -> None:
+    """Raise PinSuspError unless matplotlib can write an image with this file's ending.
+
+    Cheap, and the output path is not touched (nothing created, opened or
+    checked): meant for every image output before any work starts. The
+    formats are matplotlib's own list; the ending is matched case-insensitively
+    (``OUT.PNG`` is a PNG). Only 'pgf' looks further: for its TeX program.
+    """
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    supported = FigureCanvasBase.get_supported_filetypes()
+    ext = _extension(path)
+    hint = f"(use {', '.join(f for f in ('png', 'pdf', 'svg') if f in supported)}, ...)"
+    if not ext:
+        raise PinSuspError(f"{path}: no file ending to tell the image format {hint}")
+    if ext not in supported:
+        raise PinSuspError(f"{path}: unsupported image format {ext!r} {hint}")
+    if ext == "pgf":  # matplotlib lists it, but writes it only with a TeX installation
+        import shutil
+
+        tex = matplotlib.rcParams["pgf.texsystem"]
+        if shutil.which(tex) is None:
+            raise PinSuspError(f"{path}: image format 'pgf' needs {tex}, which is not installed")
+
+
+def _extension(path: str | Path) -> str:
+    return Path(path).suffix.removeprefix(".").lower()
+
+
 def save_figure(fig, path: str | Path) -> None:
     """Write the figure whole or not at all (format from the file's ending)."""
-    path = Path(path)
-    with atomic_write(path, binary=True) as f:
-        fig.savefig(f, format=path.suffix.lstrip(".") or "png", dpi=110)
-    plt.close(fig)
+    try:
+        check_image_path(path)
+        path = Path(path)
+        with atomic_write(path, binary=True) as f:
+            try:
+                fig.savefig(f, format=_extension(path), dpi=110)
+            except OSError as exc:
+                raise PinSuspError(f"{path}: cannot write ({exc.strerror or exc})") from None
+    finally:
+        plt.close(fig)

@@ -12,11 +12,13 @@ points and compared with pin_susp's, metric by metric and point by point.
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from .closures import ContactPatchPoint
+from .errors import PinSuspError
 from .metrics import metric_columns
 from .pointwise import PointwiseCorner
 
@@ -38,6 +40,8 @@ class EngineReport:
     failed_steps: list[int] = field(default_factory=list)
     disagree: set[str] = field(default_factory=set)
     note: str = ""
+    warnings: int = 0  # how many warnings the engine raised (MuJoCo's: silenced, counted)
+    first_warning: str = ""
 
     @property
     def worst(self) -> float:
@@ -98,16 +102,26 @@ def pointwise_points(corner, sweep) -> list[dict | None]:
 
 
 class MujocoCorner:
-    """The exported MJCF in MuJoCo, solved to targets by Newton on its own Jacobians."""
+    """The exported MJCF in MuJoCo, solved to targets by Newton on its own Jacobians.
 
-    def __init__(self, mjcf_text: str, corner):
+    Build and use it inside :func:`quiet_mujoco`: MuJoCo otherwise prints its
+    warnings and appends them to ``MUJOCO_LOG.TXT`` in the working directory.
+    """
+
+    def __init__(self, mjcf_text: str, corner, source: str = "the MJCF"):
         import mujoco
 
         self.mj = mujoco
-        self.model = mujoco.MjModel.from_xml_string(mjcf_text)
+        try:
+            self.model = mujoco.MjModel.from_xml_string(mjcf_text)
+        except ValueError as exc:
+            detail = " ".join(str(exc).split())
+            raise PinSuspError(f"{source}: MuJoCo cannot load it: {detail}") from None
         self.data = mujoco.MjData(self.model)
         self.sites = {
-            name: _Site(self, name) for name in corner.point_names if name != "contact_patch_center"
+            name: _Site(self, name, source)
+            for name in corner.point_names
+            if name != "contact_patch_center"
         }
         self.sites["contact_patch_center"] = ContactPatchPoint(
             "contact_patch_center",
@@ -130,22 +144,69 @@ class MujocoCorner:
                 rows.append([site.position(self) @ direction - value])
                 jac.append(direction @ site.jacobian(self))
             r = np.concatenate(rows)
+            if not np.all(np.isfinite(r)):
+                return None  # diverged, or a NaN in the MJCF: lstsq would fail on it
             if np.max(np.abs(r)) < 1e-13:
                 return {name: s.position(self).copy() for name, s in self.sites.items()}
             J = np.vstack(jac)
+            if not np.all(np.isfinite(J)):
+                return None
             dv = np.linalg.lstsq(J, -r, rcond=None)[0]
             mj.mj_integratePos(m, d.qpos, dv, 1.0)
         return None
 
 
+class _Warnings:
+    """A MuJoCo warning handler that only counts (and keeps the first)."""
+
+    def __init__(self):
+        self.count = 0
+        self.first = ""
+
+    def __call__(self, message: str) -> None:
+        if not self.count:
+            self.first = " ".join(str(message).split())
+        self.count += 1
+
+
+@contextmanager
+def quiet_mujoco(mj):
+    """MuJoCo's warnings counted instead of printed and logged to MUJOCO_LOG.TXT.
+
+    Installs a counting ``mju_user_warning`` handler (MuJoCo then neither
+    prints nor logs a warning) and, where MuJoCo has it (3.4+), switches the
+    default log handler's console and file output off as well; both are
+    restored on the way out. Yields the :class:`_Warnings` counter.
+    """
+    counter = _Warnings()
+    set_warning = getattr(mj, "set_mju_user_warning", None)
+    log_config = getattr(mj, "MjLogConfig", None)
+    old_warning = mj.get_mju_user_warning() if set_warning else None
+    old_config = log_config.get() if log_config else None
+    try:
+        if set_warning:
+            set_warning(counter)
+        if log_config:
+            config = log_config.get()
+            config.logto_console = False
+            config.logto_file = False
+            config.set()
+        yield counter
+    finally:
+        if set_warning:
+            set_warning(old_warning)
+        if old_config is not None:
+            old_config.set()
+
+
 class _Site:
     """A MuJoCo site as a point: position and (3 × nv) Jacobian."""
 
-    def __init__(self, engine: MujocoCorner, name: str):
+    def __init__(self, engine: MujocoCorner, name: str, source: str = "the MJCF"):
         self.name = name
         self.id = engine.mj.mj_name2id(engine.model, engine.mj.mjtObj.mjOBJ_SITE, name)
         if self.id < 0:
-            raise ValueError(f"the MJCF has no site {name!r}")
+            raise PinSuspError(f"{source}: is not the MJCF of this corner: missing site {name}")
 
     def position(self, engine: MujocoCorner) -> np.ndarray:
         return engine.data.site_xpos[self.id]
@@ -156,18 +217,45 @@ class _Site:
         return jacp
 
 
-def mujoco_points(corner, sweep, mjcf_text: str) -> list[dict | None]:
-    engine = MujocoCorner(mjcf_text, corner)
-    return [engine.solve(targets) for targets in step_targets(corner, sweep)]
+def mujoco_points(corner, sweep, mjcf_text: str, source: str = "the MJCF") -> list[dict | None]:
+    """MuJoCo's points at every step (None where it did not converge), quietly."""
+    return _mujoco_points(corner, sweep, mjcf_text, source)[0]
 
 
-def validate(corner, sweep, mjcf_text: str | None = None, tolerance: float = TOLERANCE):
+def _mujoco_points(corner, sweep, mjcf_text: str, source: str):
+    """(points, warnings counter); MuJoCo's errors as PinSuspError naming ``source``."""
+    import mujoco
+
+    with quiet_mujoco(mujoco) as counter:
+        try:
+            engine = MujocoCorner(mjcf_text, corner, source)
+            points = [engine.solve(targets) for targets in step_targets(corner, sweep)]
+        except (mujoco.FatalError, mujoco.UnexpectedError) as exc:
+            detail = " ".join(str(exc).split())
+            raise PinSuspError(f"{source}: MuJoCo failed on it: {detail}") from None
+    return points, counter
+
+
+def validate(
+    corner,
+    sweep,
+    mjcf_text: str | None = None,
+    tolerance: float = TOLERANCE,
+    mjcf_source: str = "--mjcf",
+):
     """Solve the sweep with pin_susp, then with each available engine; compare.
 
-    Returns (results, reports). ``mjcf_text`` defaults to the corner's own export.
+    Returns (results, reports). ``mjcf_text`` defaults to the corner's own
+    export; given, it must be that export (:func:`pin_susp.mjcf.check_mjcf`,
+    checked before any solving) and ``mjcf_source`` names it in errors (the
+    file's path). A file that is not this corner's MJCF, or that MuJoCo cannot
+    load, raises PinSuspError; MuJoCo's warnings are counted in the report's
+    ``warnings``, never printed nor written to MUJOCO_LOG.TXT.
     """
-    from .mjcf import tree_to_mjcf
+    from .mjcf import check_mjcf, tree_to_mjcf
 
+    if mjcf_text is not None:
+        check_mjcf(mjcf_text, corner.tree, mjcf_source)
     results = corner.run_sweep(sweep)
     points = pointwise_points(corner, sweep)
     reports = [compare(corner, results, points, "pointwise", tolerance)]
@@ -182,7 +270,12 @@ def validate(corner, sweep, mjcf_text: str | None = None, tolerance: float = TOL
             )
         )
         return results, reports
-    text = mjcf_text if mjcf_text is not None else tree_to_mjcf(corner.tree)
-    points = mujoco_points(corner, sweep, text)
-    reports.append(compare(corner, results, points, "mujoco", tolerance))
+    if mjcf_text is None:
+        text, source = tree_to_mjcf(corner.tree), "the corner's exported MJCF"
+    else:
+        text, source = mjcf_text, mjcf_source
+    points, warnings = _mujoco_points(corner, sweep, text, source)
+    report = compare(corner, results, points, "mujoco", tolerance)
+    report.warnings, report.first_warning = warnings.count, warnings.first
+    reports.append(report)
     return results, reports
