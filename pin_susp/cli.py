@@ -9,8 +9,15 @@ written).
 from __future__ import annotations
 
 import argparse
-import shutil
+import contextlib
+import hashlib
+import math
+import re
+import signal
 import sys
+import threading
+import warnings
+from dataclasses import replace
 from importlib import resources
 from pathlib import Path
 
@@ -20,10 +27,11 @@ import yaml
 from . import __version__
 from .corner import Corner, Results
 from .errors import PinSuspError
-from .export import write_text
+from .export import all_or_none, check_output, staged, write_text
 from .geometry import load_geometry
 from .metrics import METRICS
 from .sweep import load_sweep
+from .yamlio import MAX_LENGTH_MM
 
 SHEET_METRICS = (  # column, unit, short heading
     ("camber", "deg", "camber"),
@@ -43,22 +51,63 @@ EXIT_INPUT = 2
 
 def main(argv: list[str] | None = None) -> int:
     parser = _parser()
-    args = parser.parse_args(argv)
     try:
-        return args.run(args)
-    except PinSuspError as exc:
-        print(f"pin-susp: error: {exc}", file=sys.stderr)
-        return EXIT_INPUT
-    except KeyboardInterrupt:
-        print("pin-susp: interrupted, nothing written", file=sys.stderr)
-        return 130
-    except BrokenPipeError:  # output piped into `head` and the like
-        sys.stderr.close()
-        return 0
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # --help, --version, or a usage error (one line, exit 2)
+        return exc.code if isinstance(exc.code, int) else EXIT_INPUT
+    with _terminate_as_exit(), warnings.catch_warnings(), np.errstate(all="ignore"):
+        # Undefined values (parallel arms, a toggle) are NaN by design and flagged
+        # where they matter; numpy's warnings about them would only be noise.
+        warnings.simplefilter("ignore", RuntimeWarning)
+        try:
+            return args.run(args)
+        except PinSuspError as exc:
+            print(f"pin-susp: error: {exc}", file=sys.stderr)
+            return EXIT_INPUT
+        except (KeyboardInterrupt, _Terminated) as exc:
+            signal_number = exc.signal if isinstance(exc, _Terminated) else signal.SIGINT
+            print("pin-susp: interrupted, nothing written", file=sys.stderr)
+            return 128 + signal_number
+        except BrokenPipeError:  # output piped into `head` and the like
+            sys.stderr.close()
+            return 0
+
+
+class _Terminated(BaseException):
+    """SIGTERM or SIGHUP: unwinds like Ctrl+C, so temporary files and servers are removed."""
+
+    def __init__(self, signal_number: int):
+        super().__init__(signal_number)
+        self.signal = signal_number
+
+
+@contextlib.contextmanager
+def _terminate_as_exit():
+    """While a command runs, SIGTERM and SIGHUP raise _Terminated (main thread only)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def handler(signal_number, _frame):
+        raise _Terminated(signal_number)
+
+    previous = {s: signal.signal(s, handler) for s in (signal.SIGTERM, signal.SIGHUP)}
+    try:
+        yield
+    finally:
+        for s, h in previous.items():
+            signal.signal(s, h)
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with usage errors on one line (the usage is in --help)."""
+
+    def error(self, message: str):
+        self.exit(EXIT_INPUT, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(
+    p = _Parser(
         prog="pin-susp",
         description="Suspension kinematics on Pinocchio: a corner from a YAML file of "
         "hardpoints (mm, ISO 8855), solved exactly through bump and steer sweeps.",
@@ -129,7 +178,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     va.add_argument(
         "--tolerance",
-        type=float,
+        type=_positive,
         default=1e-6,
         metavar="TOL",
         help="largest difference accepted, mm and deg (default 1e-6)",
@@ -190,21 +239,21 @@ def _parser() -> argparse.ArgumentParser:
     )
     t.add_argument(
         "--thread-pitch",
-        type=float,
+        type=_positive,
         metavar="MM",
         help="also give sensitivities per turn of an adjuster with this pitch "
         "(length change per turn; a left/right-hand turnbuckle: twice the pitch)",
     )
-    t.add_argument("--camber", type=float, metavar="DEG", help="target static camber (shim)")
+    t.add_argument("--camber", type=_finite, metavar="DEG", help="target static camber (shim)")
     t.add_argument(
         "--toe",
-        type=float,
+        type=_finite,
         metavar="DEG",
         help="target static roadwheel angle, + toe-in (trackrod)",
     )
     t.add_argument(
         "--ride-height-change",
-        type=float,
+        type=_finite,
         metavar="MM",
         help="target ride-height change, + car higher (pushrod)",
     )
@@ -232,7 +281,7 @@ def _parser() -> argparse.ArgumentParser:
     h.add_argument("-o", "--output", metavar="SENS.csv", help="long-format CSV")
     h.add_argument(
         "--top",
-        type=int,
+        type=_count,
         default=3,
         metavar="N",
         help="entries per metric in the printed table (default 3)",
@@ -275,7 +324,7 @@ def _parser() -> argparse.ArgumentParser:
     _geometry_argument(v)
     v.add_argument("sweep", metavar="SWEEP", nargs="?", help="sweep YAML to animate")
     v.add_argument("--html", metavar="OUT.html", help="write a self-contained replay and exit")
-    v.add_argument("--fps", type=float, default=10.0, help="animation frames per second")
+    v.add_argument("--fps", type=_positive, default=10.0, help="animation frames per second")
     v.set_defaults(run=_view)
     return p
 
@@ -285,44 +334,92 @@ def _geometry_argument(parser: argparse.ArgumentParser) -> None:
 
 
 def _numbers(text: str) -> list[float]:
+    """Lengths in mm separated by commas: finite, within the 100 m limit of any car."""
     try:
-        return [float(x) for x in text.split(",") if x.strip()]
+        values = [float(x) for x in text.split(",") if x.strip()]
     except ValueError:
         raise argparse.ArgumentTypeError(
             f"expected numbers separated by commas, got {text!r}"
         ) from None
+    for x in values:
+        if not math.isfinite(x) or abs(x) > MAX_LENGTH_MM:
+            raise argparse.ArgumentTypeError(
+                f"{x:g} mm is not a finite length within {MAX_LENGTH_MM / 1000:g} m"
+            )
+    return values
+
+
+def _positive(text: str) -> float:
+    try:
+        x = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not (math.isfinite(x) and x > 0.0):
+        raise argparse.ArgumentTypeError(f"expected a finite number > 0, got {text!r}")
+    return x
+
+
+def _finite(text: str) -> float:
+    try:
+        x = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not math.isfinite(x):
+        raise argparse.ArgumentTypeError(f"expected a finite number, got {text!r}")
+    return x
+
+
+def _count(text: str) -> int:
+    if not re.fullmatch(r"[0-9]{1,6}", text.strip()):
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 0, got {text!r}")
+    return int(text)
 
 
 def _sweep(args) -> int:
+    check_output(args.output, "results")
+    if args.plot is not None:
+        _check_image(args.plot)
     corner = Corner(load_geometry(args.geometry))
     sweep = load_sweep(args.sweep)
     corner.solver_for(sweep.targets, sweep.source)  # target errors before any work
     results = corner.run_sweep(sweep, progress=_progress_bar(sweep.steps, args.quiet))
-    results.to_csv(args.output)
-    if args.plot:
-        from .plots import ResultsFile, report_figure, save_figure
+    plot = args.plot is not None and results["solver_converged"].any()
+    with all_or_none():
+        results.to_csv(args.output)
+        if plot:
+            from .plots import ResultsFile, report_figure, save_figure
 
-        save_figure(report_figure([ResultsFile(args.output)]), args.plot)
+            written = ResultsFile(staged(args.output), name=args.output)
+            save_figure(report_figure([written]), args.plot)
+    if args.plot is not None and not plot:
+        print(f"pin-susp: no step converged: {args.plot} not drawn", file=sys.stderr)
     if not args.quiet:
         _summary(results, args.output)
-        if args.plot:
+        if plot:
             print(f"wrote {args.plot}")
     return _report_failures(results)
 
 
 def _urdf(args) -> int:
-    corner = Corner(load_geometry(args.geometry))
-    if args.at and not args.output:
+    if args.at is not None and args.output is None:
         raise PinSuspError("--at writes a sidecar beside the URDF: give -o OUT.urdf too")
-    pose = _pose_at(corner, args.at) if args.at else None
-    if args.output:
-        write_text(corner.urdf, args.output)
-        print(f"wrote {args.output}")
-    else:
+    sidecar = None
+    if args.output is not None:
+        check_output(args.output, "URDF")
+        if args.at is not None:
+            sidecar = Path(args.output).with_suffix(".pose.yaml")
+            check_output(sidecar, "pose sidecar")
+    corner = Corner(load_geometry(args.geometry))
+    pose = _pose_at(corner, args.at) if args.at is not None else None
+    if args.output is None:
         sys.stdout.write(corner.urdf)
-    if pose is not None:
-        sidecar = Path(args.output).with_suffix(".pose.yaml")
-        write_text(yaml.safe_dump(pose, sort_keys=False), sidecar)
+        return 0
+    with all_or_none():
+        write_text(corner.urdf, args.output)
+        if pose is not None:
+            write_text(yaml.safe_dump(pose, sort_keys=False), sidecar)
+    print(f"wrote {args.output}")
+    if sidecar is not None:
         print(f"wrote {sidecar}")
     return 0
 
@@ -330,15 +427,17 @@ def _urdf(args) -> int:
 def _pose_at(corner, at: str) -> dict:
     """Joint values of one solved sweep step, by joint name (rad, m)."""
     path, _, step = at.rpartition(":")
-    if not path or not step.isdigit():
+    if not path or not re.fullmatch(r"[0-9]{1,9}", step):
         raise PinSuspError(f"--at {at}: expected SWEEP.yaml:STEP, e.g. bump_steer.yaml:20")
     sweep = load_sweep(path)
-    results = corner.run_sweep(sweep)
+    corner.solver_for(sweep.targets, sweep.source)
     i = int(step)
-    if i >= len(results):
-        raise PinSuspError(f"--at {at}: the sweep has steps 0 to {len(results) - 1}")
+    if i >= sweep.steps:
+        raise PinSuspError(f"--at {at}: the sweep has steps 0 to {sweep.steps - 1}")
+    results = corner.run_sweep(sweep)
     if not results["solver_converged"][i]:
-        raise PinSuspError(f"--at {at}: that step did not converge")
+        why = results.meta["why"][i]
+        raise PinSuspError(f"--at {at}: that step did not converge ({why})")
     q = results.meta["q"][i]
     model = corner.model
     joints = {model.names[j]: float(q[model.joints[j].idx_q]) for j in range(1, model.njoints)}
@@ -356,6 +455,7 @@ def _pose_at(corner, at: str) -> dict:
 def _mjcf(args) -> int:
     from .mjcf import tree_to_mjcf
 
+    check_output(args.output, "MJCF")
     corner = Corner(load_geometry(args.geometry))
     comment = (
         f"generated by pin_susp {__version__} from {Path(corner.geometry.source).name};"
@@ -373,12 +473,16 @@ def _validate(args) -> int:
     sweep = load_sweep(args.sweep)
     corner.solver_for(sweep.targets, sweep.source)
     mjcf_text = None
-    if args.mjcf:
+    if args.mjcf is not None:
         try:
-            mjcf_text = Path(args.mjcf).read_text()
+            mjcf_text = Path(args.mjcf).read_bytes().decode("utf-8")
         except OSError as exc:
             raise PinSuspError(f"{args.mjcf}: cannot be read ({exc.strerror})") from None
-    results, reports = validate(corner, sweep, mjcf_text, args.tolerance)
+        except UnicodeDecodeError:
+            raise PinSuspError(f"{args.mjcf}: not a text file (MJCF is XML)") from None
+    results, reports = validate(
+        corner, sweep, mjcf_text, args.tolerance, mjcf_source=args.mjcf or "--mjcf"
+    )
     names = list(dict.fromkeys(n for r in reports for n in r.differences))
     print(
         f"{corner.geometry.name}: {len(results)} steps of {sweep.source}, each re-solved from "
@@ -394,13 +498,15 @@ def _validate(args) -> int:
             for r in reports
         )
         print(f"  {name:<34}{unit:>6}{cells}")
-    ok = True
+    ok = _report_failures(results) == 0
     for r in reports:
         if r.note:
             print(f"  {r.engine}: skipped — {r.note}")
             continue
         if r.failed_steps:
             print(f"  {r.engine}: did not converge at steps {r.failed_steps}")
+        if getattr(r, "warnings", 0):
+            print(f"  {r.engine}: {r.warnings} warnings (first: {r.first_warning})")
         if r.agrees:
             print(
                 f"  {r.engine}: agrees within {args.tolerance:g} mm/deg "
@@ -417,15 +523,11 @@ def _validate(args) -> int:
 
 def _demo(args) -> int:
     out = Path(args.output)
+    if str(args.output).strip() == "" or (out.exists() and not out.is_dir()):
+        raise PinSuspError(f"{args.output!r}: the demo writes several files: give a folder")
     data = resources.files("pin_susp") / "data"
-    out.mkdir(parents=True, exist_ok=True)
-    for name in ("demo_geometry.yaml", "demo_sweep.yaml"):
-        with resources.as_file(data / name) as src:
-            shutil.copyfile(src, out / name)
+    inputs = {name: (data / name).read_text() for name in ("demo_geometry.yaml", "demo_sweep.yaml")}
     geometry_path, sweep_path = out / "demo_geometry.yaml", out / "demo_sweep.yaml"
-    corner = Corner(load_geometry(geometry_path))
-    sweep = load_sweep(sweep_path)
-    results = corner.run_sweep(sweep, progress=_progress_bar(sweep.steps, False))
     files = {
         "results": out / "demo_results.csv",
         "plots": out / "demo_report.png",
@@ -433,9 +535,25 @@ def _demo(args) -> int:
         "3D replay": out / "demo_replay.html",
         "URDF": out / "demo_corner.urdf",
     }
-    write_text(corner.urdf, files["URDF"])
-    results.to_csv(files["results"])
-    _demo_pictures(corner, results, files)
+    for path in [geometry_path, sweep_path, *files.values()]:
+        check_output(path)
+    # read from the text, named as the copies written beside the results
+    geometry, sweep = (
+        replace(
+            load(yaml.safe_load(inputs[path.name])),
+            source=str(path),
+            sha256=hashlib.sha256(inputs[path.name].encode()).hexdigest(),
+        )
+        for load, path in ((load_geometry, geometry_path), (load_sweep, sweep_path))
+    )
+    corner = Corner(geometry)
+    results = corner.run_sweep(sweep, progress=_progress_bar(sweep.steps, False))
+    with all_or_none():
+        for name, text in inputs.items():
+            write_text(text, out / name)
+        write_text(corner.urdf, files["URDF"])
+        results.to_csv(files["results"])
+        _demo_pictures(corner, results, files)
     print(f"pin_susp demo: {corner.geometry.name}, {sweep.steps}-step bump + steer sweep")
     _summary(results, files["results"])
     for what, path in [("geometry", geometry_path), ("sweep", sweep_path), *files.items()]:
@@ -454,7 +572,8 @@ def _demo_pictures(corner, results, files) -> None:
     from .plots import ResultsFile, drawing_figure, report_figure, save_figure
     from .viz import CornerScene
 
-    save_figure(report_figure([ResultsFile(files["results"])]), files["plots"])
+    written = ResultsFile(staged(files["results"]), name=files["results"])
+    save_figure(report_figure([written]), files["plots"])
     save_figure(drawing_figure(corner), files["drawing"])
     with contextlib.redirect_stdout(io.StringIO()):  # meshcat announces its server
         scene = CornerScene(corner)
@@ -490,19 +609,47 @@ def _summary(results: Results, path) -> None:
     print("  (every column, derivatives included, is in the CSV)")
 
 
-def _report_failures(results: Results) -> int:
+def _report_failures(
+    results: Results, consequence: str = "are flagged solver_converged=False with empty cells"
+) -> int:
+    """Name the steps that did not converge, and why, on stderr; the exit code."""
     failed = results.failed_steps
     if len(failed) == 0:
         return 0
-    worst = np.max(results["solver_max_residual"][failed])
+    why = results.meta["why"]
+    flipped = [int(i) for i in failed if "branch" in why[i]]
+    short = [int(i) for i in failed if "branch" not in why[i]]
+    reasons = []
+    if short:
+        worst = np.max(results["solver_max_residual"][short])
+        reasons.append(
+            f"steps {_list(short)} out of the mechanism's reach or past a lock-up "
+            f"(residual up to {worst:.3g} mm)"
+        )
+    if flipped:
+        loops = sorted({why[i].rpartition(" of ")[2] for i in flipped})
+        reasons.append(
+            f"steps {_list(flipped)} reach the targets only on another assembly branch "
+            f"({', '.join(loops)} flipped over: not the design's mechanism)"
+        )
     print(
-        f"pin-susp: warning: {len(failed)} of {len(results)} steps did not converge "
-        f"(steps {', '.join(map(str, failed[:10]))}{' ...' if len(failed) > 10 else ''}; "
-        f"residual up to {worst:.3g} mm): the targets are out of the mechanism's reach "
-        "or pass a lock-up. Their rows are flagged solver_converged=False with empty cells.",
+        f"pin-susp: warning: {len(failed)} of {len(results)} steps did not converge: "
+        f"{'; '.join(reasons)}. Their rows {consequence}.",
         file=sys.stderr,
     )
     return EXIT_NOT_CONVERGED
+
+
+def _list(steps: list[int]) -> str:
+    return ", ".join(map(str, steps[:10])) + (" ..." if len(steps) > 10 else "")
+
+
+def _check_image(path) -> None:
+    """An image output: a writable path with an extension matplotlib can write."""
+    from .plots import check_image_path
+
+    check_output(path, "image")
+    check_image_path(path)
 
 
 def _progress_bar(total: int, quiet: bool):
@@ -525,6 +672,9 @@ def _progress_bar(total: int, quiet: bool):
 def _setup(args) -> int:
     from . import setup
 
+    for path in (args.output, args.csv):
+        if path is not None:
+            check_output(path)
     geometry = load_geometry(args.geometry)
     targets = {
         name: value
@@ -535,7 +685,7 @@ def _setup(args) -> int:
         )
         if value is not None
     }
-    if args.output and not targets:
+    if args.output is not None and not targets:
         raise PinSuspError("-o writes a solved setup: give --camber, --toe or --ride-height-change")
     title = f"{geometry.name}: setup sheet ({geometry.source})"
     if targets:
@@ -546,7 +696,7 @@ def _setup(args) -> int:
             f"  hit {', '.join(f'{k} {v:g}' for k, v in targets.items())} "
             f"in {found.iterations} Newton iterations"
         )
-        if args.output:
+        if args.output is not None:
             data = setup.geometry_data(found.geometry)
             text = yaml.safe_dump(data, sort_keys=False, default_flow_style=None)
             write_text(f"# {geometry.name}: setup solved by pin-susp setup\n" + text, args.output)
@@ -563,7 +713,7 @@ def _setup(args) -> int:
     _sheet(rows, labels)
     if args.sensitivities:
         _sensitivities(rows[0], geometry, args.thread_pitch)
-    if args.csv:
+    if args.csv is not None:
         _sheet_csv(rows, labels, args.csv)
     return 0
 
@@ -619,17 +769,20 @@ def _sheet_csv(rows, labels, path) -> None:
 def _sensitivity(args) -> int:
     from .sensitivity import STEP, hardpoint_sensitivities, largest
 
+    if args.output is not None:
+        check_output(args.output)
     corner = Corner(load_geometry(args.geometry))
     sweep = None
-    if args.sweep:
+    if args.sweep is not None:
         sweep = load_sweep(args.sweep)
         corner.solver_for(sweep.targets, sweep.source)
     progress = _progress_bar(sweep.steps if sweep else 1, args.quiet)
-    states = hardpoint_sensitivities(corner, sweep, progress)
-    if args.output:
+    states, results = hardpoint_sensitivities(corner, sweep, progress, with_results=True)
+    if args.output is not None:
         _sensitivity_csv(states, corner, args.output)
+    status = 0 if results is None else _report_failures(results, "have no sensitivities")
     if args.quiet or not states:
-        return 0
+        return status
     s = states[0]
     where = "design state" if sweep is None else f"step {s.step} of {sweep.source}"
     print(f"{corner.geometry.name}: hardpoint sensitivities at the {where}")
@@ -648,12 +801,12 @@ def _sensitivity(args) -> int:
                 f"    {hardpoint + ' ' + axis:34} {value:+.4g} {unit}/mm"
                 f"   (to change it by +{step:g} {unit}, move {move:+.3g} mm)"
             )
-    if args.output:
+    if args.output is not None:
         print(
             f"wrote {args.output}: {len(states)} state(s) x {len(s.values)} metrics x "
             f"{3 * len(s.hardpoints)} hardpoint coordinates"
         )
-    return 0
+    return status
 
 
 def _sensitivity_csv(states, corner, path) -> None:
@@ -676,6 +829,7 @@ def _sensitivity_csv(states, corner, path) -> None:
 def _plot(args) -> int:
     from .plots import ResultsFile, report_figure, save_figure
 
+    _check_image(args.output)
     files = [ResultsFile(path) for path in args.results]
     save_figure(report_figure(files), args.output)
     print(f"wrote {args.output}")
@@ -685,6 +839,7 @@ def _plot(args) -> int:
 def _draw(args) -> int:
     from .plots import drawing_figure, save_figure
 
+    _check_image(args.output)
     save_figure(drawing_figure(Corner(load_geometry(args.geometry))), args.output)
     print(f"wrote {args.output}")
     return 0
@@ -697,9 +852,11 @@ def _view(args) -> int:
 
     from .viz import CornerScene
 
+    if args.html is not None:
+        check_output(args.html, "replay")
     corner = Corner(load_geometry(args.geometry))
-    qs = None
-    if args.sweep:
+    qs, results = None, None
+    if args.sweep is not None:
         sweep = load_sweep(args.sweep)
         corner.solver_for(sweep.targets, sweep.source)
         results = corner.run_sweep(sweep, progress=_progress_bar(sweep.steps, False))
@@ -712,14 +869,16 @@ def _view(args) -> int:
         scene = CornerScene(corner)
     try:
         frames = scene.animate(qs, fps=args.fps) if qs is not None else 0
-        if args.html:
+        if args.html is not None:
             write_text(scene.html(), args.html)
             print(f"wrote {args.html}" + (f" ({frames} frames)" if frames else ""))
-            return 0
+            return 0 if results is None else _report_failures(results, "are not in the replay")
         print(
             f"meshcat: {scene.viewer.url()}"
             + (f"  ({frames} frames: press play in Open Controls > Animations)" if frames else "")
         )
+        if results is not None:
+            _report_failures(results, "are not in the animation")
         print("serving; press Ctrl+C to stop", flush=True)
         while True:
             time.sleep(0.5)

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .yamlio import Reader, load_yaml
+from .yamlio import MAX_LENGTH_MM, Reader, load_yaml
 
 MM = 1e-3
 INCH = 0.0254
@@ -146,6 +146,17 @@ def unit(v: np.ndarray) -> np.ndarray:
     return v / np.linalg.norm(v, axis=-1, keepdims=True)
 
 
+def direction(v) -> np.ndarray | None:
+    """The unit vector along v, None for the zero vector; safe for any finite v
+    (scaled first, so that neither 1e300 nor 1e-300 over- or underflows)."""
+    v = np.asarray(v, dtype=float)
+    biggest = np.max(np.abs(v))
+    if not biggest > 0.0:
+        return None
+    v = v / biggest
+    return v / np.linalg.norm(v)
+
+
 def wheel_points(
     axle_inboard: np.ndarray, axle_outboard: np.ndarray, wheel: Wheel
 ) -> dict[str, np.ndarray]:
@@ -267,7 +278,7 @@ def _parse(data: dict, r: Reader, sha: str | None) -> Geometry:
     for key in names:
         if key not in hp_map:
             r.fail(f"hardpoints.{key}", "missing point")
-        hardpoints[key] = r.vector(hp_map[key], f"hardpoints.{key}") * MM
+        hardpoints[key] = r.point(hp_map[key], f"hardpoints.{key}") * MM
 
     sign = 1.0 if side == "left" else -1.0
     for key, p in hardpoints.items():
@@ -278,7 +289,7 @@ def _parse(data: dict, r: Reader, sha: str | None) -> Geometry:
                 f"y = {p[1] / MM:g} mm on a {side} corner ({side} hardpoints have {want};"
                 " check 'side' or the sign of y)",
             )
-    _check_linkage(hardpoints, steering, actuation, spring, r)
+    _check_linkage(hardpoints, steering, actuation, spring, sign, r)
     adjusters = _setup_block(config.get("setup", {}), actuation, r)
 
     cg = config.get("cg_position")
@@ -292,11 +303,11 @@ def _parse(data: dict, r: Reader, sha: str | None) -> Geometry:
         spring=spring,
         hardpoints=hardpoints,
         wheel=wheel,
-        cg_position=None if cg is None else r.vector(cg, "config.cg_position") * MM,
+        cg_position=None if cg is None else r.point(cg, "config.cg_position") * MM,
         wheelbase=(
             None
             if "wheelbase" not in config
-            else r.positive(config["wheelbase"], "config.wheelbase") * MM
+            else _size(config["wheelbase"], "config.wheelbase", r) * MM
         ),
         axle_position=(
             None
@@ -327,12 +338,22 @@ def _wheel(value, r: Reader) -> Wheel:
         "config.wheel.tire",
         required=("aspect_ratio", "section_width", "rim_diameter"),
     )
+    key = "config.wheel.tire"
     return Wheel(
-        offset=r.number(w.get("offset", 0.0), "config.wheel.offset") * MM,
-        section_width=r.positive(tire["section_width"], "config.wheel.tire.section_width") * MM,
-        aspect_ratio=r.positive(tire["aspect_ratio"], "config.wheel.tire.aspect_ratio"),
-        rim_diameter=r.positive(tire["rim_diameter"], "config.wheel.tire.rim_diameter") * INCH,
+        offset=r.length(w.get("offset", 0.0), "config.wheel.offset") * MM,
+        section_width=_size(tire["section_width"], f"{key}.section_width", r) * MM,
+        aspect_ratio=_size(tire["aspect_ratio"], f"{key}.aspect_ratio", r, limit=100.0),
+        rim_diameter=_size(tire["rim_diameter"], f"{key}.rim_diameter", r, INCH / MM) * INCH,
     )
+
+
+def _size(value, key: str, r: Reader, per_mm: float = 1.0, limit: float | None = None) -> float:
+    """A size > 0 within the hard limit on lengths (``per_mm``: mm per unit of the value)."""
+    x = r.positive(value, key)
+    limit = MAX_LENGTH_MM / per_mm if limit is None else limit
+    if x > limit:
+        r.fail(key, f"{x:g} is beyond the hard limit of {limit:g} for any car")
+    return x
 
 
 def _fraction(value, r: Reader) -> float:
@@ -355,30 +376,30 @@ def _camber_shim(value, r: Reader) -> CamberShim:
             "setup_thickness",
         ),
     )
-    a = r.vector(s["shim_face_point_a"], f"{key}.shim_face_point_a") * MM
-    b = r.vector(s["shim_face_point_b"], f"{key}.shim_face_point_b") * MM
-    n = r.vector(s["shim_face_normal"], f"{key}.shim_face_normal")
+    a = r.point(s["shim_face_point_a"], f"{key}.shim_face_point_a") * MM
+    b = r.point(s["shim_face_point_b"], f"{key}.shim_face_point_b") * MM
+    n = direction(r.vector(s["shim_face_normal"], f"{key}.shim_face_normal"))
     if np.linalg.norm(b - a) < COINCIDENT:
         r.fail(f"{key}.shim_face_point_b", "coincides with shim_face_point_a (A and B must differ)")
-    if np.linalg.norm(n) < 1e-12:
+    if n is None:
         r.fail(f"{key}.shim_face_normal", "is the zero vector (it needs a direction)")
-    n = n / np.linalg.norm(n)
     ab = unit(b - a)
     if np.linalg.norm(np.cross(ab, n)) < 1e-6:
         r.fail(
             f"{key}.shim_face_point_b",
             "A→B runs along the shim face normal: A and B must clock the face (lie across it)",
         )
-    design = r.number(s["design_thickness"], f"{key}.design_thickness", minimum=0.0) * MM
-    setup = r.number(s["setup_thickness"], f"{key}.setup_thickness", minimum=0.0) * MM
+    design = r.number(s["design_thickness"], f"{key}.design_thickness", 0.0, limit=MAX_LENGTH_MM)
+    setup = r.number(s["setup_thickness"], f"{key}.setup_thickness", 0.0, limit=MAX_LENGTH_MM)
+    design, setup = design * MM, setup * MM
     return CamberShim(a, b, n, design, setup)
 
 
 def _setup_block(value, actuation: str, r: Reader) -> tuple[float, float]:
     key = "config.setup"
     s = r.mapping(value, key, optional=("trackrod_length_delta", "pushrod_length_delta"))
-    trackrod = r.number(s.get("trackrod_length_delta", 0.0), f"{key}.trackrod_length_delta")
-    pushrod = r.number(s.get("pushrod_length_delta", 0.0), f"{key}.pushrod_length_delta")
+    trackrod = r.length(s.get("trackrod_length_delta", 0.0), f"{key}.trackrod_length_delta")
+    pushrod = r.length(s.get("pushrod_length_delta", 0.0), f"{key}.pushrod_length_delta")
     if pushrod != 0.0 and actuation != "pushrod_rocker":
         r.fail(
             f"{key}.pushrod_length_delta",
@@ -388,7 +409,7 @@ def _setup_block(value, actuation: str, r: Reader) -> tuple[float, float]:
 
 
 def _check_linkage(
-    p: dict[str, np.ndarray], steering: str, actuation: str, spring: str, r: Reader
+    p: dict[str, np.ndarray], steering: str, actuation: str, spring: str, sign: float, r: Reader
 ) -> None:
     """Reject geometry that defines no mechanism: coincident ends, balls on pivots."""
     inner, outer = STEERING_POINTS[steering]
@@ -407,6 +428,13 @@ def _check_linkage(
     for a, b, what in pairs:
         if np.linalg.norm(p[b] - p[a]) < COINCIDENT:
             r.fail(f"hardpoints.{b}", f"coincides with {a}: the {what} needs two distinct points")
+    spin = unit(p["axle_outboard"] - p["axle_inboard"])
+    if sign * spin[1] <= 0.0:
+        r.fail(
+            "hardpoints.axle_outboard",
+            "the spin axis axle_inboard→axle_outboard points inboard or straight up/down: "
+            f"axle_outboard must be outboard (toward {'+' if sign > 0 else '-'}y) of axle_inboard",
+        )
     for arm in ("lower_wishbone", "upper_wishbone"):
         front = p[f"{arm}_inboard_front"]
         axis = unit(p[f"{arm}_inboard_rear"] - front)

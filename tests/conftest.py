@@ -1,4 +1,6 @@
 import copy
+import os
+import stat
 from pathlib import Path
 
 import pytest
@@ -47,3 +49,16 @@ def corner():
     import pin_susp
 
     return pin_susp.Corner(EXAMPLES / "double_wishbone.yaml")
+
+
+@pytest.fixture(autouse=True)
+def _work_in_tmp_path(tmp_path, monkeypatch):
+    """Every test runs in its own temporary folder: a stray relative write lands there."""
+    monkeypatch.chdir(tmp_path)
+
+
+def pytest_sessionfinish(session, exitstatus):
+    """A test that replaced /dev/null (an output renamed over it) fails the run."""
+    if os.path.exists("/dev/null") and not stat.S_ISCHR(os.stat("/dev/null").st_mode):
+        print("\n/dev/null is no longer a character device: a test wrote over it")
+        session.exitstatus = 1

@@ -110,7 +110,7 @@ def test_scene_animates_one_frame_per_converged_step():
         assert "animation" in html
     finally:
         scene.close()
-    assert scene.viewer.window.server_proc.poll() is not None
+    assert scene.server.poll() is not None
 
 
 def test_view_command_serves_and_stops_on_ctrl_c():
@@ -229,7 +229,7 @@ def test_sweep_plot_option(tmp_path):
     assert png.exists()
 
 
-def test_no_progress_bar_when_not_a_terminal(capfd):
+def test_no_progress_bar_when_not_a_terminal(tmp_path, capfd):
     assert (
         main(
             [
@@ -237,7 +237,7 @@ def test_no_progress_bar_when_not_a_terminal(capfd):
                 str(EXAMPLES / "fixed_toe_link.yaml"),
                 str(EXAMPLES / "bump.yaml"),
                 "-o",
-                os.devnull,
+                str(tmp_path / "r.csv"),
             ]
         )
         == 0
