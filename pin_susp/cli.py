@@ -61,8 +61,9 @@ def main(argv: list[str] | None = None) -> int:
         warnings.simplefilter("ignore", RuntimeWarning)
         try:
             return args.run(args)
-        except PinSuspError as exc:
-            print(f"pin-susp: error: {exc}", file=sys.stderr)
+        except PinSuspError as exc:  # one line, whatever the file's keys hold
+            message = str(exc).replace("\r", "\\r").replace("\n", "\\n")
+            print(f"pin-susp: error: {message}", file=sys.stderr)
             return EXIT_INPUT
         except (KeyboardInterrupt, _Terminated) as exc:
             signal_number = exc.signal if isinstance(exc, _Terminated) else signal.SIGINT
@@ -696,11 +697,17 @@ def _setup(args) -> int:
             f"  hit {', '.join(f'{k} {v:g}' for k, v in targets.items())} "
             f"in {found.iterations} Newton iterations"
         )
-        if args.output is not None:
-            data = setup.geometry_data(found.geometry)
-            text = yaml.safe_dump(data, sort_keys=False, default_flow_style=None)
-            write_text(f"# {geometry.name}: setup solved by pin-susp setup\n" + text, args.output)
-            print(f"wrote {args.output}")
+        with all_or_none():
+            if args.output is not None:
+                data = setup.geometry_data(found.geometry)
+                text = yaml.safe_dump(data, sort_keys=False, default_flow_style=None)
+                head = f"# {geometry.name}: setup solved by pin-susp setup\n"
+                write_text(head + text, args.output)
+            if args.csv is not None:
+                _sheet_csv([found.before, found.after], ["before", "after"], args.csv)
+        for path in (args.output, args.csv):
+            if path is not None:
+                print(f"wrote {path}")
         return 0
     rows = setup.setup_sheet(geometry, args.shim, args.trackrod, args.pushrod)
     labels = (
@@ -715,6 +722,7 @@ def _setup(args) -> int:
         _sensitivities(rows[0], geometry, args.thread_pitch)
     if args.csv is not None:
         _sheet_csv(rows, labels, args.csv)
+        print(f"wrote {args.csv}")
     return 0
 
 
@@ -763,7 +771,6 @@ def _sheet_csv(rows, labels, path) -> None:
             cells = [label, *map(format_cell, row.setup)]
             cells += [format_cell(row.metrics[name]) for name, _, _ in SHEET_METRICS]
             f.write(",".join(cells) + "\n")
-    print(f"wrote {path}")
 
 
 def _sensitivity(args) -> int:
