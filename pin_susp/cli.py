@@ -26,10 +26,10 @@ import yaml
 
 from . import __version__
 from .corner import Corner, Results
-from .errors import PinSuspError
+from .errors import PinSuspError, PlausibilityWarning
 from .export import all_or_none, check_output, staged, write_text
 from .geometry import load_geometry
-from .metrics import METRICS
+from .metrics import METRIC_BY_NAME, METRICS
 from .sweep import load_sweep
 from .yamlio import MAX_LENGTH_MM
 
@@ -55,12 +55,20 @@ def main(argv: list[str] | None = None) -> int:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # --help, --version, or a usage error (one line, exit 2)
         return exc.code if isinstance(exc.code, int) else EXIT_INPUT
-    with _terminate_as_exit(), warnings.catch_warnings(), np.errstate(all="ignore"):
+    with (
+        _terminate_as_exit(),
+        warnings.catch_warnings(record=True) as caught,
+        np.errstate(all="ignore"),
+    ):
         # Undefined values (parallel arms, a toggle) are NaN by design and flagged
         # where they matter; numpy's warnings about them would only be noise.
-        warnings.simplefilter("ignore", RuntimeWarning)
+        warnings.simplefilter("ignore")
+        warnings.simplefilter("always", PlausibilityWarning)
+        args.warnings = caught
         try:
-            return args.run(args)
+            code = args.run(args)
+            _print_warnings(args)  # only for a run that went through: exit 2 is one line
+            return code
         except PinSuspError as exc:  # one line, whatever the file's keys hold
             message = str(exc).replace("\r", "\\r").replace("\n", "\\n")
             print(f"pin-susp: error: {message}", file=sys.stderr)
@@ -72,6 +80,15 @@ def main(argv: list[str] | None = None) -> int:
         except BrokenPipeError:  # output piped into `head` and the like
             sys.stderr.close()
             return 0
+
+
+def _print_warnings(args) -> None:
+    """The implausible values seen so far, one line each (not with --quiet)."""
+    seen = list(dict.fromkeys(str(w.message) for w in args.warnings))
+    args.warnings.clear()
+    if not getattr(args, "quiet", False):
+        for message in seen:
+            print(f"pin-susp: warning: {message}", file=sys.stderr)
 
 
 class _Terminated(BaseException):
@@ -101,7 +118,12 @@ def _terminate_as_exit():
 
 
 class _Parser(argparse.ArgumentParser):
-    """argparse with usage errors on one line (the usage is in --help)."""
+    """argparse with usage errors on one line (the usage is in --help), and values
+    that start with a minus and a digit (``--trackrod -1,0,1``) read as values."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = re.compile(r"^-\.?[0-9]")
 
     def error(self, message: str):
         self.exit(EXIT_INPUT, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
@@ -189,8 +211,12 @@ def _parser() -> argparse.ArgumentParser:
     d = sub.add_parser(
         "demo",
         help="run the embedded example and write its results",
-        description="Solve the embedded example corner through a combined bump+steer "
-        "sweep; write its geometry, sweep, URDF and results CSV into DIR.",
+        description="Solve the embedded example corner (the test corner of open-kinematics "
+        "0.4) through a combined bump+steer sweep and write into DIR: demo_geometry.yaml and "
+        "demo_sweep.yaml (the inputs, to edit and rerun), demo_results.csv (every column), "
+        "demo_report.png (the standard kinematics plots), demo_drawing.png (front and side "
+        "view), demo_replay.html (the 3D replay, opens in a browser with no server) and "
+        "demo_corner.urdf (the URDF with its loop closures).",
     )
     d.add_argument(
         "-o",
@@ -224,7 +250,8 @@ def _parser() -> argparse.ArgumentParser:
         type=_numbers,
         default=[],
         metavar="MM,MM,...",
-        help="trackrod length changes (+ longer), one row each",
+        help="trackrod (or fixed toe link) length changes (+ longer), one row each; "
+        "negative values as written: --trackrod -1,0,1",
     )
     t.add_argument(
         "--pushrod",
@@ -286,6 +313,14 @@ def _parser() -> argparse.ArgumentParser:
         default=3,
         metavar="N",
         help="entries per metric in the printed table (default 3)",
+    )
+    h.add_argument(
+        "--points",
+        default="designer",
+        metavar="GROUP|NAMES",
+        help="which hardpoints the printed table ranks: designer (default: chassis pickups "
+        "and link ends, not the spindle points), chassis, upright, all, or names separated "
+        "by commas (the CSV always has every hardpoint)",
     )
     h.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
     h.set_defaults(run=_sensitivity)
@@ -384,6 +419,7 @@ def _sweep(args) -> int:
     sweep = load_sweep(args.sweep)
     corner.solver_for(sweep.targets, sweep.source)  # target errors before any work
     results = corner.run_sweep(sweep, progress=_progress_bar(sweep.steps, args.quiet))
+    _warn_transmission(results)
     plot = args.plot is not None and results["solver_converged"].any()
     with all_or_none():
         results.to_csv(args.output)
@@ -549,6 +585,7 @@ def _demo(args) -> int:
     )
     corner = Corner(geometry)
     results = corner.run_sweep(sweep, progress=_progress_bar(sweep.steps, False))
+    _warn_transmission(results)
     with all_or_none():
         for name, text in inputs.items():
             write_text(text, out / name)
@@ -585,6 +622,14 @@ def _demo_pictures(corner, results, files) -> None:
         scene.close()
 
 
+# Instant-centre columns: past this (mm) the arms are all but parallel and the
+# centre is better described as "at infinity" than by a number.
+FAR = 1e5
+CENTRES = ("svic_x", "svic_z", "fvic_y", "fvic_z", "svsa_length", "fvsa_length")
+# Rocker transmission angle outside this band (deg): the rocker nears over-centre.
+TRANSMISSION_BAND = (30.0, 150.0)
+
+
 def _summary(results: Results, path) -> None:
     ok = results["solver_converged"]
     print(
@@ -599,15 +644,42 @@ def _summary(results: Results, path) -> None:
         if n in results.columns
     ]
     print(f"  {'metric':<32}{'unit':>7}{'first':>13}{'last':>13}{'min':>13}{'max':>13}")
+    blank = []
     for name in names:
         v = results[name]
         if np.all(np.isnan(v)):
+            blank.append(name)
             continue
-        print(
-            f"  {name:<32}{results.units[name]:>7}{v[0]:>13.6g}{v[-1]:>13.6g}"
-            f"{np.nanmin(v):>13.6g}{np.nanmax(v):>13.6g}"
-        )
+        line = f"  {name:<32}{results.units[name]:>7}{v[0]:>13.6g}{v[-1]:>13.6g}"
+        far = np.flatnonzero(np.abs(v) > FAR)
+        if name in CENTRES and len(far):
+            line += f"   at infinity (arms parallel) near step {far[np.argmax(np.abs(v[far]))]}"
+        else:
+            line += f"{np.nanmin(v):>13.6g}{np.nanmax(v):>13.6g}"
+        print(line)
+    for name in blank:
+        m = METRIC_BY_NAME.get(name)
+        why = f"needs {m.needs}" if m is not None and m.needs else "undefined at every step"
+        print(f"  {name:<32}{results.units[name]:>7}   (blank: {why})")
     print("  (every column, derivatives included, is in the CSV)")
+
+
+def _warn_transmission(results: Results) -> None:
+    """Name the steps where the rocker transmission angle leaves its band."""
+    angle = results.columns.get("rocker_transmission_angle")
+    if angle is None:
+        return
+    low, high = TRANSMISSION_BAND
+    outside = np.flatnonzero((angle < low) | (angle > high))
+    if len(outside):
+        worst = outside[np.argmax(np.abs(angle[outside] - 90.0))]
+        warnings.warn(
+            f"rocker transmission angle {angle[worst]:.1f} deg at step {worst}: outside "
+            f"{low:g}…{high:g} deg at steps {_list([int(i) for i in outside])} (the rocker nears "
+            "over-centre; its motion ratio falls toward zero and flips)",
+            PlausibilityWarning,
+            stacklevel=2,
+        )
 
 
 def _report_failures(
@@ -689,10 +761,11 @@ def _setup(args) -> int:
     if args.output is not None and not targets:
         raise PinSuspError("-o writes a solved setup: give --camber, --toe or --ride-height-change")
     title = f"{geometry.name}: setup sheet ({geometry.source})"
+    link = _link(geometry)
     if targets:
         found = setup.solve_setup(geometry, targets)
         print(title)
-        _sheet([found.before, found.after], ["before", "after"])
+        _sheet([found.before, found.after], ["before", "after"], _link(geometry))
         print(
             f"  hit {', '.join(f'{k} {v:g}' for k, v in targets.items())} "
             f"in {found.iterations} Newton iterations"
@@ -704,7 +777,7 @@ def _setup(args) -> int:
                 head = f"# {geometry.name}: setup solved by pin-susp setup\n"
                 write_text(head + text, args.output)
             if args.csv is not None:
-                _sheet_csv([found.before, found.after], ["before", "after"], args.csv)
+                _sheet_csv([found.before, found.after], ["before", "after"], args.csv, link)
         for path in (args.output, args.csv):
             if path is not None:
                 print(f"wrote {path}")
@@ -713,22 +786,27 @@ def _setup(args) -> int:
     labels = (
         ["as set"]
         + ["shim"] * len(args.shim)
-        + ["trackrod"] * len(args.trackrod)
+        + [link] * len(args.trackrod)
         + ["pushrod"] * len(args.pushrod)
     )
     print(title)
-    _sheet(rows, labels)
+    _sheet(rows, labels, link)
     if args.sensitivities:
         _sensitivities(rows[0], geometry, args.thread_pitch)
     if args.csv is not None:
-        _sheet_csv(rows, labels, args.csv)
+        _sheet_csv(rows, labels, args.csv, link)
         print(f"wrote {args.csv}")
     return 0
 
 
-def _sheet(rows, labels) -> None:
+def _link(geometry) -> str:
+    """The length adjuster that sets toe: the trackrod, or a fixed toe link."""
+    return "trackrod" if geometry.steering == "rack" else "toe link"
+
+
+def _sheet(rows, labels, link: str = "trackrod") -> None:
     print(
-        f"  {'':9}{'shim':>8}{'trackrod':>9}{'pushrod':>8}"
+        f"  {'':9}{'shim':>8}{link:>9}{'pushrod':>8}"
         + "".join(f"{head:>12}" for _, _, head in SHEET_METRICS)
     )
     print(
@@ -746,9 +824,10 @@ def _sheet(rows, labels) -> None:
 def _sensitivities(state, geometry, pitch) -> None:
     drawn = geometry.drawn or geometry
     have = (drawn.camber_shim is not None, True, drawn.has_pushrod)
-    columns = [("per mm shim", 0, 1.0), ("per mm trackrod", 1, 1.0), ("per mm pushrod", 2, 1.0)]
+    link = _link(drawn)
+    columns = [("per mm shim", 0, 1.0), (f"per mm {link}", 1, 1.0), ("per mm pushrod", 2, 1.0)]
     if pitch:
-        columns += [("per turn trackrod", 1, pitch), ("per turn pushrod", 2, pitch)]
+        columns += [(f"per turn {link}", 1, pitch), ("per turn pushrod", 2, pitch)]
     columns = [c for c in columns if have[c[1]]]
     print("  exact sensitivities at the static state:")
     print(f"  {'':26}" + "".join(f"{c[0]:>19}" for c in columns))
@@ -760,10 +839,11 @@ def _sensitivities(state, geometry, pitch) -> None:
         )
 
 
-def _sheet_csv(rows, labels, path) -> None:
+def _sheet_csv(rows, labels, path, link: str = "trackrod") -> None:
     from .export import atomic_write, format_cell
 
-    names = ["row", *SETUP_COLUMNS] + [name for name, _, _ in SHEET_METRICS]
+    setup_columns = [c.replace("trackrod", link.replace(" ", "_")) for c in SETUP_COLUMNS]
+    names = ["row", *setup_columns] + [name for name, _, _ in SHEET_METRICS]
     with atomic_write(path) as f:
         f.write(f"# pin_susp {__version__} setup sheet; lengths mm, angles deg\n")
         f.write(",".join(names) + "\n")
@@ -774,11 +854,12 @@ def _sheet_csv(rows, labels, path) -> None:
 
 
 def _sensitivity(args) -> int:
-    from .sensitivity import STEP, hardpoint_sensitivities, largest
+    from .sensitivity import POINT_GROUPS, STEP, hardpoint_sensitivities, largest, select_points
 
     if args.output is not None:
         check_output(args.output)
     corner = Corner(load_geometry(args.geometry))
+    points = select_points(corner, args.points)
     sweep = None
     if args.sweep is not None:
         sweep = load_sweep(args.sweep)
@@ -791,15 +872,19 @@ def _sensitivity(args) -> int:
     if args.quiet or not states:
         return status
     s = states[0]
-    where = "design state" if sweep is None else f"step {s.step} of {sweep.source}"
-    print(f"{corner.geometry.name}: hardpoint sensitivities at the {where}")
+    where = "the design state" if sweep is None else f"step {s.step} of {sweep.source}"
+    print(f"{corner.geometry.name}: hardpoint sensitivities at {where}")
     if corner.geometry.drawn is not None:
         print("  (with respect to the as-set hardpoints: shim and adjusters applied)")
+    chosen = POINT_GROUPS.get(args.points, ", ".join(points))
+    print(f"  moving {chosen}; other points: --points chassis|upright|all|NAME,NAME")
+    unmoved = []
     for name in s.values:
-        entries = largest(s, name, args.top)
-        if not entries:
-            continue
+        entries = largest(s, name, args.top, set(points))
         unit = s.units[name].removesuffix("/mm")
+        if not entries:
+            unmoved.append(name)
+            continue
         step = STEP.get(unit, 1.0)
         print(f"  {name} = {s.metrics[name]:.6g} {unit}")
         for hardpoint, axis, value in entries:
@@ -808,10 +893,12 @@ def _sensitivity(args) -> int:
                 f"    {hardpoint + ' ' + axis:34} {value:+.4g} {unit}/mm"
                 f"   (to change it by +{step:g} {unit}, move {move:+.3g} mm)"
             )
+    if unmoved:
+        print(f"  not moved by these points here: {', '.join(unmoved)}")
     if args.output is not None:
         print(
             f"wrote {args.output}: {len(states)} state(s) x {len(s.values)} metrics x "
-            f"{3 * len(s.hardpoints)} hardpoint coordinates"
+            f"{3 * len(s.hardpoints)} hardpoint coordinates (every hardpoint)"
         )
     return status
 
@@ -867,6 +954,7 @@ def _view(args) -> int:
         sweep = load_sweep(args.sweep)
         corner.solver_for(sweep.targets, sweep.source)
         results = corner.run_sweep(sweep, progress=_progress_bar(sweep.steps, False))
+        _warn_transmission(results)
         qs = [
             q if ok else None
             for q, ok in zip(results.meta["q"], results["solver_converged"], strict=True)
@@ -886,6 +974,7 @@ def _view(args) -> int:
         )
         if results is not None:
             _report_failures(results, "are not in the animation")
+        _print_warnings(args)
         print("serving; press Ctrl+C to stop", flush=True)
         while True:
             time.sleep(0.5)

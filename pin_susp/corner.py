@@ -8,6 +8,7 @@ description of the mechanism.
 from __future__ import annotations
 
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -25,10 +26,10 @@ from .closures import (
     PointTarget,
 )
 from .double_wishbone import corner_tree
-from .errors import InputError
+from .errors import InputError, PlausibilityWarning
 from .geometry import DERIVED_POINTS, Geometry, contact_patch, hardpoint_names, load_geometry, unit
 from .jet import Dual
-from .metrics import HUB_Z, RACK, Pose, metric_columns, point_columns
+from .metrics import HUB_Z, METRICS, RACK, Pose, metric_columns, point_columns
 from .solver import NewtonSolver, Predictor, Solution
 from .sweep import Sweep, Target, load_sweep
 from .urdf import read_closures, tree_to_urdf
@@ -116,6 +117,30 @@ class Corner:
         self._point_groups = [
             (j, np.array([i for i, _ in g]), np.array([o for _, o in g])) for j, g in groups.items()
         ]
+        self._warn_implausible()
+        # The sense in which bump winds a torsion bar at design (motion_ratio's sign).
+        self.spring_sense = 1.0
+        if geometry.spring == "torsion_bar":
+            design = {k: v[None] for k, v in self.design_positions.items()}
+            columns = metric_columns(geometry, self.motion([self.q_design]), design)
+            self.spring_sense = -1.0 if columns["motion_ratio"][0][0] < 0.0 else 1.0
+
+    def _warn_implausible(self) -> None:
+        """A PlausibilityWarning for each design metric outside its plausible range."""
+        design = {k: v[None] for k, v in self.design_positions.items()}
+        columns = metric_columns(self.geometry, design, design)
+        for m in METRICS:
+            if m.plausible is None or m.name not in columns:
+                continue
+            value = columns[m.name][0][0]
+            low, high = m.plausible
+            if value < low or value > high:  # NaN passes: undefined is not implausible
+                warnings.warn(
+                    f"{self.geometry.source}: design {m.name} = {value:.4g} {m.unit} is "
+                    f"outside the plausible {low:g}…{high:g} {m.unit} (a unit mistake?)",
+                    PlausibilityWarning,
+                    stacklevel=3,
+                )
 
     def _add_anchor(self, name: str, link: str, offset: np.ndarray) -> FramePoint:
         parent = self.model.frames[self.model.getFrameId(link)]
@@ -312,7 +337,7 @@ class Corner:
     def _pose(self, solution: Solution) -> Pose:
         points = self.motion([solution.q])
         design = {k: v[None] for k, v in self.design_positions.items()}
-        columns = metric_columns(self.geometry, points, design)
+        columns = metric_columns(self.geometry, points, design, self.spring_sense)
         return Pose(
             q=solution.q,
             converged=solution.converged,
@@ -384,7 +409,8 @@ class Results:
         # A step that did not converge has no trustworthy pose: its cells stay empty.
         points = corner.motion([s.q if s.converged else None for s in solutions], tangents)
         design = {k: v[None] for k, v in corner.design_positions.items()}
-        for name, (values, column_unit) in metric_columns(corner.geometry, points, design).items():
+        metrics = metric_columns(corner.geometry, points, design, corner.spring_sense)
+        for name, (values, column_unit) in metrics.items():
             columns[name], units[name] = values, column_unit
         positions = {name: p.val for name, p in points.items()}
         for name, (values, column_unit) in point_columns(corner.point_names, positions).items():

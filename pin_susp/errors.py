@@ -24,3 +24,8 @@ class InputError(PinSuspError):
         self.problem = problem
         where = f"{source}: {key}" if key else source
         super().__init__(f"{where}: {problem}")
+
+
+class PlausibilityWarning(UserWarning):
+    """A value that is valid but outside what a car has (docs/geometry.md, plausible
+    ranges): usually a unit mistake. The CLI prints one line each on stderr."""

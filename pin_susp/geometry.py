@@ -7,11 +7,13 @@ nothing after it converts units.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from .errors import PlausibilityWarning
 from .yamlio import MAX_LENGTH_MM, Reader, load_yaml
 
 MM = 1e-3
@@ -44,6 +46,20 @@ DERIVED_POINTS = (
 
 # Anything closer than this is "the same point" for an axis or a link.
 COINCIDENT = 1e-6  # m
+
+# Valid but implausible for a car (docs/geometry.md): a warning each, never an error.
+# key path → (low, high, unit as written in the file)
+PLAUSIBLE = {
+    "config.wheel.tire.rim_diameter": (8.0, 24.0, "in"),
+    "config.wheel.tire.section_width": (100.0, 400.0, "mm"),
+    "config.wheel.tire.aspect_ratio": (0.2, 0.9, ""),
+    "config.wheel.offset": (-150.0, 150.0, "mm"),
+    "tyre radius": (150.0, 500.0, "mm"),
+    "config.wheelbase": (1000.0, 5000.0, "mm"),
+    "config.cg_position.z": (100.0, 1500.0, "mm"),
+    "config.front_brake_bias": (0.4, 0.85, ""),
+    "distance from the wheel centre": (0.0, 2000.0, "mm"),
+}
 
 
 @dataclass(frozen=True)
@@ -141,6 +157,22 @@ def hardpoint_names(steering: str, actuation: str, spring: str) -> tuple[str, ..
     return names
 
 
+def wheel_side_points(steering: str, actuation: str, mount: str, spring: str) -> tuple[str, ...]:
+    """The hardpoints that ride with the wheel: outboard joints and upright mounts."""
+    names = (
+        "lower_wishbone_outboard",
+        "upper_wishbone_outboard",
+        STEERING_POINTS[steering][1],
+        *AXLE_POINTS,
+    )
+    if mount == "upright":
+        if actuation == "pushrod_rocker":
+            names += ("pushrod_outboard",)
+        elif spring == "coilover":
+            names += ("strut_bottom",)
+    return names
+
+
 def unit(v: np.ndarray) -> np.ndarray:
     """v / |v| along the last axis."""
     return v / np.linalg.norm(v, axis=-1, keepdims=True)
@@ -199,10 +231,44 @@ def contact_patch(wheel_center: np.ndarray, spin_axis: np.ndarray, radius: float
 def load_geometry(source: str | Path | dict) -> Geometry:
     """Read and validate a geometry file (path) or an already-loaded dict.
 
-    Raises InputError naming the file, the key and the problem.
+    Raises InputError naming the file, the key and the problem; warns
+    (PlausibilityWarning) about valid values outside a car's plausible range.
     """
     data, name, sha = load_yaml(source)
-    return _parse(data, Reader(name), sha)
+    g = _parse(data, Reader(name), sha)
+    warn_implausible(g)
+    return g
+
+
+def warn_implausible(g: Geometry) -> None:
+    """A PlausibilityWarning for each value outside PLAUSIBLE (a unit slip, often)."""
+    w = g.wheel
+    values = {
+        "config.wheel.tire.rim_diameter": w.rim_diameter / INCH,
+        "config.wheel.tire.section_width": w.section_width / MM,
+        "config.wheel.tire.aspect_ratio": w.aspect_ratio,
+        "config.wheel.offset": w.offset / MM,
+        "tyre radius": w.radius / MM,
+    }
+    if g.wheelbase is not None:
+        values["config.wheelbase"] = g.wheelbase / MM
+    if g.cg_position is not None:
+        values["config.cg_position.z"] = g.cg_position[2] / MM
+    if g.front_brake_bias is not None:
+        values["config.front_brake_bias"] = g.front_brake_bias
+    center = g.design_points()["wheel_center"]
+    far = max(g.hardpoints, key=lambda n: np.linalg.norm(g.hardpoints[n] - center))
+    values["distance from the wheel centre"] = np.linalg.norm(g.hardpoints[far] - center) / MM
+    for key, value in values.items():
+        low, high, unit_text = PLAUSIBLE[key]
+        if not low <= value <= high:
+            what = f"hardpoints.{far}: {key}" if key.startswith("distance") else key
+            warnings.warn(
+                f"{g.source}: {what} = {value:.4g} {unit_text} is outside the plausible "
+                f"{low:g}…{high:g} {unit_text} (a unit mistake?)".replace("  ", " "),
+                PlausibilityWarning,
+                stacklevel=3,
+            )
 
 
 def _parse(data: dict, r: Reader, sha: str | None) -> Geometry:
@@ -281,13 +347,16 @@ def _parse(data: dict, r: Reader, sha: str | None) -> Geometry:
         hardpoints[key] = r.point(hp_map[key], f"hardpoints.{key}") * MM
 
     sign = 1.0 if side == "left" else -1.0
-    for key, p in hardpoints.items():
+    # Chassis pickups may cross the centreline (cross-car dampers, rockers, bars);
+    # what rides with the wheel must be on the wheel's side.
+    for key in wheel_side_points(steering, actuation, mount, spring):
+        p = hardpoints[key]
         if sign * p[1] < 0.0:
             want = "y >= 0" if side == "left" else "y <= 0"
             r.fail(
                 f"hardpoints.{key}",
-                f"y = {p[1] / MM:g} mm on a {side} corner ({side} hardpoints have {want};"
-                " check 'side' or the sign of y)",
+                f"y = {p[1] / MM:g} mm on a {side} corner (the points that ride with the "
+                f"wheel have {want}; check 'side' or the sign of y)",
             )
     _check_linkage(hardpoints, steering, actuation, spring, sign, r)
     adjusters = _setup_block(config.get("setup", {}), actuation, r)

@@ -167,6 +167,24 @@ def rocker_angle(ps: PointSet):
     return ps.s * np.arctan2(y, np.sum(arm0 * arm, axis=-1))
 
 
+def rocker_transmission_angle(ps: PointSet):
+    """Angle between the rocker arm (axis → pushrod_inboard) and the pushrod
+    (pushrod_inboard → pushrod_outboard), both seen along the rocker axis: 90° is
+    ideal; near 0° or 180° the rocker goes over centre (its motion ratio flips)."""
+    u = unit(ps["rocker_axis_b"] - ps["rocker_axis_a"])
+    arm = ps["pushrod_inboard"] - ps["rocker_axis_a"]
+    rod = ps["pushrod_outboard"] - ps["pushrod_inboard"]
+    arm = arm - u * np.sum(u * arm, axis=-1, keepdims=True)
+    rod = rod - u * np.sum(u * rod, axis=-1, keepdims=True)
+    sine = np.sum(u * np.cross(arm, rod), axis=-1)
+    return np.abs(np.arctan2(sine, np.sum(arm * rod, axis=-1)))
+
+
+def rack_displacement(ps: PointSet):
+    """TRI_y − TRI_y,design: rack travel from its design (centre) position, + = left."""
+    return ps["trackrod_inboard"][..., Y] - ps.design["trackrod_inboard"][..., Y]
+
+
 def svic_x(ps: PointSet):
     """Side-view instant centre x: instant axis ∩ plane y = WC_y."""
     return ps.instant_axis_point(Y)[0]
@@ -242,6 +260,10 @@ def _always(g: Geometry) -> bool:
     return True
 
 
+def _rack(g: Geometry) -> bool:
+    return g.steering == "rack"
+
+
 def _anti(axle: str, needs_bias: bool):
     def applies(g: Geometry) -> bool:
         have = g.axle_position == axle and g.wheelbase is not None and g.cg_position is not None
@@ -272,6 +294,8 @@ class Metric:
     drivers: tuple[str, ...] = ()
     always_written: bool = False
     written: bool = True  # False: a point coordinate, already a column, for its derivative
+    needs: str = ""  # the inputs an always-written column needs to have values
+    plausible: tuple[float, float] | None = None  # at design, in output units (a warning)
 
     @property
     def scale(self) -> float:
@@ -281,14 +305,28 @@ class Metric:
 
 BOTH = (HUB_Z, RACK)
 METRICS = (
-    Metric("camber", "deg", "Camber", camber, drivers=BOTH),
-    Metric("caster", "deg", "Caster", caster, drivers=BOTH),
-    Metric("kpi", "deg", "Kingpin inclination", kpi, drivers=BOTH),
-    Metric("roadwheel_angle", "deg", "Roadwheel angle (toe, + in)", roadwheel_angle, drivers=BOTH),
-    Metric("scrub_radius", "mm", "Scrub radius", scrub_radius, drivers=BOTH),
-    Metric("mechanical_trail", "mm", "Mechanical trail", mechanical_trail, drivers=BOTH),
+    Metric("camber", "deg", "Camber", camber, drivers=BOTH, plausible=(-10.0, 10.0)),
+    Metric("caster", "deg", "Caster", caster, drivers=BOTH, plausible=(-10.0, 20.0)),
+    Metric("kpi", "deg", "Kingpin inclination", kpi, drivers=BOTH, plausible=(-10.0, 35.0)),
+    Metric(
+        "roadwheel_angle",
+        "deg",
+        "Roadwheel angle (toe, + in)",
+        roadwheel_angle,
+        drivers=BOTH,
+        plausible=(-10.0, 10.0),
+    ),
+    Metric("scrub_radius", "mm", "Scrub radius", scrub_radius, drivers=BOTH, plausible=(-150, 150)),
+    Metric(
+        "mechanical_trail",
+        "mm",
+        "Mechanical trail",
+        mechanical_trail,
+        drivers=BOTH,
+        plausible=(-100.0, 150.0),
+    ),
     Metric("wheel_travel", "mm", "Wheel travel (+ bump)", wheel_travel),
-    Metric("half_track", "mm", "Half track", half_track, drivers=BOTH),
+    Metric("half_track", "mm", "Half track", half_track, drivers=BOTH, plausible=(250, 1300)),
     Metric(
         "wheel_center_x", "mm", "Wheel centre x", wheel_center_x, drivers=(HUB_Z,), written=False
     ),
@@ -316,6 +354,14 @@ METRICS = (
         lambda g: g.spring == "torsion_bar",
         drivers=(HUB_Z,),
     ),
+    Metric(
+        "rocker_transmission_angle",
+        "deg",
+        "Rocker transmission angle",
+        rocker_transmission_angle,
+        lambda g: g.has_pushrod,
+    ),
+    Metric("rack_displacement", "mm", "Rack travel from centre", rack_displacement, _rack),
     Metric("svic_x", "mm", "Side-view IC x", svic_x, always_written=True),
     Metric("svic_z", "mm", "Side-view IC z", svic_z, always_written=True),
     Metric("fvic_y", "mm", "Front-view IC y", fvic_y, always_written=True),
@@ -323,9 +369,33 @@ METRICS = (
     Metric("svsa_length", "mm", "Side-view swing arm length", svsa_length, always_written=True),
     Metric("fvsa_length", "mm", "Front-view swing arm length", fvsa_length, always_written=True),
     Metric("svsa_angle", "deg", "Side-view swing arm angle", svsa_angle, always_written=True),
-    Metric("anti_dive", "%", "Anti-dive", anti_dive, _anti("front", True), always_written=True),
-    Metric("anti_lift", "%", "Anti-lift", anti_lift, _anti("rear", True), always_written=True),
-    Metric("anti_squat", "%", "Anti-squat", anti_squat, _anti_squat_applies, always_written=True),
+    Metric(
+        "anti_dive",
+        "%",
+        "Anti-dive",
+        anti_dive,
+        _anti("front", True),
+        always_written=True,
+        needs="config.axle_position: front, front_brake_bias, cg_position and wheelbase",
+    ),
+    Metric(
+        "anti_lift",
+        "%",
+        "Anti-lift",
+        anti_lift,
+        _anti("rear", True),
+        always_written=True,
+        needs="config.axle_position: rear, front_brake_bias, cg_position and wheelbase",
+    ),
+    Metric(
+        "anti_squat",
+        "%",
+        "Anti-squat",
+        anti_squat,
+        _anti_squat_applies,
+        always_written=True,
+        needs="config.axle_position, driven_axle (the same axle), cg_position and wheelbase",
+    ),
 )
 METRIC_BY_NAME = {m.name: m for m in METRICS}
 # The standard kinematics set: the setup sheet's static values, the report's first panels.
@@ -371,12 +441,21 @@ def derivative_columns(g: Geometry) -> list[Derivative]:
     return [Derivative(m, d) for d in drivers for m in METRICS if d in m.drivers and m.applies(g)]
 
 
-def metric_columns(geometry: Geometry, points: dict, design: dict) -> dict:
+def metric_columns(
+    geometry: Geometry, points: dict, design: dict, spring_sense: float = 1.0
+) -> dict:
     """Metric, derivative and motion-ratio columns in output units: name → (values, unit).
 
     ``points`` are plain (n, 3) arrays, or jet.Duals whose rates have one leading
     axis per driver of ``derivative_columns(geometry)`` (hub z, then rack); with
     Duals the derivative columns are included.
+
+    ``motion_ratio`` is the spring's deflection per mm of wheel travel, positive
+    when bump loads the spring as it does at the design state: a coilover's
+    compression (−d damper_length/d hub z, mm/mm), a torsion bar's wind-up
+    (``spring_sense``·d twist/d hub z, deg/mm, where ``spring_sense`` = ±1 is the
+    sign of d twist/d hub z at design, so the rocker axis's a→b order does not
+    matter). A sign change through a sweep means the rocker went over centre.
     """
     ps = PointSet(points, design, geometry)
     n = np.shape(value(points["wheel_center"]))[:-1]
@@ -397,7 +476,8 @@ def metric_columns(geometry: Geometry, points: dict, design: dict) -> dict:
     if geometry.spring == "coilover":
         out["motion_ratio"] = (-out["deriv_damper_length_wrt_hub_z"][0], "mm/mm")
     elif geometry.spring == "torsion_bar":
-        out["motion_ratio"] = (out["deriv_torsion_bar_twist_wrt_hub_z"][0], "deg/mm")
+        twist_rate = out["deriv_torsion_bar_twist_wrt_hub_z"][0]
+        out["motion_ratio"] = (spring_sense * twist_rate, "deg/mm")
     return out
 
 

@@ -39,6 +39,7 @@ from .closures import (
     Kinematics,
     PointTarget,
 )
+from .errors import InputError
 from .geometry import contact_patch, unit, wheel_points
 from .jet import Dual
 from .metrics import METRICS, PointSet, derivative_columns
@@ -402,12 +403,59 @@ def hardpoint_sensitivities(corner, sweep=None, progress=None, with_results: boo
 STEP = {"deg": 0.1, "mm": 1.0, "%": 1.0, "deg/mm": 0.01, "mm/mm": 0.01}
 
 
-def largest(s: Sensitivity, name: str, top: int = 3) -> list[tuple[str, str, float]]:
-    """The ``top`` hardpoint coordinates that move metric ``name`` most."""
-    v = s.values[name]
+def largest(s: Sensitivity, name: str, top: int = 3, points=None) -> list[tuple[str, str, float]]:
+    """The ``top`` hardpoint coordinates that move metric ``name`` most (among ``points``)."""
+    v = s.values[name].copy()
+    if points is not None:
+        v[[h not in points for h in s.hardpoints]] = np.nan
     order = np.argsort(-np.nan_to_num(np.abs(v)).ravel())[:top]
     return [
         (s.hardpoints[i // 3], AXES[i % 3], float(v.flat[i]))
         for i in order
         if np.isfinite(v.flat[i]) and abs(v.flat[i]) > 1e-12
     ]
+
+
+SPINDLE = ("axle_inboard", "axle_outboard")  # set by the hub and upright, not moved to tune
+POINT_GROUPS = {
+    "designer": "chassis pickups and link ends (not the spindle points axle_inboard/outboard)",
+    "chassis": "the chassis pickups",
+    "upright": "the points that ride with the upright, its ball joints included",
+    "all": "every hardpoint",
+}
+
+
+def select_points(corner, spec: str = "designer") -> list[str]:
+    """Hardpoints by group (POINT_GROUPS) or a comma-separated list of names."""
+    names = list(corner.geometry.hardpoints)
+    if spec == "all":
+        return names
+    if spec == "designer":
+        return [n for n in names if n not in SPINDLE]
+    if spec == "chassis":
+        return [n for n in names if corner.body_of(n) == "chassis"]
+    if spec == "upright":
+        joints = {
+            p
+            for b in corner.tree.bodies
+            if b.name == "upright" and b.joint
+            for p in b.joint.defined_by
+        }
+        on_upright = {
+            point
+            for c in corner.tree.closures
+            if any(link == "upright" for link, _ in c.anchors)
+            for point in c.points
+        }
+        return [n for n in names if corner.body_of(n) == "upright" or n in joints | on_upright]
+    wanted = [n.strip() for n in spec.split(",") if n.strip()]
+    unknown = [n for n in wanted if n not in names]
+    if unknown or not wanted:
+        groups = ", ".join(POINT_GROUPS)
+        raise InputError(
+            "--points",
+            "",
+            f"unknown hardpoint {', '.join(unknown) or repr(spec)} (give {groups} or names "
+            f"of this corner's hardpoints: {', '.join(names)})",
+        )
+    return wanted

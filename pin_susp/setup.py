@@ -41,9 +41,10 @@ PARAMETER_KEYS = {
 Z = np.array([0.0, 0.0, 1.0])
 
 
-def apply_setup(g: Geometry) -> Geometry:
+def apply_setup(g) -> Geometry:
     """The as-set geometry: shim, then adjusters. Unchanged (the same object) when
-    the setup equals the design."""
+    the setup equals the design. ``g``: a path, a dict or a Geometry."""
+    g = _geometry(g)
     if not g.needs_setup:
         return g
     hardpoints = dict(g.hardpoints)
@@ -162,9 +163,10 @@ class SetupState:
 class SetupModel:
     """The drawn corner with the setup p as parameters: static state and dq/dp."""
 
-    def __init__(self, g: Geometry):
+    def __init__(self, g):
         from .corner import Corner
 
+        g = _geometry(g)
         self.drawn = g.drawn or g
         self.corner = Corner(self.drawn, apply_setup=False)
         c = self.corner
@@ -288,15 +290,45 @@ class InverseResult:
 
 
 TARGET_PARAMETER = {"camber": 0, "roadwheel_angle": 1, "ride_height_change": 2}
+# The CLI's option names, accepted by the API too.
+TARGET_ALIASES = {"toe": "roadwheel_angle", "ride_height": "ride_height_change"}
 
 
-def solve_setup(g: Geometry, targets: dict[str, float], max_iterations: int = 25) -> InverseResult:
+def _geometry(g) -> Geometry:
+    """A Geometry from a path, a dict or a Geometry (as Corner accepts)."""
+    from .geometry import load_geometry
+
+    return g if isinstance(g, Geometry) else load_geometry(g)
+
+
+def _targets(targets: dict[str, float]) -> dict[str, float]:
+    """Target names as the CLI says them (``toe``, ``ride-height-change``) or as columns."""
+    out = {}
+    for name, value in targets.items():
+        key = TARGET_ALIASES.get(str(name).replace("-", "_"), str(name).replace("-", "_"))
+        if key not in TARGET_PARAMETER:
+            raise InputError(
+                "targets",
+                str(name),
+                "unknown setup target (valid: camber [deg], toe or roadwheel_angle [deg], "
+                "ride_height_change [mm])",
+            )
+        if isinstance(value, bool) or not isinstance(value, int | float) or not np.isfinite(value):
+            raise InputError("targets", str(name), f"expected a finite number, got {value!r}")
+        out[key] = float(value)
+    return out
+
+
+def solve_setup(g, targets: dict[str, float], max_iterations: int = 25) -> InverseResult:
     """Find shim thickness, trackrod and pushrod deltas that hit the targets.
 
-    ``targets`` maps camber (deg), roadwheel_angle (deg, the toe) and
-    ride_height_change (mm) to their wanted static values; each moves its
-    own adjuster (shim, trackrod, pushrod). Newton with exact sensitivities.
+    ``g``: a geometry file's path, its dict, or a Geometry. ``targets`` maps
+    camber (deg), toe (= roadwheel_angle, deg) and ride_height_change (mm)
+    to their wanted static values; each moves its own adjuster (shim,
+    trackrod, pushrod). Newton with exact sensitivities.
     """
+    g = _geometry(g)
+    targets = _targets(targets)
     drawn = g.drawn or g
     for name in targets:
         if name == "camber" and drawn.camber_shim is None:
@@ -381,16 +413,18 @@ def geometry_data(g: Geometry) -> dict:
 
 
 def setup_sheet(
-    g: Geometry,
+    g,
     shim: list[float] = (),
     trackrod: list[float] = (),
     pushrod: list[float] = (),
 ) -> list[SetupState]:
     """The as-set static state, then one state per listed value (mm) of one adjuster.
 
-    ``shim`` lists fitted stack thicknesses; ``trackrod`` and ``pushrod`` list
-    length deltas. Each row changes that one value from the file's setup.
+    ``g``: a geometry file's path, its dict, or a Geometry. ``shim`` lists
+    fitted stack thicknesses; ``trackrod`` and ``pushrod`` list length deltas.
+    Each row changes that one value from the file's setup.
     """
+    g = _geometry(g)
     drawn = g.drawn or g
     if shim and drawn.camber_shim is None:
         raise InputError(drawn.source, "config.camber_shim", "--shim needs a camber shim")

@@ -7,6 +7,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 import yaml
 from conftest import EXAMPLES, example, sweep_csv
@@ -311,3 +312,119 @@ def test_console_script_reports_without_traceback(tmp_path):
         f"pin-susp: error: {bad}: hardpoints.axle_inboard: missing point"
     )
     assert not out.exists()
+
+
+# -- what a new user tripped over on a first afternoon ------------------------------------
+
+
+def test_chassis_points_may_cross_the_centreline(tmp_path, capsys):
+    g = example("pushrod_rocker.yaml")
+    g["hardpoints"]["strut_top"]["y"] = -50.0  # a cross-car damper
+    path = write(tmp_path / "g.yaml", g)
+    assert (
+        main(
+            [
+                "sweep",
+                str(path),
+                str(EXAMPLES / "bump_steer.yaml"),
+                "-o",
+                str(tmp_path / "r.csv"),
+                "-q",
+            ]
+        )
+        == 0
+    )
+    g["hardpoints"]["strut_top"]["y"] = 400.0
+    g["hardpoints"]["trackrod_outboard"]["y"] = -800.0  # rides with the wheel: still refused
+    write(tmp_path / "g.yaml", g)
+    assert (
+        main(["sweep", str(path), str(EXAMPLES / "bump_steer.yaml"), "-o", str(tmp_path / "r.csv")])
+        == 2
+    )
+    assert "trackrod_outboard" in capsys.readouterr().err
+
+
+def test_implausible_values_warn_one_line_each_and_still_run(tmp_path, capsys):
+    g = example("double_wishbone.yaml")
+    g["config"]["wheel"]["tire"]["rim_diameter"] = 330  # mm written for inches
+    path = write(tmp_path / "g.yaml", g)
+    out = tmp_path / "r.csv"
+    assert main(["sweep", str(path), str(EXAMPLES / "bump_steer.yaml"), "-o", str(out)]) == 0
+    err = capsys.readouterr().err.splitlines()
+    assert any("rim_diameter = 330 in" in line and "plausible" in line for line in err)
+    assert any("scrub_radius" in line for line in err)
+    assert all(line.startswith("pin-susp: warning:") for line in err)
+    assert out.exists()
+    assert main(["sweep", str(path), str(EXAMPLES / "bump_steer.yaml"), "-o", str(out), "-q"]) == 0
+    assert capsys.readouterr().err == ""  # --quiet: nothing but errors
+    assert main(["sweep", str(path), str(tmp_path / "missing.yaml"), "-o", str(out)]) == 2
+    assert len(capsys.readouterr().err.splitlines()) == 1  # an error stays one line
+
+
+def test_summary_says_what_a_blank_column_needs_and_where_centres_go_to_infinity(tmp_path, capsys):
+    out = tmp_path / "r.csv"
+    assert (
+        main(
+            [
+                "sweep",
+                str(EXAMPLES / "double_wishbone.yaml"),
+                str(EXAMPLES / "bump_steer.yaml"),
+                "-o",
+                str(out),
+            ]
+        )
+        == 0
+    )
+    lines = capsys.readouterr().out.splitlines()
+    dive = next(line for line in lines if line.strip().startswith("anti_dive"))
+    assert "needs config.axle_position: front, front_brake_bias" in dive
+    fvic = next(line for line in lines if line.strip().startswith("fvic_y"))
+    assert "at infinity" in fvic
+    # where the centre really passes infinity: a sign change between neighbours, both far
+    with open(out) as f:
+        rows = list(csv.DictReader(line for line in f if not line.startswith("#")))
+    y = [float(r["fvic_y"]) for r in rows]
+    k = int(fvic.split("near step")[1])
+    assert abs(y[k]) > 1e5 and any(np.sign(y[i]) != np.sign(y[i + 1]) for i in (k - 1, k))
+
+
+def test_rocker_going_over_centre_is_warned(tmp_path, capsys):
+    g = example("pushrod_rocker.yaml")
+    g["hardpoints"]["pushrod_inboard"] = {"x": 0, "y": 290, "z": 440}  # arm almost along the rod
+    path = write(tmp_path / "g.yaml", g)
+    code = main(
+        ["sweep", str(path), str(EXAMPLES / "bump_steer.yaml"), "-o", str(tmp_path / "r.csv")]
+    )
+    err = capsys.readouterr().err
+    assert code in (0, 1)
+    assert "rocker transmission angle" in err and "over-centre" in err
+
+
+def test_sensitivity_ranks_the_points_a_designer_moves(capsys):
+    path = str(EXAMPLES / "double_wishbone.yaml")
+    assert main(["sensitivity", path, "--top", "3"]) == 0
+    table = capsys.readouterr().out
+    ranked = [ln.split()[0] for ln in table.splitlines() if "/mm " in ln and "move" in ln]
+    assert ranked and "axle_inboard" not in ranked and "axle_outboard" not in ranked
+    assert "not the spindle points" in table
+    assert main(["sensitivity", path, "--points", "chassis", "--top", "3"]) == 0
+    table = capsys.readouterr().out
+    ranked = [ln.split()[0] for ln in table.splitlines() if "/mm " in ln and "move" in ln]
+    assert ranked and all("inboard" in name for name in ranked)  # chassis pickups only
+    assert main(["sensitivity", path, "--points", "nonsense"]) == 2
+
+
+def test_demo_help_lists_every_output(capsys):
+    with pytest.raises(SystemExit):
+        pin_susp.cli._parser().parse_args(["demo", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    for name in (
+        "demo_results.csv",
+        "demo_report.png",
+        "demo_drawing.png",
+        "demo_replay.html",
+        "demo_corner.urdf",
+        "demo_geometry.yaml",
+        "demo_sweep.yaml",
+    ):
+        assert name in text

@@ -182,3 +182,54 @@ def test_mirrored_pushrod_rocker_corner_gives_the_same_rocker_and_damper():
     for name in SIDE_FREE + ("rocker_angle", "damper_length"):
         np.testing.assert_allclose(right[name], left[name], atol=1e-9, err_msg=name)
     assert abs(left["rocker_angle"][0]) > 1.0
+
+
+# -- rocker transmission angle, rack travel, one motion-ratio convention -----------------
+
+
+def _rocker_angle_by_hand(p: dict) -> float:
+    """The angle at pushrod_inboard between rocker arm and pushrod, seen along the axis (deg)."""
+    a, b = np.array(p["rocker_axis_a"]), np.array(p["rocker_axis_b"])
+    u = (b - a) / np.linalg.norm(b - a)
+    flat = lambda v: v - u * (u @ v)  # noqa: E731
+    arm = flat(np.array(p["pushrod_inboard"]) - a)
+    rod = flat(np.array(p["pushrod_outboard"]) - np.array(p["pushrod_inboard"]))
+    return np.degrees(np.arccos(arm @ rod / np.linalg.norm(arm) / np.linalg.norm(rod)))
+
+
+def test_rocker_transmission_angle_matches_the_angle_by_hand(tmp_path):
+    corner = pin_susp.Corner(example("pushrod_rocker.yaml"))
+    results = corner.run_sweep(example("bump_steer.yaml"))
+    for i in (0, 20, 40):
+        p = {n: [results[f"{n}_{a}"][i] for a in "xyz"] for n in corner.point_names}
+        assert results["rocker_transmission_angle"][i] == pytest.approx(
+            _rocker_angle_by_hand(p), abs=1e-9
+        )
+
+
+def test_rack_displacement_is_rack_travel_from_design():
+    corner = pin_susp.Corner(example("double_wishbone.yaml"))
+    results = corner.run_sweep(example("bump_steer.yaml"))
+    np.testing.assert_allclose(results["rack_displacement"], np.linspace(-10, 10, 41), atol=1e-9)
+
+
+def _torsion_bar(swap_axis: bool) -> dict:
+    g = example("pushrod_rocker.yaml")
+    g["spring"] = {"type": "torsion_bar"}
+    for name in ("strut_top", "strut_bottom"):
+        del g["hardpoints"][name]
+    if swap_axis:
+        hp = g["hardpoints"]
+        hp["rocker_axis_a"], hp["rocker_axis_b"] = hp["rocker_axis_b"], hp["rocker_axis_a"]
+    return g
+
+
+def test_motion_ratio_has_one_sign_convention_for_coilover_and_torsion_bar():
+    sweep = example("bump_steer.yaml")
+    coil = pin_susp.Corner(example("pushrod_rocker.yaml")).run_sweep(sweep)
+    bar = pin_susp.Corner(_torsion_bar(False)).run_sweep(sweep)
+    swapped = pin_susp.Corner(_torsion_bar(True)).run_sweep(sweep)
+    assert coil["motion_ratio"][16] > 0 and bar["motion_ratio"][16] > 0  # bump loads both
+    np.testing.assert_allclose(swapped["motion_ratio"], bar["motion_ratio"], rtol=0, atol=1e-12)
+    # the twist itself keeps its spec sign, which the a→b order flips
+    np.testing.assert_allclose(swapped["torsion_bar_twist"], -bar["torsion_bar_twist"], atol=1e-9)

@@ -387,3 +387,45 @@ def test_setup_list_for_a_missing_part_is_an_error(capsys):
     assert "--pushrod needs a pushrod" in capsys.readouterr().err
     assert main(["setup", str(EXAMPLES / "double_wishbone.yaml"), "--shim", "10"]) == 2
     assert "--shim needs a camber shim" in capsys.readouterr().err
+
+
+# -- what a new user tried first: the API takes what Corner takes, and the CLI's names --
+
+
+@pytest.mark.parametrize("form", ["path", "str", "dict", "geometry"])
+def test_setup_api_accepts_a_path_a_dict_or_a_geometry(form):
+    path = EXAMPLES / "camber_shim.yaml"
+    g = {
+        "path": path,
+        "str": str(path),
+        "dict": example("camber_shim.yaml"),
+        "geometry": load_geometry(path),
+    }[form]
+    sheet = pin_susp.setup_sheet(g, shim=[25.0])
+    reference = pin_susp.setup_sheet(load_geometry(path), shim=[25.0])
+    assert sheet[1].metrics["camber"] == reference[1].metrics["camber"]
+    found = pin_susp.solve_setup(g, {"camber": -2.5})
+    assert found.after.metrics["camber"] == pytest.approx(-2.5, abs=1e-9)
+
+
+def test_solve_setup_speaks_the_cli_names():
+    path = EXAMPLES / "camber_shim.yaml"
+    by_cli = solve_setup(path, {"toe": 0.1, "camber": -2.5})
+    by_column = solve_setup(path, {"roadwheel_angle": 0.1, "camber": -2.5})
+    assert by_cli.after.metrics == by_column.after.metrics
+    with pytest.raises(pin_susp.InputError, match="valid: camber.*toe or roadwheel_angle"):
+        solve_setup(path, {"toes": 0.1})
+
+
+def test_negative_lists_work_as_written(capsys):
+    assert main(["setup", str(EXAMPLES / "double_wishbone.yaml"), "--trackrod", "-1,0,1"]) == 0
+    rows = [ln for ln in capsys.readouterr().out.splitlines() if ln.strip().startswith("trackrod")]
+    assert [float(r.split()[2]) for r in rows] == [-1.0, 0.0, 1.0]
+
+
+def test_a_toe_link_corner_says_toe_link_not_trackrod(tmp_path, capsys):
+    path = str(EXAMPLES / "fixed_toe_link.yaml")
+    assert main(["setup", path, "--trackrod=-1", "--csv", str(tmp_path / "s.csv")]) == 0
+    out = capsys.readouterr().out
+    assert "toe link" in out and "trackrod" not in out
+    assert "toe_link_length_delta" in (tmp_path / "s.csv").read_text()
