@@ -330,7 +330,8 @@ def _parser() -> argparse.ArgumentParser:
         help="standard kinematics report from results CSVs (one panel per metric)",
         description="Camber, toe, caster, KPI, scrub, trail, half track (and instant centres, "
         "anti geometry, motion ratio, camber gain and bump steer where present) against wheel "
-        "travel, or rack position for a steer sweep. Several CSVs compare designs.",
+        "travel, or rack travel from centre for a steer sweep. Several CSVs compare designs "
+        "(of the same kind of sweep: a bump and a steer sweep cannot share one figure).",
     )
     pl.add_argument("results", nargs="+", metavar="RESULTS.csv", help="pin-susp sweep output")
     pl.add_argument(
@@ -341,12 +342,17 @@ def _parser() -> argparse.ArgumentParser:
     dr = sub.add_parser(
         "draw",
         help="front and side view drawing of a corner",
-        description="Draw GEOMETRY at its design (as-set) state in front and side view; a "
-        "shimmed corner shows its drawn geometry dashed.",
+        description="Draw GEOMETRY at its design (as-set) state in front and side view, with "
+        "the instant-centre construction (ball joints to the front- and side-view instant "
+        "centres, the contact patch through them, and the roll centre of a symmetric axle on "
+        "the centreline); a shimmed corner shows its drawn geometry dashed.",
     )
     _geometry_argument(dr)
     dr.add_argument(
         "-o", "--output", required=True, metavar="OUT.png", help="image (png, pdf, svg)"
+    )
+    dr.add_argument(
+        "--labels", action="store_true", help="name every hardpoint and add a colour legend"
     )
     dr.set_defaults(run=_draw)
 
@@ -934,7 +940,8 @@ def _draw(args) -> int:
     from .plots import drawing_figure, save_figure
 
     _check_image(args.output)
-    save_figure(drawing_figure(Corner(load_geometry(args.geometry))), args.output)
+    corner = Corner(load_geometry(args.geometry))
+    save_figure(drawing_figure(corner, labels=args.labels), args.output)
     print(f"wrote {args.output}")
     return 0
 

@@ -231,8 +231,7 @@ def test_results_of_another_kind_of_sweep(tmp_path, results_csv):
     with pytest.raises(InputError) as info:
         report_figure([ResultsFile(out), ResultsFile(rear)])
     assert str(info.value) == (
-        f"{rear}: trackrod_inboard_y: no values, but steer is plotted against it: "
-        "plot results of the same kind of sweep together"
+        f"{rear}: x is wheel travel but {out}'s is rack travel: plot them separately"
     )
 
 
