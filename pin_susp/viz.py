@@ -7,6 +7,15 @@ axis down to the ground and the contact patch — are drawn between their
 solved points. A sweep becomes a meshcat animation with its play controls:
 each frame is recorded by pointing the visualizer at the animation frame and
 displaying the pose there.
+
+At load the camera is framed on the corner: it looks from the front, a
+little outboard and above, at a point near the middle of the corner's
+bounding box (its design points and tyre), chosen so that the corner's
+picture is centred, from far enough for the corner to fill most of the view.
+meshcat orbits about the world origin, so the scene is moved to put that
+point there. The ground (the contact patch's height at design, where scrub
+and trail are measured) is drawn as a translucent square, with meshcat's
+grid on it.
 """
 
 from __future__ import annotations
@@ -28,6 +37,12 @@ LINKS = {  # name: (ends, colour, radius)
 }
 AXIS_COLOUR, PATCH_COLOUR = 0xE8C020, 0xE83070
 GHOST = [0.55, 0.55, 0.6, 0.35]
+GROUND_COLOUR, GROUND_OPACITY = 0xB4B4A8, 0.3
+GROUND_SIZE, GROUND_THICKNESS = 1.5, 0.002  # m: a square under the corner, its top at the CP
+VIEW = np.array([1.6, 0.35, 0.7])  # camera direction: front, outboard (y by side), above
+FOV = 75.0  # degrees, vertical: meshcat's default camera (three.js PerspectiveCamera)
+FILL = 0.8  # the corner's share of the view's height, or of its width ...
+ASPECT = 4 / 3  # ... in a view at least this wide for its height
 
 
 def segments(corner, positions: dict[str, np.ndarray]) -> dict[str, tuple[np.ndarray, np.ndarray]]:
@@ -46,6 +61,66 @@ def segments(corner, positions: dict[str, np.ndarray]) -> dict[str, tuple[np.nda
     if abs(k[2]) > 1e-9:
         out["steering_axis"] = (ubj, lbj + (ground - lbj[2]) / k[2] * k)
     return out
+
+
+def outline(*corners) -> np.ndarray:
+    """Points (m, N×3) around what is drawn of the corners at design.
+
+    Their design points, the rack's end on the car's centre plane, and the
+    tyre's two rims: circles of the wheel's radius at its inboard and
+    outboard faces.
+    """
+    points = []
+    angles = np.linspace(0.0, 2.0 * np.pi, 48, endpoint=False)
+    for corner in corners:
+        g, p = corner.geometry, corner.design_positions
+        points += list(p.values())
+        if g.steering == "rack":  # the rack is drawn to the centre plane (y = 0)
+            points.append(p[g.steering_points[0]] * np.array([1.0, 0.0, 1.0]))
+        a, b = p["wheel_inboard"], p["wheel_outboard"]
+        axis = (b - a) / np.linalg.norm(b - a)
+        e1 = np.cross(axis, [1.0, 0.0, 0.0] if abs(axis[0]) < 0.9 else [0.0, 0.0, 1.0])
+        e1 /= np.linalg.norm(e1)
+        e2 = np.cross(axis, e1)
+        rim = g.wheel.radius * (np.outer(np.cos(angles), e1) + np.outer(np.sin(angles), e2))
+        points += [*(a + rim), *(b + rim)]
+    return np.array(points)
+
+
+def bounds(*corners) -> tuple[np.ndarray, np.ndarray]:
+    """The box (lowest, highest corner, m) around what is drawn of the corners at design."""
+    points = outline(*corners)
+    return points.min(axis=0), points.max(axis=0)
+
+
+def framing(points: np.ndarray, sign: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    """Where the camera looks and where it sits from there (m, world frame) to frame the points.
+
+    It looks along ``VIEW`` (outboard on the side ``sign``), z up, at a point
+    near the points' bounding-box centre, moved across the view until the
+    points' picture is centred; it is set back until every point is within
+    ``FILL`` of the view's half-height, and across within that of a view of
+    aspect ``ASPECT``.
+    """
+    u = VIEW * np.array([1.0, sign, 1.0])
+    u = u / np.linalg.norm(u)
+    right = np.cross(-u, [0.0, 0.0, 1.0])
+    right /= np.linalg.norm(right)
+    up = np.cross(right, -u)
+    points = np.asarray(points, dtype=float)
+    reach = FILL * np.tan(np.radians(FOV / 2)) * np.array([ASPECT, 1.0])
+    target = 0.5 * (points.min(axis=0) + points.max(axis=0))
+    for _ in range(30):
+        c = points - target
+        # c is in view when |c·right|, |c·up| <= reach·(distance - c·u)
+        across = np.abs(np.stack([c @ right, c @ up], axis=1)) / reach
+        distance = float(np.max(c @ u + across.max(axis=1)))
+        seen = np.stack([c @ right, c @ up], axis=1) / (distance - c @ u)[:, None]
+        middle = 0.5 * (seen.min(axis=0) + seen.max(axis=0))
+        if np.abs(middle).max() < 1e-5:
+            break
+        target = target + distance * (middle[0] * right + middle[1] * up)
+    return target, distance * u
 
 
 # meshcat's own server, with its web server bound to loopback (meshcat 0.3.2's
@@ -144,7 +219,7 @@ class CornerScene:
         self.viewer[f"{ROOT}/contact_patch"].set_object(
             mg.Sphere(0.018), mg.MeshLambertMaterial(color=PATCH_COLOUR)
         )
-        self._camera()
+        self._frame([c for c, _ in self.robots])
         self.show()
 
     def _robot(self, corner, name, colour):
@@ -158,17 +233,43 @@ class CornerScene:
         viz.display(corner.q_design)
         return corner, viz
 
-    def _camera(self) -> None:
-        """Look at the corner from the front, a little outboard and above.
+    def _frame(self, corners) -> None:
+        """Put the corners' middle on the orbit target, set the camera back, lay the ground.
 
-        The camera offset is written in meshcat's rotated camera frame
-        (three.js: x, z up, −y), looking at the origin.
+        meshcat 0.3.2 orbits its camera about the world origin and cannot move
+        that target (OrbitControls' target is not in the scene tree and there
+        is no command for it; moving /Cameras/default moves the camera, but
+        three.js's lookAt still aims it at the world origin), so the scene is
+        moved instead: the point the camera looks at goes to the origin. The
+        camera's position is written in meshcat's rotated camera frame
+        (three.js: x, z up, −y).
         """
-        s = self.corner.geometry.sign
+        import meshcat.geometry as mg
+
+        points = outline(*corners)
+        target, eye = framing(points, self.corner.geometry.sign)
+        shift = np.eye(4)
+        shift[:3, 3] = -target
+        self.viewer[ROOT].set_transform(shift)
         self.viewer["/Cameras/default/rotated/<object>"].set_property(
-            "position", [1.6, 0.7, -s * 0.35]
+            "position", [float(eye[0]), float(eye[2]), float(-eye[1])]
         )
         self.viewer["/Axes"].set_property("visible", False)
+
+        ground = float(self.corner.design_positions["contact_patch_center"][2])
+        self.viewer[f"{ROOT}/ground"].set_object(
+            mg.Box([GROUND_SIZE, GROUND_SIZE, GROUND_THICKNESS]),
+            mg.MeshLambertMaterial(
+                color=GROUND_COLOUR, opacity=GROUND_OPACITY, transparent=True, depthWrite=False
+            ),
+        )
+        plane = np.eye(4)  # its top face at the ground, centred under the corner
+        plane[:2, 3] = 0.5 * (points.min(axis=0) + points.max(axis=0))[:2]
+        plane[2, 3] = ground - 0.5 * GROUND_THICKNESS
+        self.viewer[f"{ROOT}/ground"].set_transform(plane)
+        grid = shift.copy()  # meshcat's grid on the same ground, in the car's x and y
+        grid[2, 3] = ground - target[2] - 0.5 * GROUND_THICKNESS
+        self.viewer["/Grid"].set_transform(grid)
 
     def show(self, q: np.ndarray | None = None, viewer=None) -> None:
         """Display the corner at q (default: its design state), drawn on ``viewer``."""

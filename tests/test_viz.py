@@ -9,7 +9,8 @@ import sys
 
 import numpy as np
 import pytest
-from conftest import EXAMPLES, sweep_csv
+import yaml
+from conftest import EXAMPLES, example, mirrored, sweep_csv
 
 import pin_susp
 from pin_susp.cli import main
@@ -53,38 +54,7 @@ def test_replay_makes_no_network_requests(replay):
 def test_replay_renders_the_suspension_in_headless_chromium(replay, tmp_path):
     from PIL import Image
 
-    shot = tmp_path / "shot.png"
-    command = [
-        CHROMIUM,
-        "--headless",
-        "--no-sandbox",
-        "--enable-unsafe-swiftshader",
-        "--disable-gpu",
-        "--disable-dev-shm-usage",
-        "--disable-background-networking",
-        "--disable-component-update",
-        "--disable-sync",
-        "--disable-extensions",
-        "--no-first-run",
-        "--run-all-compositor-stages-before-draw",
-        "--virtual-time-budget=5000",
-        "--window-size=1000,700",
-        f"--screenshot={shot}",
-    ]
-    # headless chromium now and then hangs on start-up here: give it three tries
-    for attempt in range(3):
-        proc = subprocess.Popen(
-            [*command, f"--user-data-dir={tmp_path / f'profile{attempt}'}", replay.as_uri()],
-            stdout=subprocess.DEVNULL,
-            stderr=subprocess.DEVNULL,
-            start_new_session=True,
-        )
-        try:
-            proc.wait(timeout=60)
-            break
-        except subprocess.TimeoutExpired:
-            os.killpg(proc.pid, signal.SIGKILL)
-            proc.wait()
+    shot = _screenshot(replay, tmp_path)
     assert shot.exists(), "chromium wrote no screenshot"
     rgb = np.asarray(Image.open(shot).convert("RGB")).astype(int)
     r, g, b = rgb[..., 0], rgb[..., 1], rgb[..., 2]
@@ -243,3 +213,151 @@ def test_no_progress_bar_when_not_a_terminal(tmp_path, capfd):
         == 0
     )
     assert "solving [" not in capfd.readouterr().err
+
+
+def _screenshot(page, tmp_path, size=(1000, 700)):
+    """Headless chromium's screenshot (a PNG's path) of the page after 5 s of virtual time."""
+    shot = tmp_path / f"{page.stem}.png"
+    command = [
+        CHROMIUM,
+        "--headless",
+        "--no-sandbox",
+        "--enable-unsafe-swiftshader",
+        "--disable-gpu",
+        "--disable-dev-shm-usage",
+        "--disable-background-networking",
+        "--disable-component-update",
+        "--disable-sync",
+        "--disable-extensions",
+        "--no-first-run",
+        "--run-all-compositor-stages-before-draw",
+        "--virtual-time-budget=5000",
+        f"--window-size={size[0]},{size[1]}",
+        f"--screenshot={shot}",
+    ]
+    # headless chromium now and then hangs on start-up here: give it three tries
+    for attempt in range(3):
+        profile = tmp_path / f"profile-{page.stem}-{attempt}"
+        proc = subprocess.Popen(
+            [*command, f"--user-data-dir={profile}", page.as_uri()],
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+            start_new_session=True,
+        )
+        try:
+            proc.wait(timeout=60)
+            break
+        except subprocess.TimeoutExpired:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+    return shot
+
+
+# Only the corner on the page's own (white) background: meshcat's gradient,
+# grid and controls, and our ground plane, hidden. The scene's commands are
+# applied later (each is a fetch() of a data: URL), so none must show them again.
+CORNER_ONLY = """<script>
+viewer.set_property(["Background"], "visible", false);
+viewer.set_property(["Grid"], "visible", false);
+viewer.set_property(["meshcat", "pin_susp", "ground"], "visible", false);
+viewer.gui.domElement.style.display = "none";
+</script>
+</body>"""
+
+
+@pytest.mark.skipif(CHROMIUM is None, reason="chromium is not installed (Debian package chromium)")
+@pytest.mark.parametrize("side", ["left", "right"])
+def test_replay_frames_the_corner_in_the_middle_of_the_view(side, tmp_path):
+    from PIL import Image
+
+    geometry = example("double_wishbone.yaml")
+    if side == "right":
+        geometry = mirrored(geometry)
+    source = tmp_path / f"{side}.yaml"
+    source.write_text(yaml.safe_dump(geometry))
+    html = tmp_path / f"{side}.html"
+    assert main(["view", str(source), "--html", str(html)]) == 0
+    page = tmp_path / f"{side}-corner-only.html"
+    page.write_text(html.read_text().replace("</body>", CORNER_ONLY, 1))
+    shot = _screenshot(page, tmp_path)
+    assert shot.exists(), "chromium wrote no screenshot"
+
+    rgb = np.asarray(Image.open(shot).convert("RGB")).astype(int)
+    h, w, _ = rgb.shape
+    border = np.concatenate([rgb[0], rgb[-1], rgb[:, 0], rgb[:, -1]])
+    background = np.median(border, axis=0)
+    ys, xs = np.nonzero(np.abs(rgb - background).max(axis=2) > 40)
+    assert len(xs) > 5000, "no corner to be seen"
+    x0, x1, y0, y1 = xs.min(), xs.max(), ys.min(), ys.max()
+    width, height = (x1 - x0 + 1) / w, (y1 - y0 + 1) / h
+    middle = ((x0 + x1 + 1) / 2 / w - 0.5, (y0 + y1 + 1) / 2 / h - 0.5)
+    seen = f"corner over {width:.0%} × {height:.0%} of the view, its middle off by {middle}"
+    assert max(width, height) >= 0.6, seen
+    assert abs(middle[0]) <= 0.15 and abs(middle[1]) <= 0.15, seen
+    assert x0 > 0 and y0 > 0 and x1 < w - 1 and y1 < h - 1, f"cut by the edge: {seen}"
+
+
+def _commands(html: str) -> list[dict]:
+    """The scene's meshcat commands in a static page (base64 msgpack in data: URLs)."""
+    import base64
+
+    import umsgpack
+
+    blobs = re.findall(r'fetch\("data:application/octet-binary;base64,([A-Za-z0-9+/=]*)"\)', html)
+    return [umsgpack.unpackb(base64.b64decode(b)) for b in blobs]
+
+
+def _transform(commands: list[dict], path: str) -> np.ndarray:
+    (matrix,) = [
+        c["matrix"] for c in commands if c["type"] == "set_transform" and c["path"] == path
+    ]
+    return np.array(matrix, dtype=float).reshape(4, 4).T  # meshcat sends it column-major
+
+
+@pytest.mark.parametrize("name", ["double_wishbone", "camber_shim", "right"])
+def test_scene_has_the_ground_at_the_contact_patch_and_the_camera_on_the_corner(name):
+    from pin_susp.viz import CornerScene, bounds
+
+    if name == "right":
+        corner = pin_susp.Corner(mirrored(example("double_wishbone.yaml")))
+    else:
+        corner = pin_susp.Corner(EXAMPLES / f"{name}.yaml")
+    assert (corner.geometry.drawn is not None) == (name == "camber_shim")
+    scene = CornerScene(corner)
+    try:
+        commands = _commands(scene.html())
+    finally:
+        scene.close()
+
+    (ground,) = [
+        c["object"]
+        for c in commands
+        if c["type"] == "set_object" and c["path"] == "/meshcat/pin_susp/ground"
+    ]
+    (box,) = ground["geometries"]
+    assert box["type"] == "BoxGeometry" and box["width"] >= 1.0 and box["depth"] < 0.01
+    (material,) = ground["materials"]
+    assert material["transparent"] and material["opacity"] < 1.0
+    root = _transform(commands, "/meshcat/pin_susp")  # the corner's frame in the scene
+    plane = _transform(commands, "/meshcat/pin_susp/ground")
+    patch = corner.design_positions["contact_patch_center"]
+    top = plane[2, 3] + box["depth"] / 2
+    assert top == pytest.approx(patch[2], abs=1e-6)  # in the corner's frame: the ground
+    assert np.all(np.abs(plane[:2, 3] - patch[:2]) < box["width"] / 2 - 0.1)  # under the tyre
+    grid = _transform(commands, "/Grid")  # meshcat's grid on the same ground, in the scene
+    assert grid[2, 3] == pytest.approx(root[2, 3] + plane[2, 3], abs=1e-6)
+
+    # The camera orbits the scene's origin: a point of the corner near its middle,
+    # seen from in front, outboard and above.
+    lo, hi = bounds(*(c for c, _ in scene.robots))  # with the ghost, if any
+    target = -root[:3, 3]
+    assert np.all(target > lo) and np.all(target < hi)
+    assert np.linalg.norm(target - (lo + hi) / 2) < 0.2 * np.linalg.norm(hi - lo)
+    (position,) = [
+        c["value"]
+        for c in commands
+        if c["type"] == "set_property" and c["path"] == "/Cameras/default/rotated/<object>"
+    ]
+    eye = np.array([position[0], -position[2], position[1]])  # three.js (y up) to the world's
+    assert eye[0] > 0 and corner.geometry.sign * eye[1] > 0 and eye[2] > 0
+    assert 0.3 < np.linalg.norm(eye) < 3.0
