@@ -504,3 +504,21 @@ def test_yaml_numbers_as_an_engineer_writes_them(tmp_path, capsys):
     g = pin_susp.load_geometry(path)
     assert g.hardpoints["lower_wishbone_inboard_front"][0] == pytest.approx(0.250)
     assert g.hardpoints["lower_wishbone_inboard_front"][2] == pytest.approx(0.200)
+
+
+def test_an_output_onto_an_input_is_refused(tmp_path, capsys):
+    g = tmp_path / "g.yaml"
+    g.write_text((EXAMPLES / "double_wishbone.yaml").read_text())
+    before = g.read_text()
+    link = tmp_path / "link.yaml"
+    link.symlink_to(g)
+    for out in (g, link):
+        one_line_error(["sweep", g, BUMP_STEER, "-o", out], capsys, "is an input")
+    one_line_error(["setup", g, "--toe", "0", "-o", g], capsys, "is an input")
+    assert g.read_text() == before
+
+
+def test_two_outputs_on_one_path_are_refused(tmp_path, capsys):
+    out = tmp_path / "set.yaml"
+    one_line_error(["setup", GEOMETRY, "--toe", "0", "-o", out, "--csv", out], capsys, "one file")
+    assert files(tmp_path) == set()
