@@ -8,7 +8,7 @@ STAMP := $(VENV)/.installed
 DEMO_DIR ?= demo_output
 GEOMETRIES := $(shell grep -l '^hardpoints:' examples/*.yaml)
 
-.PHONY: demo test bench urdf lint format clean
+.PHONY: demo test fuzz bench urdf lint format clean
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -24,6 +24,14 @@ test: $(STAMP)
 	@$(BIN)/python -m pytest -q; status=$$?; \
 	if [ $$status -eq 5 ]; then echo "make test: pytest collected no tests" >&2; fi; \
 	exit $$status
+
+# Property-based fuzzing of the command line (tests/test_fuzz.py): 10 000 random inputs,
+# a new seed each run (printed; PIN_SUSP_FUZZ_SEED=N repeats it), then the counts per exit
+# code and command. PIN_SUSP_FUZZ_FINDINGS=DIR saves each failing input as files.
+fuzz: $(STAMP)
+	PIN_SUSP_FUZZ_EXAMPLES=$${PIN_SUSP_FUZZ_EXAMPLES:-10000} \
+	PIN_SUSP_FUZZ_SEED=$${PIN_SUSP_FUZZ_SEED:-random} \
+	$(BIN)/python -m pytest -q -s tests/test_fuzz.py -k holds
 
 # Speed figures against baselines run in the same process (see README, Performance).
 bench: $(STAMP)

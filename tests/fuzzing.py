@@ -1,0 +1,1561 @@
+"""Property-based fuzzing of the ``pin-susp`` command line: strategies and invariants.
+
+``cases()`` draws one command line with its input files: an example geometry
+with perturbed hardpoints, wild values, dropped or unknown keys, changed
+types and hand-made YAML text variations; a sweep with random targets (or a
+broken one); and a command (mostly ``sweep``). ``run_case()`` runs it in
+process through ``pin_susp.cli.main()`` in a fresh temporary directory, and
+``check_case()`` asserts what must hold for every input:
+
+1. exit 0 only when every written row converged on the design branch with
+   ``solver_max_residual <= 1e-9`` mm (and, independently, the rows' points
+   keep every rigid distance, meet the targets and stay on the design side
+   of every loop);
+2. exit 1 only with the failing steps named on stderr (the steps flagged
+   ``False`` in the CSV are the ones named, at least the first 10);
+3. exit 2 with exactly one non-empty stderr line starting with ``pin-susp``
+   and nothing written or touched;
+4. never a traceback (an exception escaping main() propagates as itself);
+5. nothing outside the declared outputs touched, no temporary file left, no
+   ``MUJOCO_LOG.TXT``, the inputs unchanged.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import copy
+import hashlib
+import io
+import json
+import math
+import os
+import re
+import tempfile
+import time
+import warnings
+from collections import Counter
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import yaml
+from hypothesis import strategies as st
+
+ROOT = Path(__file__).resolve().parent.parent
+EXAMPLES = ROOT / "examples"
+GEOMETRY_FILES = (
+    "double_wishbone.yaml",
+    "fixed_toe_link.yaml",
+    "pushrod_rocker.yaml",
+    "camber_shim.yaml",
+)
+BASES = {name: yaml.safe_load((EXAMPLES / name).read_text()) for name in GEOMETRY_FILES}
+
+RESIDUAL_LIMIT = 1e-9  # mm: what a converged row promises
+GEOMETRIC_TOLERANCE = 1e-7  # mm: rigid distances and targets checked from the CSV's points
+SOLVER_COLUMNS = ("step_index", "solver_converged", "solver_max_residual", "solver_iterations")
+
+# Per (command, exit code, or the exception's name): filled by run_case, printed by the test.
+COUNTS: Counter = Counter()
+# Per failure signature(), when failures are collected rather than raised.
+FOUND: Counter = Counter()
+# (seconds in main(), command line) of the slowest runs.
+SLOWEST: list[tuple[float, str]] = []
+
+
+# --------------------------------------------------------------------------- YAML text
+
+
+class Raw(str):
+    """A scalar written verbatim into the YAML text (``0250``, ``2e2``, ``.nan``, ...)."""
+
+
+class Pairs(list):
+    """A mapping written as its (key, value) pairs: it may repeat a key."""
+
+
+_PLAIN = re.compile(r"[A-Za-z_][A-Za-z0-9_ .()-]*")
+_YAML_WORDS = {"yes", "no", "on", "off", "true", "false", "null", "~"}
+
+
+def scalar(value) -> str:
+    if isinstance(value, Raw):
+        return str(value)
+    if value is None:
+        return "null"
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        if math.isnan(value):
+            return ".nan"
+        if math.isinf(value):
+            return ".inf" if value > 0 else "-.inf"
+        return repr(value)
+    text = str(value)
+    if _PLAIN.fullmatch(text) and text.lower() not in _YAML_WORDS and text == text.strip():
+        return text
+    return json.dumps(text)  # a JSON string is a YAML double-quoted scalar
+
+
+def _items(node):
+    return list(node) if isinstance(node, Pairs) else list(node.items())
+
+
+def _is_map(node) -> bool:
+    return isinstance(node, dict | Pairs)
+
+
+def _flow(node) -> str | None:
+    """A small mapping or list of scalars on one line, else None."""
+    if _is_map(node):
+        items = _items(node)
+        if items and all(not _is_map(v) and not isinstance(v, list) for _, v in items):
+            return "{" + ", ".join(f"{scalar(k)}: {scalar(v)}" for k, v in items) + "}"
+        return "{}" if not items else None
+    if isinstance(node, list):
+        if all(not _is_map(v) and not isinstance(v, list) for v in node):
+            return "[" + ", ".join(scalar(v) for v in node) + "]"
+        if all(isinstance(v, list) for v in node):
+            inner = [_flow(v) for v in node]
+            if all(i is not None for i in inner):
+                return "[" + ", ".join(inner) + "]"
+    return None
+
+
+def to_yaml(node, indent: int = 0) -> str:
+    """Block-style YAML of dicts, Pairs, lists and scalars (Raw verbatim)."""
+    pad = " " * indent
+    if _is_map(node):
+        lines = []
+        for key, value in _items(node):
+            flow = _flow(value) if (_is_map(value) or isinstance(value, list)) else None
+            if _is_map(value) or isinstance(value, list):
+                if flow is not None and (not _is_map(value) or len(_items(value)) <= 6):
+                    lines.append(f"{pad}{scalar(key)}: {flow}")
+                else:
+                    lines.append(f"{pad}{scalar(key)}:")
+                    lines.append(to_yaml(value, indent + 2).rstrip("\n"))
+            else:
+                lines.append(f"{pad}{scalar(key)}: {scalar(value)}")
+        return "\n".join(lines) + "\n"
+    if isinstance(node, list):
+        lines = []
+        for value in node:
+            if _is_map(value) and _items(value):
+                text = to_yaml(value, indent + 2).rstrip("\n")
+                lines.append(pad + "- " + text[indent + 2 :])
+            else:
+                flow = _flow(value) if isinstance(value, list) or _is_map(value) else None
+                lines.append(f"{pad}- {flow if flow is not None else scalar(value)}")
+        return "\n".join(lines) + "\n"
+    return pad + scalar(node) + "\n"
+
+
+# --------------------------------------------------------------------------- data paths
+
+
+def paths(node, want, prefix=()):
+    """Paths (tuples of keys and indices) to the nodes for which want(node) holds."""
+    found = [prefix] if prefix and want(node) else []
+    if isinstance(node, dict):
+        for k, v in node.items():
+            found += paths(v, want, prefix + (k,))
+    elif isinstance(node, list):
+        for i, v in enumerate(node):
+            found += paths(v, want, prefix + (i,))
+    return found
+
+
+def get(node, path):
+    for k in path:
+        node = node[k]
+    return node
+
+
+def put(node, path, value):
+    get(node, path[:-1])[path[-1]] = value
+
+
+def _is_leaf(node) -> bool:
+    return not isinstance(node, dict | list)
+
+
+def _is_number(node) -> bool:
+    return isinstance(node, int | float) and not isinstance(node, bool)
+
+
+# --------------------------------------------------------------------------- values
+
+# A coordinate or config value set to something no car has.
+# fmt: off
+WILD = (
+    0, 0.0, -0.0, 1e6, -1e20, 10**30, 2**64, 10**400, 1e-300, 99_999.0, 100_001.0, float("nan"),
+    float("inf"), float("-inf"), Raw(".NaN"), Raw("1e999"), Raw("-1e400"), "ten", "", None,
+    True, False, [1.0, 2.0], [1.0, 2.0, 3.0, 4.0], [1.0, 2.0, 3.0], [], {}, {"x": 1.0},
+    Raw("0250"), Raw("0259"), Raw("-0250"), Raw("2e2"), Raw("1.e5"), Raw("+5"), Raw("5."),
+    Raw("0x1F"), Raw("0o17"), Raw("1_000"), Raw("1:30"), Raw("2020-01-01"), Raw("!!float abc"),
+    Raw("!!int 1e3"), Raw("!!binary aGVsbG8="), Raw("'250'"), Raw("~"), Raw("*nowhere"),
+    Raw("&anchor 5"), Raw('"\\u0000"'), Raw("!!python/object/apply:os.getcwd []"),
+    Raw("9" * 400), Raw("1" + "0" * 25 + ".5"), "a\nb",
+)
+# fmt: on
+
+# Unknown keys, some of them hostile.
+UNKNOWN_KEYS = ("colour", "wheel_centre", "x2", "notes", "a\nb", "", 12, "Hardpoints")
+
+
+def chance(draw, percent: int) -> bool:
+    """True with about this probability; False is the simplest choice (it shrinks there)."""
+    return draw(st.integers(0, 99)) >= 100 - percent
+
+
+def wild() -> st.SearchStrategy:
+    return st.sampled_from(WILD)
+
+
+def small(limit: float) -> st.SearchStrategy:
+    """A round number in [-limit, limit] mm (three decimals: short texts, good shrinking)."""
+    k = int(limit * 1000)
+    return st.integers(-k, k).map(lambda i: i / 1000)
+
+
+def restyled(x) -> list[str]:
+    """Ways engineers write the number x that must read back as x (or fail cleanly)."""
+    out = []
+    if isinstance(x, bool) or not _is_number(x) or abs(x) > 1e300 or not math.isfinite(x):
+        return out
+    if float(x).is_integer() and abs(x) < 1e15:
+        n = int(x)
+        if n != 0:
+            mantissa, exponent = abs(n), 0
+            while mantissa % 10 == 0:
+                mantissa, exponent = mantissa // 10, exponent + 1
+            sign = "-" if n < 0 else ""
+            out += [f"{sign}{mantissa}e{exponent}", f"{sign}0{abs(n)}", f"{n}."]
+            if abs(n) >= 1000:
+                out.append(f"{n:_}")
+            if abs(n) >= 60:
+                out.append(f"{sign}{abs(n) // 60}:{abs(n) % 60:02d}")
+        else:
+            out += ["00", "-0", "0e0"]
+    else:
+        out += [f"{x:e}", f"{x:.6E}".replace("E+0", "E"), "+" + repr(x) if x > 0 else repr(x)]
+    out.append(f"'{x}'")
+    return out
+
+
+# --------------------------------------------------------------------------- geometry
+
+
+@dataclass
+class Inputs:
+    """What was drawn for a file: the data, its text, and what was done to it."""
+
+    data: object
+    text: bytes
+    changes: list[str] = field(default_factory=list)
+
+
+def _hardpoint_names(data) -> list[str]:
+    hp = data.get("hardpoints") if isinstance(data, dict) else None
+    return list(hp) if isinstance(hp, dict) else []
+
+
+def _numeric_point(point) -> list[float] | None:
+    """[x, y, z] of a point written {x, y, z} or [x, y, z] with plain numbers, else None."""
+    if isinstance(point, dict) and set(point) == set("xyz"):
+        point = [point[a] for a in "xyz"]
+    if isinstance(point, list) and len(point) == 3:
+        if all(_is_number(v) and abs(v) < 1e300 for v in point):
+            return [float(v) for v in point]
+    return None
+
+
+def _coordinate_paths(data) -> list[tuple]:
+    out = []
+    for name in _hardpoint_names(data):
+        point = data["hardpoints"][name]
+        if isinstance(point, dict):
+            out += [("hardpoints", name, a) for a in "xyz" if _is_number(point.get(a))]
+        elif isinstance(point, list):
+            out += [("hardpoints", name, i) for i, v in enumerate(point) if _is_number(v)]
+    return out
+
+
+def _mirror(data) -> None:
+    """Mirror a geometry through Y = 0 (a valid corner on the other side)."""
+    data["side"] = "right" if data.get("side", "left") == "left" else "left"
+
+    def flip(point):
+        if isinstance(point, dict) and _is_number(point.get("y")):
+            point["y"] = -point["y"]
+
+    for p in (data.get("hardpoints") or {}).values():
+        flip(p)
+    config = data.get("config") or {}
+    flip(config.get("cg_position"))
+    shim = config.get("camber_shim") or {}
+    for key in ("shim_face_point_a", "shim_face_point_b", "shim_face_normal"):
+        flip(shim.get(key))
+
+
+def _steering_to(data, kind: str, rename: bool) -> None:
+    config = data.setdefault("config", {})
+    config["steering"] = {"type": kind}
+    hp = data.get("hardpoints")
+    if not rename or not isinstance(hp, dict):
+        return
+    old, new = ("trackrod", "toe_link") if kind == "none" else ("toe_link", "trackrod")
+    for end in ("inboard", "outboard"):
+        if f"{old}_{end}" in hp:
+            hp[f"{new}_{end}"] = hp.pop(f"{old}_{end}")
+
+
+ROCKER_POINTS = {k: BASES["pushrod_rocker.yaml"]["hardpoints"][k] for k in (
+    "pushrod_outboard", "pushrod_inboard", "rocker_axis_a", "rocker_axis_b"
+)}  # fmt: skip
+STRUT_POINTS = {k: BASES["pushrod_rocker.yaml"]["hardpoints"][k] for k in (
+    "strut_bottom", "strut_top"
+)}  # fmt: skip
+
+
+@st.composite
+def _mutate_geometry(draw, data) -> str:
+    """One structural change to a geometry dict, in place; its label."""
+    kinds = (
+        "drop_key drop_hardpoint unknown_key retype wild_coordinate wild_point mirror "
+        "side_only steering actuation mount spring shim adjuster wheel restyle_number "
+        "points_as_lists degenerate degenerate scale translate"
+    ).split()
+    kind = draw(st.sampled_from(kinds))
+    if kind == "drop_key":
+        choices = paths(data, lambda n: True)
+        path = draw(st.sampled_from(sorted(choices, key=repr)))
+        del get(data, path[:-1])[path[-1]]
+        return f"drop {'.'.join(map(str, path))}"
+    if kind == "drop_hardpoint" and _hardpoint_names(data):
+        name = draw(st.sampled_from(_hardpoint_names(data)))
+        del data["hardpoints"][name]
+        return f"drop hardpoints.{name}"
+    if kind == "unknown_key":
+        maps = [()] + paths(data, lambda n: isinstance(n, dict))
+        path = draw(st.sampled_from(sorted(maps, key=repr)))
+        key = draw(st.sampled_from(UNKNOWN_KEYS))
+        get(data, path)[key] = draw(st.one_of(small(100), wild()))
+        return f"unknown key {key!r} in {'.'.join(map(str, path)) or 'top'}"
+    if kind == "retype":
+        leaves = [p for p in paths(data, _is_leaf) if p[0] != "hardpoints"] or [("name",)]
+        path = draw(st.sampled_from(sorted(leaves, key=repr)))
+        value = draw(st.one_of(wild(), small(100)))
+        put(data, path, value)
+        return f"{'.'.join(map(str, path))} = {value!r}"
+    if kind == "wild_coordinate" and _coordinate_paths(data):
+        path = draw(st.sampled_from(_coordinate_paths(data)))
+        value = draw(wild())
+        put(data, path, value)
+        return f"{'.'.join(map(str, path))} = {value!r}"
+    if kind == "wild_point" and _hardpoint_names(data):
+        name = draw(st.sampled_from(_hardpoint_names(data)))
+        value = draw(
+            st.sampled_from(
+                (
+                    [1.0, 2.0],
+                    [1.0, 2.0, 3.0, 4.0],
+                    [[1.0, 2.0, 3.0]],
+                    "origin",
+                    None,
+                    {},
+                    {"x": 1.0, "y": 2.0},
+                    {"x": 1.0, "y": 2.0, "z": 3.0, "w": 4.0},
+                    {"X": 1.0, "Y": 2.0, "Z": 3.0},
+                    Raw("{x: 1, y: 2, z: }"),
+                )
+            )
+        )
+        data["hardpoints"][name] = value
+        return f"hardpoints.{name} = {value!r}"
+    if kind == "mirror":
+        _mirror(data)
+        return "mirrored"
+    if kind == "side_only":
+        value = draw(st.sampled_from(("right", "left", "both", "Left", None)))
+        data["side"] = value
+        return f"side = {value!r}"
+    if kind == "steering":
+        value = draw(st.sampled_from(("none", "rack", "pinion")))
+        rename = draw(st.booleans())
+        _steering_to(data, value, rename)
+        return f"steering {value}" + (" (points renamed)" if rename else "")
+    if kind == "actuation":
+        value = draw(st.sampled_from(("pushrod_rocker", "direct", "pullrod")))
+        mount = draw(st.sampled_from(("lower_wishbone", "upright")))
+        data["actuation"] = {"type": value, "mount": mount}
+        hp = data.get("hardpoints")
+        if isinstance(hp, dict) and draw(st.booleans()):
+            if value == "pushrod_rocker":
+                for k, v in ROCKER_POINTS.items():
+                    hp.setdefault(k, dict(v))
+            else:
+                for k in ROCKER_POINTS:
+                    hp.pop(k, None)
+            return f"actuation {value} on {mount} (points fitted)"
+        return f"actuation {value} on {mount}"
+    if kind == "mount":
+        act = data.get("actuation")
+        if isinstance(act, dict):
+            act["mount"] = "upright" if act.get("mount") == "lower_wishbone" else "lower_wishbone"
+            return f"mount {act['mount']}"
+        return "mount (no actuation)"
+    if kind == "spring":
+        value = draw(st.sampled_from(("coilover", "torsion_bar", "none", "leaf")))
+        data["spring"] = {"type": value}
+        hp = data.get("hardpoints")
+        if isinstance(hp, dict) and draw(st.booleans()):
+            if value == "coilover":
+                for k, v in STRUT_POINTS.items():
+                    hp.setdefault(k, dict(v))
+            else:
+                for k in STRUT_POINTS:
+                    hp.pop(k, None)
+            return f"spring {value} (points fitted)"
+        return f"spring {value}"
+    if kind == "shim":
+        config = data.setdefault("config", {})
+        if not isinstance(config, dict):
+            return "shim (config not a mapping)"
+        shim = config.get("camber_shim")
+        if not isinstance(shim, dict):
+            shim = copy.deepcopy(BASES["camber_shim.yaml"]["config"]["camber_shim"])
+            config["camber_shim"] = shim
+        key = draw(
+            st.sampled_from(
+                (
+                    "setup_thickness",
+                    "setup_thickness",
+                    "design_thickness",
+                    "shim_face_normal",
+                    "shim_face_point_b",
+                )
+            )
+        )
+        if key.endswith("thickness"):
+            value = draw(st.one_of(small(60).map(abs), small(100), wild()))
+        elif key == "shim_face_normal":
+            value = draw(
+                st.sampled_from(
+                    (
+                        {"x": 0.0, "y": 0.0, "z": 0.0},
+                        {"x": 0.0, "y": -1.0, "z": 0.0},
+                        {"x": 0.1, "y": 1.0, "z": 0.05},
+                        {"x": 0.0, "y": 0.0, "z": 1.0},
+                    )
+                )
+            )
+        else:
+            value = copy.deepcopy(shim.get("shim_face_point_a"))
+        shim[key] = value
+        return f"camber_shim.{key} = {value!r}"
+    if kind == "adjuster":
+        config = data.setdefault("config", {})
+        if not isinstance(config, dict):
+            return "adjuster (config not a mapping)"
+        key = draw(st.sampled_from(("trackrod_length_delta", "pushrod_length_delta")))
+        value = draw(st.one_of(small(20), small(20), wild()))
+        setup = config.get("setup")
+        if not isinstance(setup, dict):
+            setup = config["setup"] = {}
+        setup[key] = value
+        return f"setup.{key} = {value!r}"
+    if kind == "wheel":
+        key = draw(st.sampled_from(("offset", "aspect_ratio", "section_width", "rim_diameter")))
+        value = draw(st.one_of(small(60), wild()))
+        wheel = (data.get("config") or {}).get("wheel") if isinstance(data, dict) else None
+        if isinstance(wheel, dict):
+            target = wheel if key == "offset" else wheel.get("tire")
+            if isinstance(target, dict):
+                target[key] = value
+                return f"wheel {key} = {value!r}"
+        return "wheel (missing)"
+    if kind == "restyle_number":
+        numbers = [p for p in paths(data, _is_number) if restyled(get(data, p))]
+        if numbers:
+            path = draw(st.sampled_from(numbers))
+            text = draw(st.sampled_from(restyled(get(data, path))))
+            put(data, path, Raw(text))
+            return f"{'.'.join(map(str, path))} written {text}"
+        return "restyle (no number)"
+    if kind == "degenerate":  # a point on (or a hair off) the line of two others
+        names = [n for n in _hardpoint_names(data) if _numeric_point(data["hardpoints"][n])]
+        if len(names) >= 3:
+            p, a, b = draw(st.permutations(names))[:3]
+            t = draw(st.sampled_from((0.0, 1.0, 0.5, 2.0, -1.0)))
+            eps = draw(st.sampled_from((0.0, 1e-9, 1e-6, 1e-3, 0.1)))
+            pa, pb = _numeric_point(data["hardpoints"][a]), _numeric_point(data["hardpoints"][b])
+            new = [pa[i] + t * (pb[i] - pa[i]) + (eps if i == 0 else 0.0) for i in range(3)]
+            data["hardpoints"][p] = dict(zip("xyz", new, strict=True))
+            return f"{p} = {a} + {t:g}·({b} - {a}) + {eps:g} x"
+        return "degenerate (too few points)"
+    if kind in ("scale", "translate"):  # the whole corner, its hardpoints only
+        if kind == "scale":
+            k = draw(st.sampled_from((0.001, 0.1, 10.0, 100.0, -1.0)))
+            move = lambda v, i: v * k  # noqa: E731
+        else:
+            d = draw(st.sampled_from(((1e4, 0, 0), (0, 5e4, 0), (0, 0, -3e4), (0, -2e3, 0))))
+            move = lambda v, i: v + d[i]  # noqa: E731
+        for name in _hardpoint_names(data):
+            point = _numeric_point(data["hardpoints"][name])
+            if point is not None:
+                data["hardpoints"][name] = dict(
+                    zip("xyz", (round(move(v, i), 9) for i, v in enumerate(point)), strict=True)
+                )
+        return f"{kind} {k if kind == 'scale' else d}"
+    if kind == "points_as_lists":
+        for name in _hardpoint_names(data):
+            point = data["hardpoints"][name]
+            if isinstance(point, dict) and set(point) == set("xyz"):
+                data["hardpoints"][name] = [point[a] for a in "xyz"]
+        return "points as [x, y, z]"
+    return f"{kind} (not applicable)"
+
+
+# Whole files that are not a geometry at all.
+GARBAGE = (
+    b"",
+    b"\n# only a comment\n",
+    b"[]\n",
+    b"42\n",
+    b"hardpoints: [\n",
+    b"\tside: left\n",
+    b"---\nside: left\n---\nside: right\n",
+    b"\xff\xfe\x00junk",
+    b"\xef\xbb\xbfside: left\n",
+    b"key: \x07bell\n",
+    b"[" * 400 + b"]" * 400,
+    b"a: &a [1, 2]\nb: &b [*a, *a, *a, *a, *a, *a, *a, *a]\nc: [*b, *b, *b, *b, *b, *b, *b]\n",
+    b"? [1, 2]\n: complex key\n",
+    b"<<: {side: left}\n",
+    b"!!python/object/apply:os.system ['true']\n",
+    b"name: '" + b"x" * 100_000 + b"'\n",
+)
+
+
+def _duplicate(draw, data):
+    """The data with one key of one mapping written twice (Pairs), as the last change."""
+    maps = [()] + paths(data, lambda n: isinstance(n, dict) and len(n) > 0)
+    path = draw(st.sampled_from(sorted(maps, key=repr)))
+    node = get(data, path)
+    if not node:
+        return data, "duplicate (empty mapping)"
+    key = draw(st.sampled_from(sorted(node, key=repr)))
+    twin = Pairs(node.items())
+    again = draw(st.sampled_from(("same", "other")))
+    twin.insert(draw(st.integers(0, len(twin))), (key, node[key] if again == "same" else 1.0))
+    if not path:
+        return twin, f"duplicate top-level key {key} ({again} value)"
+    put(data, path, twin)
+    return data, f"duplicate key {'.'.join(map(str, path + (key,)))} ({again} value)"
+
+
+def _render(data, draw, changes) -> bytes:
+    if chance(draw, 5):
+        data, change = _duplicate(draw, data)
+        changes.append(change)
+    text = to_yaml(data) if (_is_map(data) or isinstance(data, list)) else scalar(data) + "\n"
+    variant = draw(st.sampled_from(("plain",) * 12 + ("crlf", "bom", "comment", "end")))
+    if variant == "crlf":
+        text = text.replace("\n", "\r\n")
+    elif variant == "bom":
+        text = "\ufeff" + text
+    elif variant == "comment":
+        text = "# fuzzed geometry\n" + text.replace("\n", "  # note\n", 1)
+    elif variant == "end":
+        text += "...\n"
+    if variant != "plain":
+        changes.append(f"text {variant}")
+    return text.encode("utf-8")
+
+
+@st.composite
+def geometries(draw) -> Inputs:
+    """A geometry file: an example, perturbed, maybe broken; its data and YAML text."""
+    base = draw(st.sampled_from(GEOMETRY_FILES))
+    data = copy.deepcopy(BASES[base])
+    changes = [base]
+    if chance(draw, 2):
+        text = draw(st.sampled_from(GARBAGE))
+        return Inputs(None, text, [*changes, f"garbage {text[:30]!r}"])
+    mode = draw(st.sampled_from(("none", "small", "small", "small", "some", "large")))
+    coordinates = _coordinate_paths(data)
+    if mode == "small":  # every coordinate within ±5 mm
+        deltas = draw(st.lists(small(5), min_size=len(coordinates), max_size=len(coordinates)))
+        for path, d in zip(coordinates, deltas, strict=True):
+            put(data, path, round(get(data, path) + d, 6))
+        changes.append("all ±5 mm")
+    elif mode in ("some", "large"):
+        limit = 5 if mode == "some" else 100
+        moves = draw(
+            st.lists(st.tuples(st.sampled_from(coordinates), small(limit)), min_size=1, max_size=4)
+        )
+        for path, d in moves:
+            put(data, path, round(get(data, path) + d, 6))
+            changes.append(f"{'.'.join(map(str, path))} {d:+g}")
+    count = draw(st.sampled_from((0, 0, 0, 0, 0, 0, 1, 1, 2, 3)))
+    for _ in range(count):
+        changes.append(draw(_mutate_geometry(data)))
+    return Inputs(data, _render(data, draw, changes), changes)
+
+
+# --------------------------------------------------------------------------- sweep
+
+
+@dataclass
+class Plan:
+    """A target as meant (when the sweep text was not broken on purpose)."""
+
+    point: str
+    direction: tuple[float, float, float]  # unit
+    mode: str
+    values: list[float]
+
+
+def _design_point(geometry, name: str):
+    """Roughly where a point is in the geometry data (mm), for absolute targets."""
+    hp = geometry.get("hardpoints") if isinstance(geometry, dict) else None
+    if not isinstance(hp, dict):
+        return None
+    alias = {"wheel_center": "axle_outboard", "axle_midpoint": "axle_outboard"}
+    return _numeric_point(hp.get(alias.get(name, name)))
+
+
+def _is_rack(geometry) -> bool | None:
+    if not isinstance(geometry, dict):
+        return None
+    config = geometry.get("config")
+    steering = config.get("steering") if isinstance(config, dict) else None
+    kind = steering.get("type") if isinstance(steering, dict) else None
+    return {"rack": True, "none": False}.get(kind) if isinstance(kind, str) else None
+
+
+WHEEL_POINTS = ("wheel_center",) * 6 + (
+    "contact_patch_center",
+    "axle_outboard",
+    "axle_midpoint",
+    "lower_wishbone_outboard",
+    "upper_wishbone_outboard",
+)
+CHASSIS_POINTS = ("lower_wishbone_inboard_front", "upper_wishbone_inboard_rear", "rocker_axis_a")
+UNKNOWN_POINTS = ("wheel_centre", "hub", "", "trackrod_inboard_y", "Wheel_Center")
+
+
+def _unit(v) -> tuple[float, float, float]:
+    n = math.sqrt(sum(x * x for x in v))
+    return tuple(x / n for x in v)
+
+
+@st.composite
+def _target(draw, geometry, steps: int, rack: bool):
+    """One target dict and its Plan: the wheel (bump) or the rack (steer)."""
+    if rack:
+        point, limit = "trackrod_inboard", 15
+        axis = (0.0, 1.0, 0.0)
+        form = draw(st.sampled_from(("axis",) * 8 + ("vector", "minus")))
+        direction = {
+            "axis": {"axis": "y"},
+            "vector": {"vector": [0.0, 1.0, 0.0]},
+            "minus": {"vector": [0, -2, 0]},
+        }[form]
+        if form == "minus":
+            axis = (0.0, -1.0, 0.0)
+    else:
+        point = draw(st.sampled_from(WHEEL_POINTS))
+        limit = 600 if chance(draw, 10) else 60  # sometimes beyond the mechanism's reach
+        form = draw(st.sampled_from(("axis",) * 6 + ("vector", "tilted", "sideways")))
+        if form == "axis":
+            direction, axis = {"axis": "z"}, (0.0, 0.0, 1.0)
+        elif form == "vector":
+            k = draw(st.sampled_from((1, 2, 0.5, -1)))
+            direction, axis = {"vector": [0, 0, k]}, _unit((0, 0, k))
+        elif form == "tilted":
+            v = [draw(small(0.5)), draw(small(0.5)), 1.0]
+            direction, axis = {"vector": v}, _unit(v)
+        else:
+            v = draw(st.sampled_from(([1, 0, 0], [0, 1, 0], [1, 1, 1])))
+            direction, axis = {"vector": v}, _unit(v)
+    mode = draw(st.sampled_from(("relative",) * 5 + ("absolute",)))
+    target = {"point": point, "direction": direction}
+    offset = 0.0
+    if mode == "absolute":
+        target["mode"] = "absolute"
+        p = _design_point(geometry, point)
+        offset = sum(a * b for a, b in zip(axis, p, strict=True)) if p else draw(small(600))
+    elif draw(st.booleans()):
+        target["mode"] = "relative"
+    if chance(draw, 20):
+        values = draw(st.lists(small(limit), min_size=steps, max_size=steps))
+        values = [round(v + offset, 6) for v in values]
+        target["values"] = values
+    else:
+        start, stop = draw(small(limit)), draw(small(limit))
+        start, stop = round(start + offset, 6), round(stop + offset, 6)
+        target["start"], target["stop"] = start, stop
+        values = (
+            [start + (stop - start) * i / (steps - 1) for i in range(steps)]
+            if steps > 1
+            else [start]
+        )
+    return target, Plan(point, axis, mode, values)
+
+
+@st.composite
+def _mutate_sweep(draw, data, steps: int) -> str:
+    targets = data.get("targets")
+    kinds = (
+        "drop_target extra_target chassis_point unknown_point lengths wild_value "
+        "wild_steps no_steps direction mode unknown_key drop_key targets restyle_number "
+        "duplicate_key"
+    ).split()
+    kind = draw(st.sampled_from(kinds))
+    pool = [x for x in targets if isinstance(x, dict)] if isinstance(targets, list) else []
+    t = draw(st.sampled_from(pool)) if pool else None
+    if kind == "drop_target" and t is not None:
+        targets.remove(t)
+        return "dropped a target"
+    if kind == "extra_target" and t is not None:
+        twin = copy.deepcopy(t)
+        if draw(st.booleans()):
+            twin["point"] = draw(st.sampled_from(("axle_outboard", "upper_wishbone_outboard")))
+        targets.append(twin)
+        return f"extra target on {twin['point']}"
+    if kind == "chassis_point" and t:
+        t["point"] = draw(st.sampled_from(CHASSIS_POINTS))
+        return f"target on {t['point']}"
+    if kind == "unknown_point" and t:
+        t["point"] = draw(st.sampled_from(UNKNOWN_POINTS + (None, 5, ["wheel_center"])))
+        return f"target on {t['point']!r}"
+    if kind == "lengths" and t:
+        n = draw(st.integers(1, 8).filter(lambda n: n != steps))
+        t.pop("start", None)
+        t.pop("stop", None)
+        t["values"] = draw(st.lists(small(30), min_size=n, max_size=n))
+        return f"a target with {n} values"
+    if kind == "wild_value" and t:
+        keys = [k for k in ("start", "stop") if k in t] or ["values"]
+        key = draw(st.sampled_from(keys))
+        value = draw(wild())
+        if key == "values" and isinstance(t.get("values"), list) and draw(st.booleans()):
+            t["values"][draw(st.integers(0, len(t["values"]) - 1))] = value
+            return f"a value = {value!r}"
+        t[key] = value
+        return f"{key} = {value!r}"
+    if kind == "wild_steps":
+        value = draw(
+            st.sampled_from((0, -1, 1.5, "ten", True, 10**12, 2**70, None, "", [], Raw("0x10")))
+        )
+        data["steps"] = value
+        return f"steps = {value!r}"
+    if kind == "no_steps":
+        data.pop("steps", None)
+        return "no steps"
+    if kind == "direction" and t:
+        value = draw(
+            st.sampled_from(
+                (
+                    {"axis": "w"},
+                    {"axis": "Z"},
+                    {"vector": [0, 0, 0]},
+                    {"vector": [0, 1]},
+                    {"vector": [float("nan"), 0, 1]},
+                    {"vector": [1e-300, 0, 0]},
+                    {"vector": [1e300, 1e300, 0]},
+                    {"axis": "z", "vector": [0, 0, 1]},
+                    {},
+                    "z",
+                    None,
+                )
+            )
+        )
+        t["direction"] = value
+        return f"direction = {value!r}"
+    if kind == "mode" and t:
+        t["mode"] = draw(st.sampled_from(("relativ", "Absolute", None, 1)))
+        return f"mode = {t['mode']!r}"
+    if kind == "unknown_key":
+        where = t if t is not None and draw(st.booleans()) else data
+        key = draw(st.sampled_from(UNKNOWN_KEYS))
+        where[key] = 1
+        return f"unknown key {key!r}"
+    if kind == "drop_key":
+        where = t if t is not None and draw(st.booleans()) else data
+        if where:
+            key = draw(st.sampled_from(sorted(where, key=repr)))
+            del where[key]
+            return f"dropped {key!r}"
+    if kind == "targets":
+        data["targets"] = draw(st.sampled_from(([], None, "wheel_center", {}, [None], [[]])))
+        return f"targets = {data['targets']!r}"
+    if kind == "restyle_number":
+        numbers = [p for p in paths(data, _is_number) if restyled(get(data, p))]
+        if numbers:
+            path = draw(st.sampled_from(numbers))
+            text = draw(st.sampled_from(restyled(get(data, path))))
+            put(data, path, Raw(text))
+            return f"{'.'.join(map(str, path))} written {text}"
+    if kind == "duplicate_key":
+        node = t if t is not None and draw(st.booleans()) else None
+        if node:
+            key = draw(st.sampled_from(sorted(node, key=repr)))
+            i = data["targets"].index(node)
+            data["targets"][i] = Pairs([*node.items(), (key, node[key])])
+            return f"duplicate key {key!r} in a target"
+    return f"{kind} (not applicable)"
+
+
+@st.composite
+def sweeps(draw, geometry, max_steps: int = 60):
+    """A sweep file for the drawn geometry: (Inputs, plans or None when broken on purpose)."""
+    rack = _is_rack(geometry)
+    if rack is None:
+        rack = draw(st.booleans())
+    steps = draw(st.one_of(st.integers(1, min(12, max_steps)), st.integers(1, max_steps)))
+    targets, plans = [], []
+    wheel, plan = draw(_target(geometry, steps, rack=False))
+    targets.append(wheel)
+    plans.append(plan)
+    if rack:
+        steer, plan = draw(_target(geometry, steps, rack=True))
+        targets.append(steer)
+        plans.append(plan)
+    if len(targets) > 1 and chance(draw, 20):
+        targets.reverse()
+        plans.reverse()
+    data = {"version": 1, "steps": steps, "targets": targets}
+    if draw(st.booleans()) and all("values" in t for t in targets):
+        del data["steps"]
+    changes = [f"{steps} steps"]
+    if chance(draw, 2):
+        text = draw(st.sampled_from(GARBAGE))
+        return Inputs(None, text, [*changes, f"garbage {text[:30]!r}"]), None
+    if chance(draw, 20):
+        for _ in range(draw(st.integers(1, 2))):
+            changes.append(draw(_mutate_sweep(data, steps)))
+        plans = None
+    text = to_yaml(data).encode()
+    return Inputs(data, text, changes), plans
+
+
+# --------------------------------------------------------------------------- commands
+
+
+@dataclass
+class Case:
+    """One command line, its input files and what it may write."""
+
+    command: str  # sweep, sensitivity, urdf, urdf-at, mjcf, setup, draw
+    argv: list[str]
+    files: dict[str, bytes]  # input files, relative to the run directory
+    outputs: list[str]  # declared output paths (the only files it may create)
+    geometry: Inputs
+    sweep: Inputs | None = None
+    plans: list[Plan] | None = None
+    stale: list[str] = field(default_factory=list)  # outputs that exist before the run
+    quiet: bool = False
+    links: dict[str, str] = field(default_factory=dict)  # output -> input it links to
+
+    def _repr_pretty_(self, printer, cycle) -> None:  # how Hypothesis prints a failing case
+        printer.text(repr(self))
+
+    def __repr__(self) -> str:
+        parts = [f"Case({self.command}): pin-susp {' '.join(map(_quote, self.argv))}"]
+        parts.append(f"  geometry changes: {self.geometry.changes}")
+        parts.append(_indent("g.yaml", self.geometry.text))
+        if self.sweep is not None:
+            parts.append(f"  sweep changes: {self.sweep.changes}")
+            parts.append(_indent("s.yaml", self.sweep.text))
+        if self.stale:
+            parts.append(f"  existing outputs: {self.stale}")
+        if self.links:
+            parts.append(f"  outputs that are symlinks to inputs: {self.links}")
+        return "\n".join(parts)
+
+
+def _quote(arg: str) -> str:
+    return arg if re.fullmatch(r"[A-Za-z0-9_./:,=+-]+", arg) else repr(arg)
+
+
+def _indent(name: str, text: bytes) -> str:
+    body = text.decode("utf-8", "backslashreplace")
+    if len(body) > 4000:
+        body = body[:4000] + f"\n... ({len(body)} characters)"
+    return f"  --- {name}\n" + "\n".join("    " + line for line in body.splitlines())
+
+
+def _numbers_argument(values) -> str:
+    return ",".join(v if isinstance(v, str) else f"{v:g}" for v in values)
+
+
+def _output(draw, name: str, inputs=()) -> str:
+    """Mostly the plain name; sometimes a new folder, spaces, no valid file at all, or
+    (rarely) one of the input files."""
+    if inputs and chance(draw, 1):
+        return draw(st.sampled_from(sorted(inputs)))
+    return draw(
+        st.sampled_from(
+            (name,) * 60 + (f"new/{name}", f"with space {name}", ".", "", "g.yaml/x", "new/")
+        )
+    )
+
+
+def _pictures_available() -> bool:
+    try:
+        from pin_susp.plots import check_image_path  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+COMMANDS = ("sweep",) * 50 + ("sensitivity",) * 10 + ("urdf",) * 5 + ("urdf-at",) * 7
+COMMANDS += ("mjcf",) * 5 + ("setup",) * 13
+
+
+@st.composite
+def cases(draw, pictures: bool | None = None) -> Case:
+    """A command line with its files; ``pictures`` (default: when pin_susp.plots is ready)
+    adds the slow matplotlib outputs, rarely: ``draw`` and ``sweep --plot``."""
+    if pictures is None:
+        pictures = _pictures_available()
+    commands = COMMANDS + (("draw",) if pictures else ())
+    command = draw(st.sampled_from(commands))
+    geometry = draw(geometries())
+    files = {"g.yaml": geometry.text}
+    g_arg = "g.yaml"
+    if chance(draw, 1):
+        g_arg = draw(st.sampled_from(("missing.yaml", ".", "g.yaml/")))
+    sweep = plans = None
+    outputs: list[str] = []
+    quiet = False
+    if command in ("sweep", "sensitivity", "urdf-at"):
+        with_sweep = command != "sensitivity" or not chance(draw, 25)
+        if with_sweep:
+            sweep, plans = draw(sweeps(geometry.data, 20 if command == "sensitivity" else 60))
+            files["s.yaml"] = sweep.text
+    s_arg = "s.yaml"
+    if sweep is not None and chance(draw, 1):
+        s_arg = draw(st.sampled_from(("missing.yaml", "g.yaml", ".")))
+    if command == "sweep":
+        out = _output(draw, "out.csv", files)
+        quiet = not chance(draw, 30)
+        argv = ["sweep", g_arg, s_arg, "-o", out] + (["-q"] if quiet else [])
+        outputs.append(out)
+        if pictures and chance(draw, 2):
+            image = draw(st.sampled_from(("p.png", "p.png", "p.svg", "p.txt", "new/p.png", "")))
+            if not image:  # the results and the report on one path
+                image = outputs[0] = argv[4] = "r.png"
+            argv += ["--plot", image]
+            outputs.append(image)
+    elif command == "sensitivity":
+        argv = ["sensitivity", g_arg]
+        if sweep is not None:
+            argv += ["--sweep", s_arg]
+        if not chance(draw, 10):
+            out = _output(draw, "sens.csv", files)
+            argv += ["-o", out]
+            outputs.append(out)
+        quiet = not chance(draw, 30)
+        if quiet:
+            argv.append("-q")
+        if chance(draw, 10):
+            argv += ["--top", draw(st.sampled_from(("0", "1", "5", "-1", "x", "1e3")))]
+    elif command in ("urdf", "urdf-at"):
+        argv = ["urdf", g_arg]
+        if command == "urdf" and chance(draw, 10):
+            pass  # to standard output
+        else:
+            out = _output(draw, "o.urdf", files)
+            argv += ["-o", out]
+            outputs.append(out)
+        if command == "urdf-at":
+            steps = len(plans[0].values) if plans else 5
+            step = str(draw(st.integers(0, steps - 1)))
+            if chance(draw, 15):
+                step = draw(st.sampled_from((str(steps), "-1", "x", "", "99999999999", "1.5")))
+            argv += ["--at", f"{s_arg}:{step}"]
+            if outputs and Path(outputs[0]).name:
+                outputs.append(str(Path(outputs[0]).with_suffix(".pose.yaml")))
+    elif command == "mjcf":
+        out = _output(draw, "o.xml", files)
+        argv = ["mjcf", g_arg, "-o", out]
+        outputs.append(out)
+    elif command == "draw":
+        out = _output(draw, draw(st.sampled_from(("d.png", "d.svg", "d.txt"))), files)
+        argv = ["draw", g_arg, "-o", out]
+        outputs.append(out)
+    else:  # setup
+        argv = ["setup", g_arg]
+        argv += draw(_setup_arguments(geometry.data))
+        if chance(draw, 35):
+            out = _output(draw, "set.yaml", files)
+            argv += ["-o", out]
+            outputs.append(out)
+        if chance(draw, 25):
+            out = _output(draw, "sheet.csv", files)
+            if outputs and chance(draw, 20):
+                out = outputs[0]  # the sheet onto the solved geometry
+            argv += ["--csv", out]
+            outputs.append(out)
+    stale, links = [], {}
+    for out in outputs:
+        if _plain_file(out) and out not in files and out not in stale + list(links):
+            if chance(draw, 1):  # a symlink to an input in the output's place
+                links[out] = draw(st.sampled_from(sorted(files)))
+            elif chance(draw, 20):
+                stale.append(out)
+    return Case(command, argv, files, outputs, geometry, sweep, plans, stale, quiet, links)
+
+
+def _has(geometry, what: str) -> bool:
+    """Whether the geometry data (as drawn, maybe broken) has a shim, a rack or a pushrod."""
+    if not isinstance(geometry, dict):
+        return False
+    config = geometry.get("config") if isinstance(geometry.get("config"), dict) else {}
+    if what == "shim":
+        return isinstance(config.get("camber_shim"), dict)
+    if what == "rack":
+        return _is_rack(geometry) is True
+    actuation = geometry.get("actuation")
+    return isinstance(actuation, dict) and actuation.get("type") == "pushrod_rocker"
+
+
+@st.composite
+def _setup_arguments(draw, geometry) -> list[str]:
+    """Rows (--shim, --trackrod, --pushrod, --sensitivities) or targets (--camber, ...),
+    mostly for the parts the corner has."""
+    argv = []
+    anything = chance(draw, 15)  # also flags for parts the corner lacks
+    wild_number = st.sampled_from(("nan", "inf", "abc", "1e9", "-1e300", "", ",", "5,,6"))
+    if draw(st.booleans()):  # rows
+        for flag, low, high, part in (
+            ("--shim", 0, 60, "shim"),
+            ("--trackrod", -10, 10, "rack"),
+            ("--pushrod", -10, 10, "pushrod"),
+        ):
+            if (anything or _has(geometry, part)) and chance(draw, 50):
+                number = st.one_of(st.integers(low, high), small(max(-low, high)))
+                if chance(draw, 10):
+                    number = st.one_of(number, wild_number)
+                values = _numbers_argument(draw(st.lists(number, min_size=1, max_size=4)))
+                # "--trackrod -1,1" reads as an option to argparse: "--trackrod=-1,1" works
+                argv += [f"{flag}={values}"] if draw(st.booleans()) else [flag, values]
+        if draw(st.booleans()):
+            argv.append("--sensitivities")
+            if draw(st.booleans()):
+                pitch = draw(st.sampled_from(("1.5", "1", "0", "-1", "nan")))
+                argv += ["--thread-pitch", pitch]
+    else:  # targets
+        for flag, low, high, part in (
+            ("--camber", -6, 2, "shim"),
+            ("--toe", -1, 1, "rack"),
+            ("--ride-height-change", -20, 20, "pushrod"),
+        ):
+            if (anything or _has(geometry, part)) and chance(draw, 60):
+                value = draw(st.integers(1000 * low, 1000 * high).map(lambda i: i / 1000))
+                if chance(draw, 10):
+                    value = draw(st.sampled_from(("nan", "100", "-45", "x", "1e400")))
+                argv += [flag, value if isinstance(value, str) else f"{value:g}"]
+    return argv
+
+
+def _plain_file(out: str) -> bool:
+    return out not in ("", ".", "new/") and not out.startswith(("g.yaml/", "new/"))
+
+
+# --------------------------------------------------------------------------- running
+
+
+STALE = b"stale contents from an earlier run\n"
+
+
+@dataclass
+class Outcome:
+    code: int
+    stdout: str
+    stderr: str
+    new: set[str]  # paths created (files and folders), relative
+    changed: set[str]  # files that existed and changed
+    removed: set[str]
+    texts: dict[str, bytes]  # contents of every file afterwards, by relative path
+    directory: str  # the run directory (removed after the checks)
+    mujoco_log: bool
+
+
+def _snapshot(root: Path) -> dict[str, tuple]:
+    out = {}
+    for folder, dirs, names in os.walk(root):
+        for d in dirs:
+            path = Path(folder, d)
+            out[str(path.relative_to(root))] = ("dir",)
+        for n in names:
+            path = Path(folder, n)
+            st_ = path.lstat()
+            digest = hashlib.sha256(path.read_bytes()).hexdigest() if path.is_file() else ""
+            out[str(path.relative_to(root))] = (st_.st_mode, st_.st_size, st_.st_mtime_ns, digest)
+    return out
+
+
+@contextlib.contextmanager
+def run_case(case: Case):
+    """Run the case in a fresh folder in process; yield its Outcome, then remove the folder.
+
+    An exception escaping main() propagates as itself (invariant 4), with the
+    case attached as a note.
+    """
+    from pin_susp.cli import main
+
+    root_log = (ROOT / "MUJOCO_LOG.TXT").exists()
+    with tempfile.TemporaryDirectory(prefix="pin_susp_fuzz-") as tmp:
+        run_dir = Path(tmp)
+        for name, text in case.files.items():
+            (run_dir / name).write_bytes(text)
+        for name in case.stale:
+            path = run_dir / name
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_bytes(STALE)
+        for name, target in case.links.items():
+            (run_dir / name).symlink_to(target)
+        before = _snapshot(run_dir)
+        out, err = io.StringIO(), io.StringIO()
+        cwd = os.getcwd()
+        os.chdir(run_dir)
+        start = time.perf_counter()
+        try:
+            with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+                code = main(list(case.argv))
+        except Exception as exc:
+            COUNTS[case.command, type(exc).__name__] += 1
+            exc.add_note(f"escaped pin_susp.cli.main() (invariant 4, never a traceback)\n{case!r}")
+            exc.add_note(f"stderr: {err.getvalue()!r}")
+            raise
+        finally:
+            os.chdir(cwd)
+            SLOWEST.append((time.perf_counter() - start, " ".join(map(_quote, case.argv))))
+            SLOWEST.sort(reverse=True)
+            del SLOWEST[3:]
+        COUNTS[case.command, code] += 1
+        after = _snapshot(run_dir)
+        texts = {
+            name: (run_dir / name).read_bytes()
+            for name, info in after.items()
+            if info[0] != "dir" and (run_dir / name).is_file()
+        }
+        yield Outcome(
+            code=code,
+            stdout=out.getvalue(),
+            stderr=err.getvalue(),
+            new=set(after) - set(before),
+            changed={k for k in set(after) & set(before) if after[k] != before[k]},
+            removed=set(before) - set(after),
+            texts=texts,
+            directory=tmp,
+            mujoco_log=any(Path(k).name == "MUJOCO_LOG.TXT" for k in after)
+            or (not root_log and (ROOT / "MUJOCO_LOG.TXT").exists()),
+        )
+
+
+# --------------------------------------------------------------------------- invariants
+
+EXIT_CODES = {
+    "sweep": {0, 1, 2},
+    "sensitivity": {0, 1, 2},
+    "urdf": {0, 2},
+    "urdf-at": {0, 2},
+    "mjcf": {0, 2},
+    "setup": {0, 2},
+    "draw": {0, 2},
+}
+_WARNING = re.compile(r"pin-susp: warning: (\d+) of (\d+) steps did not converge")
+_STEPS = re.compile(r"\bsteps? (\d+(?:, \d+)*)")
+
+
+def check_case(case: Case, o: Outcome) -> None:
+    """Assert the invariants of one run; each assert is its own line (one bug per line)."""
+    context = f"\n{case!r}\nexit {o.code}\nstdout: {o.stdout[-2000:]!r}\nstderr: {o.stderr!r}"
+    # 4. never a traceback
+    assert "Traceback" not in o.stderr and "Traceback" not in o.stdout, "traceback" + context
+    # exit codes the command documents
+    expected = EXIT_CODES[case.command]
+    if case.command == "sensitivity" and "--sweep" not in case.argv:
+        expected = {0, 2}
+    assert isinstance(o.code, int) and o.code in expected, "unexpected exit code" + context
+    # 5. nothing outside the declared outputs; no temporary file; no MuJoCo log
+    leftovers = [p for p in o.new | o.changed if Path(p).name.startswith(".pin_susp-")]
+    assert not leftovers, f"temporary files left: {leftovers}" + context
+    assert not o.mujoco_log, "MUJOCO_LOG.TXT written" + context
+    assert not o.removed, f"files removed: {sorted(o.removed)}" + context
+    inputs_changed = sorted(set(case.files) & o.changed)
+    assert not inputs_changed, f"input files changed: {inputs_changed}" + context
+    lines = [line for line in o.stderr.splitlines() if line.strip()]
+    paths_out = [os.path.normpath(out) for out in case.outputs]
+    if len(set(paths_out)) < len(paths_out):
+        assert o.code == 2, "two outputs on one path: one of them lost, not refused" + context
+    if o.code == 2:
+        # 3. one line naming the problem, nothing written
+        assert len(lines) == 1, f"exit 2 with {len(lines)} stderr lines" + context
+        assert lines[0].startswith("pin-susp"), "exit 2 line not from pin-susp" + context
+        assert not o.new, f"exit 2 but created {sorted(o.new)}" + context
+        assert not o.changed, f"exit 2 but changed {sorted(o.changed)}" + context
+        return
+    allowed = _declared(case)
+    stray = sorted(p for p in o.new | o.changed if p not in allowed)
+    assert not stray, f"wrote outside the declared outputs: {stray}" + context
+    errors = [line for line in lines if line.startswith("pin-susp: error")]
+    assert not errors, f"exit {o.code} with an error line" + context
+    for out in case.outputs:
+        written = o.texts.get(os.path.normpath(out), STALE) != STALE
+        # a report of a sweep where no step converged has nothing to draw: exit 1, said so
+        skipped = o.code == 1 and f"{out} not drawn" in o.stderr
+        assert written or skipped, f"exit {o.code} but {out} not written" + context
+    if case.quiet and o.code == 0:
+        assert o.stdout == "", "-q printed on stdout" + context
+    if case.command == "sweep":
+        _check_sweep(case, o, lines, context)
+    elif case.command == "sensitivity":
+        _check_sensitivity(case, o, lines, context)
+    elif case.command == "setup":
+        _check_setup(case, o, context)
+    elif case.command == "urdf-at" and len(case.outputs) == 2:
+        pose = yaml.safe_load(o.texts[os.path.normpath(case.outputs[1])])
+        values = list(pose["joints"].values())
+        assert all(math.isfinite(v) for v in values), "pose sidecar not finite" + context
+
+
+def _declared(case: Case) -> set[str]:
+    allowed = set()
+    for out in case.outputs:
+        path = Path(os.path.normpath(out))
+        allowed.add(str(path))
+        allowed.update(str(p) for p in path.parents if str(p) != ".")
+    return allowed
+
+
+def parse_csv(text: str) -> tuple[list[str], list[list[str]]]:
+    """A pin_susp CSV: '#' comment lines, a header, rows (no quoting in pin_susp output)."""
+    lines = [line for line in text.splitlines() if not line.startswith("#")]
+    assert lines, "no header"
+    header = lines[0].split(",")
+    return header, [line.split(",") for line in lines[1:]]
+
+
+def _finite_or_empty(cell: str) -> bool:
+    if cell == "":
+        return True
+    try:
+        return math.isfinite(float(cell)) and cell.strip().lower() not in ("nan", "inf")
+    except ValueError:
+        return False
+
+
+def _warning(lines, context) -> tuple[int, int, set[int], list[str]]:
+    warnings = [line for line in lines if _WARNING.match(line)]
+    assert len(warnings) == 1, "exit 1 without one 'steps did not converge' line" + context
+    m = _WARNING.match(warnings[0])
+    named = {int(x) for group in _STEPS.findall(warnings[0]) for x in group.split(", ")}
+    return int(m.group(1)), int(m.group(2)), named, warnings
+
+
+def _check_sweep(case: Case, o: Outcome, lines, context) -> None:
+    text = o.texts[os.path.normpath(case.outputs[0])].decode()
+    for what, name in (("geometry", case.argv[1]), ("sweep", case.argv[2])):
+        line = next((x for x in text.splitlines() if x.startswith(f"# {what}: ")), "")
+        sha = re.search(r"sha256=([0-9a-f]{64})", line)
+        assert sha, f"no sha256 of the {what} in the CSV" + context
+        digest = hashlib.sha256(case.files[os.path.normpath(name)]).hexdigest()
+        assert sha.group(1) == digest, f"the CSV's sha256 of {name} is not its bytes'" + context
+    header, rows = parse_csv(text)
+    for name in SOLVER_COLUMNS:
+        assert name in header, f"no {name} column" + context
+    col = {name: i for i, name in enumerate(header)}
+    assert all(len(r) == len(header) for r in rows), "a row with a wrong cell count" + context
+    assert [r[0] for r in rows] == [str(i) for i in range(len(rows))], "step_index" + context
+    if case.plans:
+        assert len(rows) == len(case.plans[0].values), "not one row per step" + context
+    flags = [r[col["solver_converged"]] for r in rows]
+    assert set(flags) <= {"True", "False"}, f"solver_converged cells {set(flags)}" + context
+    failed = [i for i, f in enumerate(flags) if f == "False"]
+    solver = {col[n] for n in SOLVER_COLUMNS}
+    for i, r in enumerate(rows):
+        if flags[i] == "True":
+            residual = float(r[col["solver_max_residual"]])
+            assert residual <= RESIDUAL_LIMIT, f"row {i}: residual {residual}" + context
+            bad = [header[j] for j, c in enumerate(r) if j != col["solver_converged"]
+                   and not _finite_or_empty(c)]  # fmt: skip
+            assert not bad, f"row {i}: non-finite cells {bad[:5]}" + context
+        else:
+            filled = [header[j] for j, c in enumerate(r) if j not in solver and c != ""]
+            assert not filled, f"failed row {i} has cells {filled[:5]}" + context
+    if o.code == 0:
+        # 1. exit 0 only when every row converged
+        assert not failed, f"exit 0 with steps {failed[:10]} flagged False" + context
+        assert not any(_WARNING.match(line) for line in lines), "exit 0 with a warning" + context
+    else:
+        # 2. exit 1 only with the failing steps named
+        assert failed, "exit 1 but every row converged" + context
+        n, total, named, _ = _warning(lines, context)
+        assert n == len(failed) and total == len(rows), "warning counts" + context
+        assert named <= set(failed), f"named {sorted(named - set(failed))} converged" + context
+        assert set(failed[:10]) <= named, f"failed {failed[:10]}, named {sorted(named)}" + context
+    _check_geometry_of_rows(case, o, header, rows, context)
+
+
+def _check_sensitivity(case: Case, o: Outcome, lines, context) -> None:
+    states = set()
+    if case.outputs:
+        header, rows = parse_csv(o.texts[os.path.normpath(case.outputs[0])].decode())
+        assert header[:5] == ["step_index", "metric", "hardpoint", "axis", "value"], (
+            "sensitivity header" + context
+        )
+        bad = [r for r in rows if len(r) != len(header) or not _finite_or_empty(r[4])]
+        assert not bad, f"sensitivity rows {bad[:3]}" + context
+        states = {int(r[0]) for r in rows if r[4] != ""}
+    if o.code == 1:
+        n, total, named, _ = _warning(lines, context)
+        if case.plans:
+            assert total == len(case.plans[0].values), "warning step count" + context
+        assert not named & states, f"steps {sorted(named & states)} named but solved" + context
+    elif case.plans and case.outputs:
+        assert states == set(range(len(case.plans[0].values))), "a step missing" + context
+
+
+def _check_setup(case: Case, o: Outcome, context) -> None:
+    for out in case.outputs:
+        text = o.texts[os.path.normpath(out)]
+        if out.endswith(".csv"):
+            _, rows = parse_csv(text.decode())
+            bad = [c for r in rows for c in r[1:] if not _finite_or_empty(c)]
+            assert not bad, f"setup sheet cells {bad[:5]}" + context
+        else:
+            from pin_susp import load_geometry
+
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                load_geometry(Path(o.directory) / os.path.normpath(out))  # reads back
+
+
+# ------------------------------------------------- independent check of converged rows
+
+
+def chirality(a, b, c, d) -> float:
+    u, v, w = ([q[i] - a[i] for i in range(3)] for q in (b, c, d))
+    det = (
+        u[0] * (v[1] * w[2] - v[2] * w[1])
+        - u[1] * (v[0] * w[2] - v[2] * w[0])
+        + u[2] * (v[0] * w[1] - v[1] * w[0])
+    )
+    scale = math.sqrt(sum(x * x for x in u) * sum(x * x for x in v) * sum(x * x for x in w))
+    return det / scale if scale > 0 else 0.0
+
+
+def bodies(g) -> tuple[list[str], list[list[str]], list[tuple[str, str, str, str]]]:
+    """(chassis points, rigid groups incl. rods, branch loops) of an as-set Geometry."""
+    inner, outer = g.steering_points
+    pushrod = g.has_pushrod
+    mount = g.actuation_mount
+    chassis = [
+        "lower_wishbone_inboard_front",
+        "lower_wishbone_inboard_rear",
+        "upper_wishbone_inboard_front",
+        "upper_wishbone_inboard_rear",
+    ]
+    lower = chassis[:2] + ["lower_wishbone_outboard"]
+    upper = chassis[2:] + ["upper_wishbone_outboard"]
+    upright = ["lower_wishbone_outboard", "upper_wishbone_outboard", "axle_inboard"]
+    upright += ["axle_outboard", outer, "wheel_center", "axle_midpoint"]
+    upright += ["wheel_inboard", "wheel_outboard"]
+    groups = [lower, upper, upright, [inner, outer]]
+    rocker: list[str] = []
+    on = {"lower_wishbone": lower, "upright": upright}[mount]
+    if g.steering == "none":
+        chassis.append(inner)
+    if pushrod:
+        chassis += ["rocker_axis_a", "rocker_axis_b"]
+        rocker = ["rocker_axis_a", "rocker_axis_b", "pushrod_inboard"]
+        on.append("pushrod_outboard")
+        groups += [rocker, ["pushrod_outboard", "pushrod_inboard"]]
+    if g.spring == "coilover":
+        chassis.append("strut_top")
+        (rocker if pushrod else on).append("strut_bottom")
+    loops = [
+        (
+            "upper_wishbone_inboard_front",
+            "upper_wishbone_inboard_rear",
+            "lower_wishbone_outboard",
+            "upper_wishbone_outboard",
+        ),
+        ("lower_wishbone_outboard", "upper_wishbone_outboard", inner, outer),
+    ]
+    if pushrod:
+        loops.append(("rocker_axis_a", "rocker_axis_b", "pushrod_outboard", "pushrod_inboard"))
+    return chassis, groups, loops
+
+
+def design_points(g) -> dict[str, list[float]]:
+    """Every point of the as-set geometry at its design state, mm (docs/geometry.md)."""
+    p = {name: [1000.0 * x for x in v] for name, v in g.hardpoints.items()}
+    ai, ao = p["axle_inboard"], p["axle_outboard"]
+    a = _unit([ao[i] - ai[i] for i in range(3)])
+    offset, half = 1000.0 * g.wheel.offset, 500.0 * g.wheel.section_width
+    wc = [ao[i] - offset * a[i] for i in range(3)]
+    p["wheel_center"] = wc
+    p["axle_midpoint"] = [(ai[i] + ao[i]) / 2 for i in range(3)]
+    p["wheel_inboard"] = [wc[i] - half * a[i] for i in range(3)]
+    p["wheel_outboard"] = [wc[i] + half * a[i] for i in range(3)]
+    down = [a[2] * a[0], a[2] * a[1], -1.0 + a[2] * a[2]]  # −Ẑ minus its part along â
+    n = math.sqrt(sum(x * x for x in down))
+    if n > 1e-12:
+        r = 1000.0 * g.wheel.radius
+        p["contact_patch_center"] = [wc[i] + r * down[i] / n for i in range(3)]
+    return p
+
+
+def _dist(a, b) -> float:
+    return math.sqrt(sum((a[i] - b[i]) ** 2 for i in range(3)))
+
+
+def _check_geometry_of_rows(case: Case, o: Outcome, header, rows, context) -> None:
+    """Independently of the solver's own flags: converged rows close the loops, meet the
+    targets and stay on the design branch, read from the CSV's point columns."""
+    converged = [r for r in rows if r[header.index("solver_converged")] == "True"]
+    if not converged:
+        return
+    from pin_susp import Corner
+
+    with warnings.catch_warnings():  # implausible values: the run has reported them
+        warnings.simplefilter("ignore")
+        g = Corner(str(Path(o.directory) / "g.yaml")).geometry
+    design = design_points(g)
+    col = {name: i for i, name in enumerate(header)}
+    chassis, groups, loops = bodies(g)
+    scale = max(abs(x) for v in design.values() for x in v)
+    tol = GEOMETRIC_TOLERANCE + 1e-12 * scale
+    signs = {}
+    for loop in loops:
+        c = chirality(*(design[n] for n in loop))
+        if abs(c) >= 1e-6:
+            signs[loop] = math.copysign(1.0, c)
+    for r in converged:
+        step = r[0]
+
+        def at(name, r=r):
+            cells = [col.get(f"{name}_{a}") for a in "xyz"]
+            if None in cells:
+                return None
+            return [float(r[i]) for i in cells]
+
+        for name in chassis:
+            p = at(name)
+            if p is not None:
+                moved = _dist(p, design[name])
+                assert moved <= tol, f"step {step}: chassis point {name} moved {moved}" + context
+        if g.steering == "rack":
+            p, d = at("trackrod_inboard"), design["trackrod_inboard"]
+            off = max(abs(p[0] - d[0]), abs(p[2] - d[2]))
+            assert off <= tol, f"step {step}: the rack left its line by {off} mm" + context
+        for group in groups:
+            present = [n for n in group if at(n) is not None and n in design]
+            for i, a in enumerate(present):
+                for b in present[i + 1 :]:
+                    err = abs(_dist(at(a), at(b)) - _dist(design[a], design[b]))
+                    assert err <= tol, f"step {step}: |{a} - {b}| off by {err} mm" + context
+        for loop, sign in signs.items():
+            points = [at(n) for n in loop]
+            c = chirality(*points)
+            assert c * sign > -1e-9, f"step {step}: off the design branch of {loop}" + context
+        if "wheel_travel" in col and r[col["wheel_travel"]] != "":
+            travel = float(r[col["wheel_travel"]])
+            err = abs(travel - (at("wheel_center")[2] - design["wheel_center"][2]))
+            assert err <= tol, f"step {step}: wheel_travel off by {err} mm" + context
+        for plan in case.plans or ():
+            p = at(plan.point)
+            if p is None or plan.point not in design:
+                continue
+            value = plan.values[int(step)]
+            reached = sum(p[i] * plan.direction[i] for i in range(3))
+            if plan.mode == "relative":
+                reached -= sum(design[plan.point][i] * plan.direction[i] for i in range(3))
+            err = abs(reached - value)
+            assert err <= tol, f"step {step}: target {plan.point} off by {err} mm" + context
+
+
+def summary() -> str:
+    """Counts per exit code and per command."""
+    by_code: Counter = Counter()
+    by_command: dict[str, Counter] = {}
+    for (command, code), n in COUNTS.items():
+        by_code[code] += n
+        by_command.setdefault(command, Counter())[code] += n
+    total = sum(by_code.values())
+    lines = [f"pin-susp fuzz: {total} runs"]
+    lines.append(
+        "  by exit code: " + ", ".join(f"{k}: {v}" for k, v in sorted(by_code.items(), key=str))
+    )
+    for command in sorted(by_command):
+        c = by_command[command]
+        counts = ", ".join(f"exit {k}: {v}" for k, v in sorted(c.items(), key=str))
+        lines.append(f"  {command:<12} {sum(c.values()):>6}  ({counts})")
+    if SLOWEST:
+        slow = ", ".join(f"{t:.2f} s ({argv[:60]})" for t, argv in SLOWEST)
+        lines.append(f"  slowest: {slow}")
+    if FOUND:
+        lines.append(f"  failures collected ({sum(FOUND.values())}):")
+        lines += [f"    {n:>6}  {name}" for name, n in FOUND.most_common()]
+    return "\n".join(lines)
+
+
+def signature(exc: BaseException) -> str:
+    """A short name for a failure: the broken assert, or where the exception came from."""
+    import traceback
+
+    frames = traceback.extract_tb(exc.__traceback__)
+    if isinstance(exc, AssertionError) and frames:
+        first = str(exc).split("\n", 1)[0]
+        words = re.sub(r"[^A-Za-z0-9]+", "_", re.sub(r"\d+(\.\d+)?(e-?\d+)?", "N", first))
+        return f"invariant-{frames[-1].lineno}-{words.strip('_')[:60]}"
+    inner = [f for f in frames if "pin_susp" in f.filename and "tests" not in f.filename]
+    where = inner[-1] if inner else (frames[-1] if frames else None)
+    place = f"{Path(where.filename).stem}-{where.lineno}" if where else "unknown"
+    return f"crash-{type(exc).__name__}-{place}"
+
+
+def size(case: Case) -> tuple[int, int]:
+    """How big a case is: its changes, then its text (to keep the smallest of a kind)."""
+    changes = len(case.geometry.changes) + (len(case.sweep.changes) if case.sweep else 0)
+    return changes, sum(len(t) for t in case.files.values()) + len(" ".join(case.argv))
+
+
+def save_case(case: Case, exc: BaseException, folder: Path, keep_smaller: bool = False) -> Path:
+    """Write the case as files to run by hand: g.yaml, s.yaml, command.txt, problem.txt.
+
+    One folder per signature(); it holds the last case saved, or with
+    ``keep_smaller`` the smallest.
+    """
+    import traceback
+
+    where = folder / signature(exc)
+    sized = where / "size.json"
+    if keep_smaller and sized.exists() and tuple(json.loads(sized.read_text())) <= size(case):
+        return where
+    if where.exists():
+        for old in where.iterdir():
+            if old.is_file():
+                old.unlink()
+    where.mkdir(parents=True, exist_ok=True)
+    for name, text in case.files.items():
+        (where / name).write_bytes(text)
+    command = "pin-susp " + " ".join(map(_quote, case.argv))
+    (where / "command.txt").write_text(
+        f"# run in this folder (outputs existing before the run: {case.stale}; "
+        f"symlinks: {case.links})\n{command}\n"
+    )
+    problem = "".join(traceback.format_exception(exc))
+    (where / "problem.txt").write_text(f"{problem}\n{case!r}\n")
+    sized.write_text(json.dumps(size(case)))
+    return where

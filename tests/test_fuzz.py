@@ -1,0 +1,172 @@
+"""Property-based fuzzing of ``pin-susp`` in process (strategies and invariants: fuzzing.py).
+
+``make test`` runs ``PIN_SUSP_FUZZ_EXAMPLES`` inputs (default 500, about 20 s),
+derandomized: the same inputs every run, no example database and nothing
+written into the repository. ``make fuzz`` runs 10 000 (about 8 min) with a
+fresh seed, printed with the counts per exit code and command.
+``PIN_SUSP_FUZZ_SEED=N`` repeats a run; ``PIN_SUSP_FUZZ_FINDINGS=DIR`` saves
+each failing input as files to run by hand (the shrunk one last);
+``PIN_SUSP_FUZZ_COLLECT=1`` counts failures instead of stopping at them (the
+smallest of each kind saved), for triage while the code is being fixed.
+"""
+
+import dataclasses
+import os
+import random
+from pathlib import Path
+
+import hypothesis.configuration
+import pytest
+from fuzzing import (
+    COUNTS,
+    FOUND,
+    ROOT,
+    SLOWEST,
+    Case,
+    Inputs,
+    Plan,
+    cases,
+    check_case,
+    run_case,
+    save_case,
+    signature,
+    summary,
+)
+from hypothesis import HealthCheck, Phase, given, seed, settings
+
+EXAMPLES = int(os.environ.get("PIN_SUSP_FUZZ_EXAMPLES", "500"))
+SEED = os.environ.get("PIN_SUSP_FUZZ_SEED", "").strip()
+if SEED == "random":
+    SEED = str(random.SystemRandom().randrange(2**32))
+FINDINGS = os.environ.get("PIN_SUSP_FUZZ_FINDINGS")
+# Triage: count and save every failure (the smallest of each kind) and keep going.
+COLLECT = os.environ.get("PIN_SUSP_FUZZ_COLLECT", "") not in ("", "0")
+
+
+@pytest.fixture(autouse=True)
+def _hypothesis_home(tmp_path):
+    """Anything Hypothesis keeps (even with no database it writes constants/) goes into
+    the test's own temporary folder: never the repository, never a shared /tmp path."""
+    hypothesis.configuration.set_hypothesis_home_dir(tmp_path / "hypothesis")
+
+
+def _one(case: Case) -> None:
+    try:
+        with run_case(case) as outcome:
+            check_case(case, outcome)
+    except Exception as exc:
+        if FINDINGS:
+            save_case(case, exc, Path(FINDINGS), keep_smaller=COLLECT)
+        if not COLLECT:
+            raise
+        FOUND[signature(exc)] += 1
+
+
+_fuzz = settings(
+    max_examples=EXAMPLES,
+    deadline=None,
+    suppress_health_check=[
+        HealthCheck.too_slow,
+        HealthCheck.data_too_large,
+        HealthCheck.filter_too_much,
+        HealthCheck.large_base_example,
+    ],
+    derandomize=not SEED,
+    database=None,
+    report_multiple_bugs=True,
+    print_blob=False,
+    # no explain phase: tracing every shrink step makes a failing run ten times slower
+    phases=[Phase.explicit, Phase.reuse, Phase.generate, Phase.target, Phase.shrink],
+)(given(case=cases())(_one))
+if SEED:
+    _fuzz = seed(int(SEED))(_fuzz)
+
+
+def test_cli_holds_its_invariants():
+    COUNTS.clear()
+    FOUND.clear()
+    SLOWEST.clear()
+    try:
+        _fuzz()
+    finally:
+        print(
+            "\n"
+            + summary()
+            + (f"\n  seed {SEED} (PIN_SUSP_FUZZ_SEED={SEED} repeats it)" if SEED else "")
+        )
+
+
+def _known_good_sweep() -> Case:
+    geometry = (ROOT / "examples" / "double_wishbone.yaml").read_bytes()
+    sweep = (
+        b"version: 1\nsteps: 3\ntargets:\n"
+        b"  - {point: wheel_center, direction: {axis: z}, start: -10, stop: 10}\n"
+        b"  - {point: trackrod_inboard, direction: {axis: y}, start: 0, stop: 5}\n"
+    )
+    plans = [
+        Plan("wheel_center", (0.0, 0.0, 1.0), "relative", [-10.0, 0.0, 10.0]),
+        Plan("trackrod_inboard", (0.0, 1.0, 0.0), "relative", [0.0, 2.5, 5.0]),
+    ]
+    return Case(
+        "sweep",
+        ["sweep", "g.yaml", "s.yaml", "-o", "out.csv", "-q"],
+        {"g.yaml": geometry, "s.yaml": sweep},
+        ["out.csv"],
+        Inputs(None, geometry, []),
+        Inputs(None, sweep, []),
+        plans,
+        quiet=True,
+    )
+
+
+def _edit(csv: bytes, row: int, column: str, value: str) -> bytes:
+    lines = csv.decode().splitlines()
+    first = next(i for i, line in enumerate(lines) if not line.startswith("#"))
+    j = lines[first].split(",").index(column)
+    cells = lines[first + 1 + row].split(",")
+    cells[j] = value
+    lines[first + 1 + row] = ",".join(cells)
+    return ("\n".join(lines) + "\n").encode()
+
+
+def test_the_checker_catches_broken_invariants():
+    """The invariants are not vacuous: a good run passes, each tampered copy fails."""
+    case = _known_good_sweep()
+    with run_case(case) as good:
+        check_case(case, good)
+        assert good.code == 0
+        csv = good.texts["out.csv"]
+        tampered = {
+            "exit 0 with a failed row": {
+                "texts": {"out.csv": _edit(csv, 1, "solver_converged", "False")}
+            },
+            "residual above 1e-9 mm": {
+                "texts": {"out.csv": _edit(csv, 2, "solver_max_residual", "2e-9")}
+            },
+            "nan text": {"texts": {"out.csv": _edit(csv, 0, "camber", "nan")}},
+            "a point off its body": {
+                "texts": {"out.csv": _edit(csv, 1, "axle_outboard_x", "-19.99")}
+            },
+            "the rack off its line": {
+                "texts": {"out.csv": _edit(csv, 2, "trackrod_inboard_z", "250.001")}
+            },
+            "exit 1 naming nothing": {
+                "code": 1,
+                "texts": {"out.csv": _edit(csv, 1, "solver_converged", "False")},
+            },
+            "exit 2 on two lines": {"code": 2, "stderr": "pin-susp: error: a\nb\n", "new": set()},
+            "exit 2 writing": {"code": 2, "stderr": "pin-susp: error: x\n"},
+            "a traceback": {"stderr": "Traceback (most recent call last):\n"},
+            "a temporary file left": {"new": {"out.csv", ".pin_susp-abc.tmp"}},
+            "an input changed": {"changed": {"g.yaml"}},
+            "a stray file": {"new": {"out.csv", "elsewhere.txt"}},
+            "MuJoCo's log": {"mujoco_log": True},
+            "exit 3": {"code": 3},
+        }
+        for what, changes in tampered.items():
+            with pytest.raises(AssertionError):
+                check_case(case, dataclasses.replace(good, **changes))
+                pytest.fail(f"not caught: {what}")
+        shifted = [dataclasses.replace(p, values=[v + 1e-3 for v in p.values]) for p in case.plans]
+        with pytest.raises(AssertionError, match="target"):
+            check_case(dataclasses.replace(case, plans=shifted), good)
