@@ -448,10 +448,11 @@ def _sweep(args) -> int:
 def _urdf(args) -> int:
     if args.at is not None and args.output is None:
         raise PinSuspError("--at writes a sidecar beside the URDF: give -o OUT.urdf too")
+    _check_outputs(args, args.output)
     sidecar = None
     if args.output is not None and args.at is not None:
         sidecar = Path(args.output).with_suffix(".pose.yaml")
-    _check_outputs(args, args.output, sidecar)
+        _check_outputs(args, args.output, sidecar)
     corner = Corner(load_geometry(args.geometry))
     pose = _pose_at(corner, args.at) if args.at is not None else None
     if args.output is None:

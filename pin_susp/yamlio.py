@@ -102,9 +102,16 @@ class _Loader(yaml.SafeLoader):
 
     def construct_decimal_int(self, node):
         value = self.construct_scalar(node).replace("_", "")
+        if ":" in value:  # YAML 1.1 base 60 (3:20 = 200): a time, not a length; keep the text
+            return self.construct_scalar(node)
         if _LEADING_ZERO.fullmatch(value):
             return int(value, 10)
         return self.construct_yaml_int(node)
+
+    def construct_decimal_float(self, node):
+        if ":" in self.construct_scalar(node):  # base 60, as for ints
+            return self.construct_scalar(node)
+        return self.construct_yaml_float(node)
 
 
 # Appended, so YAML 1.1's own int and float patterns still match first.
@@ -117,6 +124,7 @@ _Loader.add_implicit_resolver(  # the YAML 1.2 core schema float
     list("-+.0123456789"),
 )
 _Loader.add_constructor("tag:yaml.org,2002:int", _Loader.construct_decimal_int)
+_Loader.add_constructor("tag:yaml.org,2002:float", _Loader.construct_decimal_float)
 
 
 def load_yaml(source: str | Path | dict) -> tuple[dict, str, str | None]:

@@ -522,3 +522,8 @@ def test_two_outputs_on_one_path_are_refused(tmp_path, capsys):
     out = tmp_path / "set.yaml"
     one_line_error(["setup", GEOMETRY, "--toe", "0", "-o", out, "--csv", out], capsys, "one file")
     assert files(tmp_path) == set()
+
+
+@pytest.mark.parametrize("bad", ["", ".", "/"])
+def test_urdf_at_with_an_empty_or_folder_output(tmp_path, capsys, bad):
+    one_line_error(["urdf", GEOMETRY, "-o", bad, "--at", f"{BUMP_STEER}:0"], capsys)

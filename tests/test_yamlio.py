@@ -211,3 +211,11 @@ def test_readers_without_a_limit_work_as_before():
     assert np.array_equal(r.vector([1e20, 0, 0], "k"), [1e20, 0, 0])
     with pytest.raises(InputError, match=r"^corner.yaml: k: must be >= 0, got -1$"):
         r.number(-1, "k", 0.0, limit=MAX_LENGTH_MM)
+
+
+def test_base_60_numbers_stay_text(tmp_path):
+    """YAML 1.1 reads 3:20 as 200 (sexagesimal): a length written so is a mistake."""
+    path = tmp_path / "g.yaml"
+    path.write_text("a: 3:20\nb: 1:30.5\n")
+    data, _, _ = load_yaml(path)
+    assert data == {"a": "3:20", "b": "1:30.5"}
