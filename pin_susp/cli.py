@@ -393,24 +393,19 @@ def _numbers(text: str) -> list[float]:
     return values
 
 
+def _finite(text: str, positive: bool = False) -> float:
+    try:
+        x = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not math.isfinite(x) or (positive and x <= 0.0):
+        bound = " > 0" if positive else ""
+        raise argparse.ArgumentTypeError(f"expected a finite number{bound}, got {text!r}")
+    return x
+
+
 def _positive(text: str) -> float:
-    try:
-        x = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
-    if not (math.isfinite(x) and x > 0.0):
-        raise argparse.ArgumentTypeError(f"expected a finite number > 0, got {text!r}")
-    return x
-
-
-def _finite(text: str) -> float:
-    try:
-        x = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
-    if not math.isfinite(x):
-        raise argparse.ArgumentTypeError(f"expected a finite number, got {text!r}")
-    return x
+    return _finite(text, positive=True)
 
 
 def _count(text: str) -> int:
