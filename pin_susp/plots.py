@@ -283,9 +283,9 @@ def drawing_figure(corner, labels: bool = False):
     fig, (front, side) = plt.subplots(1, 2, figsize=(14, 6.5))
     corners = [(corner, 1.0, "-")]
     if corner.geometry.drawn is not None:
-        from .corner import Corner
+        from .linkage import Linkage
 
-        corners.insert(0, (Corner(corner.geometry.drawn, apply_setup=False), 0.3, "--"))
+        corners.insert(0, (Linkage(corner.geometry.drawn), 0.3, "--"))
     for c, alpha, style in corners:
         _draw_corner(front, side, c, alpha, style)
     ground = _mm(corner)["contact_patch_center"][2]

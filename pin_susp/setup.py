@@ -26,10 +26,13 @@ import numpy as np
 import pinocchio as pin
 
 from .closures import DistanceClosure, JointTarget, LoopBranch, PointTarget, chirality
+from .double_wishbone import corner_tree
 from .errors import InputError
-from .geometry import MM, Geometry
+from .geometry import MM, Geometry, load_geometry
 from .jet import Dual
+from .linkage import Linkage
 from .metrics import METRIC_BY_NAME, STANDARD, PointSet
+from .shim import ShimAssembly
 from .solver import NewtonSolver
 
 PARAMETERS = ("shim_thickness", "trackrod_length", "pushrod_length")
@@ -50,8 +53,6 @@ def apply_setup(g) -> Geometry:
     hardpoints = dict(g.hardpoints)
     shim = g.camber_shim
     if shim is not None and shim.setup_thickness != shim.design_thickness:
-        from .shim import ShimAssembly
-
         hardpoints.update(ShimAssembly(g).shimmed_hardpoints())
         _check_branches(g, hardpoints, PARAMETER_KEYS["shim_thickness"])
     as_set = replace(g, hardpoints=hardpoints, drawn=g)
@@ -65,8 +66,6 @@ def apply_setup(g) -> Geometry:
 
 def _check_branches(drawn: Geometry, hardpoints: dict[str, np.ndarray], key: str) -> None:
     """The set-up corner must be the drawn mechanism: every loop on its drawn branch."""
-    from .double_wishbone import corner_tree
-
     for loop in corner_tree(drawn).closures:
         if not loop.branch:
             continue
@@ -83,9 +82,7 @@ def _check_branches(drawn: Geometry, hardpoints: dict[str, np.ndarray], key: str
 
 def _adjusted_hardpoints(g: Geometry) -> dict[str, np.ndarray]:
     """Apply the trackrod/pushrod length changes with the static load path held."""
-    from .corner import Corner
-
-    corner = Corner(g)
+    corner = Linkage(g)
     delta = {
         "trackrod": g.trackrod_length_delta,
         "toe_link": g.trackrod_length_delta,
@@ -164,11 +161,9 @@ class SetupModel:
     """The drawn corner with the setup p as parameters: static state and dq/dp."""
 
     def __init__(self, g):
-        from .corner import Corner
-
         g = _geometry(g)
         self.drawn = g.drawn or g
-        self.corner = Corner(self.drawn, apply_setup=False)
+        self.corner = Linkage(self.drawn)
         c = self.corner
         self.ball = next(x for x in c.closures if x.name == "upper_ball_joint")
         self.links = {x.name: x for x in c.closures if isinstance(x, DistanceClosure)}
@@ -296,8 +291,6 @@ TARGET_ALIASES = {"toe": "roadwheel_angle", "ride_height": "ride_height_change"}
 
 def _geometry(g) -> Geometry:
     """A Geometry from a path, a dict or a Geometry (as Corner accepts)."""
-    from .geometry import load_geometry
-
     return g if isinstance(g, Geometry) else load_geometry(g)
 
 

@@ -202,9 +202,9 @@ class CornerScene:
         self.robots = []
         drawn = corner.geometry.drawn
         if drawn is not None:  # the geometry as drawn, translucent, under the as-set one
-            from .corner import Corner
+            from .linkage import Linkage
 
-            self.robots.append(self._robot(Corner(drawn, apply_setup=False), "drawn", GHOST))
+            self.robots.append(self._robot(Linkage(drawn), "drawn", GHOST))
         self.robots.append(self._robot(corner, "corner", None))
 
         present = segments(corner, corner.design_positions)
