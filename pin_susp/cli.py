@@ -141,235 +141,16 @@ def _parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--version", action="version", version=f"pin_susp {__version__}")
     sub = p.add_subparsers(title="commands", metavar="COMMAND", required=True)
-
-    s = sub.add_parser(
-        "sweep",
-        help="solve a sweep and write one CSV row per step",
-        description="Solve every step of SWEEP on the corner GEOMETRY and write the "
-        "metrics (camber, toe, caster, KPI, scrub, trail, ...) and every point to CSV. "
-        "Exit code 1 if any step did not converge (its row is flagged).",
-    )
-    _geometry_argument(s)
-    s.add_argument("sweep", metavar="SWEEP", help="sweep YAML (targets per step)")
-    s.add_argument("-o", "--output", required=True, metavar="OUT.csv", help="results CSV")
-    s.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
-    s.add_argument("--plot", metavar="OUT.png", help="also draw the standard kinematics report")
-    s.set_defaults(run=_sweep)
-
-    u = sub.add_parser(
-        "urdf",
-        help="write the corner as URDF (tree + loop closures)",
-        description="Write the URDF of GEOMETRY: the kinematic tree in metres, every "
-        "hardpoint as a link, loop closures as <pin_susp:loop_closure> elements.",
-    )
-    _geometry_argument(u)
-    u.add_argument(
-        "-o", "--output", metavar="OUT.urdf", help="file to write (default: standard output)"
-    )
-    u.add_argument(
-        "--at",
-        metavar="SWEEP:STEP",
-        help="also write the joint values of that solved step to a YAML sidecar "
-        "(OUT.pose.yaml), so another tool can load the pose",
-    )
-    u.set_defaults(run=_urdf)
-
-    mj = sub.add_parser(
-        "mjcf",
-        help="write the corner as MJCF (MuJoCo; loop closures as equality connects)",
-        description="Write GEOMETRY as MJCF: the URDF's bodies and joints, every point a "
-        "site, ball closures as <connect>, distance closures as a rod on a universal joint "
-        "closed by a <connect>. Loads in MuJoCo and in Pinocchio's MJCF parser.",
-    )
-    _geometry_argument(mj)
-    mj.add_argument("-o", "--output", required=True, metavar="OUT.xml", help="file to write")
-    mj.set_defaults(run=_mjcf)
-
-    va = sub.add_parser(
-        "validate",
-        help="re-solve a sweep with MuJoCo and a point-based solver; compare every column",
-        description="Solve SWEEP with pin_susp, then re-solve every step independently with "
-        "MuJoCo (from the exported MJCF) and with a point-based formulation (hardpoints as "
-        "unknowns, rigid distances, scipy); print the largest difference per column and "
-        "engine; exit 1 where one exceeds the tolerance. MuJoCo is optional: "
-        "pip install 'pin_susp[validate]'.",
-    )
-    _geometry_argument(va)
-    va.add_argument("sweep", metavar="SWEEP", help="sweep YAML")
-    va.add_argument(
-        "--mjcf",
-        metavar="FILE.xml",
-        help="an exported MJCF to check against (default: export it now)",
-    )
-    va.add_argument(
-        "--tolerance",
-        type=_positive,
-        default=1e-6,
-        metavar="TOL",
-        help="largest difference accepted, mm and deg (default 1e-6)",
-    )
-    va.set_defaults(run=_validate)
-
-    d = sub.add_parser(
-        "demo",
-        help="run the embedded example and write its results",
-        description="Solve the embedded example corner (the test corner of open-kinematics "
-        "0.4) through a combined bump+steer sweep and write into DIR: demo_geometry.yaml and "
-        "demo_sweep.yaml (the inputs, to edit and rerun), demo_results.csv (every column), "
-        "demo_report.png (the standard kinematics plots), demo_drawing.png (front and side "
-        "view), demo_replay.html (the 3D replay, opens in a browser with no server) and "
-        "demo_corner.urdf (the URDF with its loop closures).",
-    )
-    d.add_argument(
-        "-o",
-        "--output",
-        default="pin_susp_demo",
-        metavar="DIR",
-        help="output folder (default: ./pin_susp_demo)",
-    )
-    d.set_defaults(run=_demo)
-
-    t = sub.add_parser(
-        "setup",
-        help="setup sheet: static metrics, shim/trackrod/pushrod rows, sensitivities, inverse",
-        description="Print the static metrics of GEOMETRY as set (camber shim and length "
-        "adjusters applied). List values to see one row each; ask for exact sensitivities; "
-        "or give target values to find the shim, trackrod and pushrod settings that hit them.",
-        epilog="Example: pin-susp setup examples/camber_shim.yaml --shim 15,20,25,30 "
-        "--sensitivities; pin-susp setup examples/camber_shim.yaml --camber -2.5 --toe 0.1 "
-        "-o set.yaml",
-    )
-    _geometry_argument(t)
-    t.add_argument(
-        "--shim",
-        type=_numbers,
-        default=[],
-        metavar="MM,MM,...",
-        help="fitted shim stack thicknesses, one row each",
-    )
-    t.add_argument(
-        "--trackrod",
-        type=_numbers,
-        default=[],
-        metavar="MM,MM,...",
-        help="trackrod (or fixed toe link) length changes (+ longer), one row each; "
-        "negative values as written: --trackrod -1,0,1",
-    )
-    t.add_argument(
-        "--pushrod",
-        type=_numbers,
-        default=[],
-        metavar="MM,MM,...",
-        help="pushrod length changes (+ longer), one row each",
-    )
-    t.add_argument(
-        "--sensitivities",
-        action="store_true",
-        help="exact d(camber, toe, ride height)/d(shim, trackrod, pushrod)",
-    )
-    t.add_argument(
-        "--thread-pitch",
-        type=_positive,
-        metavar="MM",
-        help="also give sensitivities per turn of an adjuster with this pitch "
-        "(length change per turn; a left/right-hand turnbuckle: twice the pitch)",
-    )
-    t.add_argument("--camber", type=_finite, metavar="DEG", help="target static camber (shim)")
-    t.add_argument(
-        "--toe",
-        type=_finite,
-        metavar="DEG",
-        help="target static roadwheel angle, + toe-in (trackrod)",
-    )
-    t.add_argument(
-        "--ride-height-change",
-        type=_finite,
-        metavar="MM",
-        help="target ride-height change, + car higher (pushrod)",
-    )
-    t.add_argument(
-        "-o",
-        "--output",
-        metavar="SET.yaml",
-        help="with targets: write the geometry with the setup found",
-    )
-    t.add_argument("--csv", metavar="OUT.csv", help="also write the sheet's rows as CSV")
-    t.set_defaults(run=_setup)
-
-    h = sub.add_parser(
-        "sensitivity",
-        help="exact d(metric)/d(hardpoint coordinate), at design or along a sweep",
-        description="How much each hardpoint coordinate moves each metric and each derivative "
-        "column (camber gain, bump steer, ...): exact, by implicit differentiation of the "
-        "closure equations. Writes a long-format CSV (step_index, metric, hardpoint, axis, "
-        "value, unit) and prints the largest entries per metric.",
-    )
-    _geometry_argument(h)
-    h.add_argument(
-        "--sweep", metavar="SWEEP", help="at every step of this sweep (default: the design state)"
-    )
-    h.add_argument("-o", "--output", metavar="SENS.csv", help="long-format CSV")
-    h.add_argument(
-        "--top",
-        type=_count,
-        default=3,
-        metavar="N",
-        help="entries per metric in the printed table (default 3)",
-    )
-    h.add_argument(
-        "--points",
-        default="designer",
-        metavar="GROUP|NAMES",
-        help="which hardpoints the printed table ranks: designer (default: chassis pickups "
-        "and link ends, not the spindle points), chassis, upright, all, or names separated "
-        "by commas (the CSV always has every hardpoint)",
-    )
-    h.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
-    h.set_defaults(run=_sensitivity)
-
-    pl = sub.add_parser(
-        "plot",
-        help="standard kinematics report from results CSVs (one panel per metric)",
-        description="Camber, toe, caster, KPI, scrub, trail, half track (and instant centres, "
-        "anti geometry, motion ratio, camber gain and bump steer where present) against wheel "
-        "travel, or rack travel from centre for a steer sweep. Several CSVs compare designs "
-        "(of the same kind of sweep: a bump and a steer sweep cannot share one figure).",
-    )
-    pl.add_argument("results", nargs="+", metavar="RESULTS.csv", help="pin-susp sweep output")
-    pl.add_argument(
-        "-o", "--output", required=True, metavar="OUT.png", help="image (png, pdf, svg)"
-    )
-    pl.set_defaults(run=_plot)
-
-    dr = sub.add_parser(
-        "draw",
-        help="front and side view drawing of a corner",
-        description="Draw GEOMETRY at its design (as-set) state in front and side view, with "
-        "the instant-centre construction (ball joints to the front- and side-view instant "
-        "centres, the contact patch through them, and the roll centre of a symmetric axle on "
-        "the centreline); a shimmed corner shows its drawn geometry dashed.",
-    )
-    _geometry_argument(dr)
-    dr.add_argument(
-        "-o", "--output", required=True, metavar="OUT.png", help="image (png, pdf, svg)"
-    )
-    dr.add_argument(
-        "--labels", action="store_true", help="name every hardpoint and add a colour legend"
-    )
-    dr.set_defaults(run=_draw)
-
-    v = sub.add_parser(
-        "view",
-        help="3D view in meshcat (live, or a self-contained HTML replay)",
-        description="Open GEOMETRY in a meshcat scene served locally (works offline) and print "
-        "its URL; with SWEEP, play the solved motion as an animation. --html writes the scene "
-        "and animation as one HTML file that opens in a browser with no server.",
-    )
-    _geometry_argument(v)
-    v.add_argument("sweep", metavar="SWEEP", nargs="?", help="sweep YAML to animate")
-    v.add_argument("--html", metavar="OUT.html", help="write a self-contained replay and exit")
-    v.add_argument("--fps", type=_positive, default=10.0, help="animation frames per second")
-    v.set_defaults(run=_view)
+    _sweep_command(sub)
+    _urdf_command(sub)
+    _mjcf_command(sub)
+    _validate_command(sub)
+    _demo_command(sub)
+    _setup_command(sub)
+    _sensitivity_command(sub)
+    _plot_command(sub)
+    _draw_command(sub)
+    _view_command(sub)
     return p
 
 
@@ -414,6 +195,22 @@ def _count(text: str) -> int:
     return int(text)
 
 
+def _sweep_command(sub) -> None:
+    s = sub.add_parser(
+        "sweep",
+        help="solve a sweep and write one CSV row per step",
+        description="Solve every step of SWEEP on the corner GEOMETRY and write the "
+        "metrics (camber, toe, caster, KPI, scrub, trail, ...) and every point to CSV. "
+        "Exit code 1 if any step did not converge (its row is flagged).",
+    )
+    _geometry_argument(s)
+    s.add_argument("sweep", metavar="SWEEP", help="sweep YAML (targets per step)")
+    s.add_argument("-o", "--output", required=True, metavar="OUT.csv", help="results CSV")
+    s.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
+    s.add_argument("--plot", metavar="OUT.png", help="also draw the standard kinematics report")
+    s.set_defaults(run=_sweep)
+
+
 def _sweep(args) -> int:
     _check_outputs(args, args.output, args.plot)
     if args.plot is not None:
@@ -438,6 +235,26 @@ def _sweep(args) -> int:
         if plot:
             print(f"wrote {args.plot}")
     return _report_failures(results)
+
+
+def _urdf_command(sub) -> None:
+    u = sub.add_parser(
+        "urdf",
+        help="write the corner as URDF (tree + loop closures)",
+        description="Write the URDF of GEOMETRY: the kinematic tree in metres, every "
+        "hardpoint as a link, loop closures as <pin_susp:loop_closure> elements.",
+    )
+    _geometry_argument(u)
+    u.add_argument(
+        "-o", "--output", metavar="OUT.urdf", help="file to write (default: standard output)"
+    )
+    u.add_argument(
+        "--at",
+        metavar="SWEEP:STEP",
+        help="also write the joint values of that solved step to a YAML sidecar "
+        "(OUT.pose.yaml), so another tool can load the pose",
+    )
+    u.set_defaults(run=_urdf)
 
 
 def _urdf(args) -> int:
@@ -491,6 +308,19 @@ def _pose_at(corner, at: str) -> dict:
     }
 
 
+def _mjcf_command(sub) -> None:
+    mj = sub.add_parser(
+        "mjcf",
+        help="write the corner as MJCF (MuJoCo; loop closures as equality connects)",
+        description="Write GEOMETRY as MJCF: the URDF's bodies and joints, every point a "
+        "site, ball closures as <connect>, distance closures as a rod on a universal joint "
+        "closed by a <connect>. Loads in MuJoCo and in Pinocchio's MJCF parser.",
+    )
+    _geometry_argument(mj)
+    mj.add_argument("-o", "--output", required=True, metavar="OUT.xml", help="file to write")
+    mj.set_defaults(run=_mjcf)
+
+
 def _mjcf(args) -> int:
     from .mjcf import tree_to_mjcf
 
@@ -503,6 +333,33 @@ def _mjcf(args) -> int:
     write_text(tree_to_mjcf(corner.tree, comment), args.output)
     print(f"wrote {args.output}")
     return 0
+
+
+def _validate_command(sub) -> None:
+    va = sub.add_parser(
+        "validate",
+        help="re-solve a sweep with MuJoCo and a point-based solver; compare every column",
+        description="Solve SWEEP with pin_susp, then re-solve every step independently with "
+        "MuJoCo (from the exported MJCF) and with a point-based formulation (hardpoints as "
+        "unknowns, rigid distances, scipy); print the largest difference per column and "
+        "engine; exit 1 where one exceeds the tolerance. MuJoCo is optional: "
+        "pip install 'pin_susp[validate]'.",
+    )
+    _geometry_argument(va)
+    va.add_argument("sweep", metavar="SWEEP", help="sweep YAML")
+    va.add_argument(
+        "--mjcf",
+        metavar="FILE.xml",
+        help="an exported MJCF to check against (default: export it now)",
+    )
+    va.add_argument(
+        "--tolerance",
+        type=_positive,
+        default=1e-6,
+        metavar="TOL",
+        help="largest difference accepted, mm and deg (default 1e-6)",
+    )
+    va.set_defaults(run=_validate)
 
 
 def _validate(args) -> int:
@@ -558,6 +415,27 @@ def _validate(args) -> int:
                 "(marked !)"
             )
     return 0 if ok else 1
+
+
+def _demo_command(sub) -> None:
+    d = sub.add_parser(
+        "demo",
+        help="run the embedded example and write its results",
+        description="Solve the embedded example corner (the test corner of open-kinematics "
+        "0.4) through a combined bump+steer sweep and write into DIR: demo_geometry.yaml and "
+        "demo_sweep.yaml (the inputs, to edit and rerun), demo_results.csv (every column), "
+        "demo_report.png (the standard kinematics plots), demo_drawing.png (front and side "
+        "view), demo_replay.html (the 3D replay, opens in a browser with no server) and "
+        "demo_corner.urdf (the URDF with its loop closures).",
+    )
+    d.add_argument(
+        "-o",
+        "--output",
+        default="pin_susp_demo",
+        metavar="DIR",
+        help="output folder (default: ./pin_susp_demo)",
+    )
+    d.set_defaults(run=_demo)
 
 
 def _demo(args) -> int:
@@ -773,6 +651,75 @@ def _progress_bar(total: int, quiet: bool):
     return show
 
 
+def _setup_command(sub) -> None:
+    t = sub.add_parser(
+        "setup",
+        help="setup sheet: static metrics, shim/trackrod/pushrod rows, sensitivities, inverse",
+        description="Print the static metrics of GEOMETRY as set (camber shim and length "
+        "adjusters applied). List values to see one row each; ask for exact sensitivities; "
+        "or give target values to find the shim, trackrod and pushrod settings that hit them.",
+        epilog="Example: pin-susp setup examples/camber_shim.yaml --shim 15,20,25,30 "
+        "--sensitivities; pin-susp setup examples/camber_shim.yaml --camber -2.5 --toe 0.1 "
+        "-o set.yaml",
+    )
+    _geometry_argument(t)
+    t.add_argument(
+        "--shim",
+        type=_numbers,
+        default=[],
+        metavar="MM,MM,...",
+        help="fitted shim stack thicknesses, one row each",
+    )
+    t.add_argument(
+        "--trackrod",
+        type=_numbers,
+        default=[],
+        metavar="MM,MM,...",
+        help="trackrod (or fixed toe link) length changes (+ longer), one row each; "
+        "negative values as written: --trackrod -1,0,1",
+    )
+    t.add_argument(
+        "--pushrod",
+        type=_numbers,
+        default=[],
+        metavar="MM,MM,...",
+        help="pushrod length changes (+ longer), one row each",
+    )
+    t.add_argument(
+        "--sensitivities",
+        action="store_true",
+        help="exact d(camber, toe, ride height)/d(shim, trackrod, pushrod)",
+    )
+    t.add_argument(
+        "--thread-pitch",
+        type=_positive,
+        metavar="MM",
+        help="also give sensitivities per turn of an adjuster with this pitch "
+        "(length change per turn; a left/right-hand turnbuckle: twice the pitch)",
+    )
+    t.add_argument("--camber", type=_finite, metavar="DEG", help="target static camber (shim)")
+    t.add_argument(
+        "--toe",
+        type=_finite,
+        metavar="DEG",
+        help="target static roadwheel angle, + toe-in (trackrod)",
+    )
+    t.add_argument(
+        "--ride-height-change",
+        type=_finite,
+        metavar="MM",
+        help="target ride-height change, + car higher (pushrod)",
+    )
+    t.add_argument(
+        "-o",
+        "--output",
+        metavar="SET.yaml",
+        help="with targets: write the geometry with the setup found",
+    )
+    t.add_argument("--csv", metavar="OUT.csv", help="also write the sheet's rows as CSV")
+    t.set_defaults(run=_setup)
+
+
 def _setup(args) -> int:
     from . import setup
 
@@ -882,6 +829,39 @@ def _sheet_csv(rows, labels, path, link: str = "trackrod") -> None:
             f.write(",".join(cells) + "\n")
 
 
+def _sensitivity_command(sub) -> None:
+    h = sub.add_parser(
+        "sensitivity",
+        help="exact d(metric)/d(hardpoint coordinate), at design or along a sweep",
+        description="How much each hardpoint coordinate moves each metric and each derivative "
+        "column (camber gain, bump steer, ...): exact, by implicit differentiation of the "
+        "closure equations. Writes a long-format CSV (step_index, metric, hardpoint, axis, "
+        "value, unit) and prints the largest entries per metric.",
+    )
+    _geometry_argument(h)
+    h.add_argument(
+        "--sweep", metavar="SWEEP", help="at every step of this sweep (default: the design state)"
+    )
+    h.add_argument("-o", "--output", metavar="SENS.csv", help="long-format CSV")
+    h.add_argument(
+        "--top",
+        type=_count,
+        default=3,
+        metavar="N",
+        help="entries per metric in the printed table (default 3)",
+    )
+    h.add_argument(
+        "--points",
+        default="designer",
+        metavar="GROUP|NAMES",
+        help="which hardpoints the printed table ranks: designer (default: chassis pickups "
+        "and link ends, not the spindle points), chassis, upright, all, or names separated "
+        "by commas (the CSV always has every hardpoint)",
+    )
+    h.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
+    h.set_defaults(run=_sensitivity)
+
+
 def _sensitivity(args) -> int:
     from .sensitivity import POINT_GROUPS, STEP, hardpoint_sensitivities, largest, select_points
 
@@ -948,6 +928,22 @@ def _sensitivity_csv(states, corner, path) -> None:
                         )
 
 
+def _plot_command(sub) -> None:
+    pl = sub.add_parser(
+        "plot",
+        help="standard kinematics report from results CSVs (one panel per metric)",
+        description="Camber, toe, caster, KPI, scrub, trail, half track (and instant centres, "
+        "anti geometry, motion ratio, camber gain and bump steer where present) against wheel "
+        "travel, or rack travel from centre for a steer sweep. Several CSVs compare designs "
+        "(of the same kind of sweep: a bump and a steer sweep cannot share one figure).",
+    )
+    pl.add_argument("results", nargs="+", metavar="RESULTS.csv", help="pin-susp sweep output")
+    pl.add_argument(
+        "-o", "--output", required=True, metavar="OUT.png", help="image (png, pdf, svg)"
+    )
+    pl.set_defaults(run=_plot)
+
+
 def _plot(args) -> int:
     from .plots import ResultsFile, report_figure, save_figure
 
@@ -958,6 +954,25 @@ def _plot(args) -> int:
     return 0
 
 
+def _draw_command(sub) -> None:
+    dr = sub.add_parser(
+        "draw",
+        help="front and side view drawing of a corner",
+        description="Draw GEOMETRY at its design (as-set) state in front and side view, with "
+        "the instant-centre construction (ball joints to the front- and side-view instant "
+        "centres, the contact patch through them, and the roll centre of a symmetric axle on "
+        "the centreline); a shimmed corner shows its drawn geometry dashed.",
+    )
+    _geometry_argument(dr)
+    dr.add_argument(
+        "-o", "--output", required=True, metavar="OUT.png", help="image (png, pdf, svg)"
+    )
+    dr.add_argument(
+        "--labels", action="store_true", help="name every hardpoint and add a colour legend"
+    )
+    dr.set_defaults(run=_draw)
+
+
 def _draw(args) -> int:
     from .plots import drawing_figure, save_figure
 
@@ -966,6 +981,21 @@ def _draw(args) -> int:
     save_figure(drawing_figure(corner, labels=args.labels), args.output)
     print(f"wrote {args.output}")
     return 0
+
+
+def _view_command(sub) -> None:
+    v = sub.add_parser(
+        "view",
+        help="3D view in meshcat (live, or a self-contained HTML replay)",
+        description="Open GEOMETRY in a meshcat scene served locally (works offline) and print "
+        "its URL; with SWEEP, play the solved motion as an animation. --html writes the scene "
+        "and animation as one HTML file that opens in a browser with no server.",
+    )
+    _geometry_argument(v)
+    v.add_argument("sweep", metavar="SWEEP", nargs="?", help="sweep YAML to animate")
+    v.add_argument("--html", metavar="OUT.html", help="write a self-contained replay and exit")
+    v.add_argument("--fps", type=_positive, default=10.0, help="animation frames per second")
+    v.set_defaults(run=_view)
 
 
 def _view(args) -> int:
