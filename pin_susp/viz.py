@@ -21,7 +21,6 @@ grid on it.
 from __future__ import annotations
 
 import os
-import signal
 import subprocess
 import sys
 
@@ -124,9 +123,16 @@ def framing(points: np.ndarray, sign: float = 1.0) -> tuple[np.ndarray, np.ndarr
 
 
 # meshcat's own server, with its web server bound to loopback (meshcat 0.3.2's
-# listens on every interface; its ZMQ socket is on 127.0.0.1 already).
+# listens on every interface; its ZMQ socket is on 127.0.0.1 already). It asks
+# Linux to end it when its parent (the pin-susp process, argv[1]) dies, even by
+# SIGKILL: set here, after exec, not in a preexec_fn (unsafe in a threaded parent).
 _SERVER = """
-import sys
+import os, signal, sys
+if sys.platform.startswith("linux"):
+    import ctypes
+    ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
+    if os.getppid() != int(sys.argv[1]):  # the parent died before that: go now
+        sys.exit(0)
 import tornado.web
 listen = tornado.web.Application.listen
 tornado.web.Application.listen = lambda app, port, address="127.0.0.1", **kw: listen(
@@ -146,11 +152,10 @@ def start_server() -> tuple[subprocess.Popen, str]:
     from meshcat.servers.zmqserver import match_zmq_url
 
     proc = subprocess.Popen(
-        [sys.executable, "-u", "-c", _SERVER],
+        [sys.executable, "-u", "-c", _SERVER, str(os.getpid())],
         stdout=subprocess.PIPE,
         stderr=subprocess.DEVNULL,
         start_new_session=True,  # a Ctrl+C is ours to handle: we stop it in close()
-        preexec_fn=_die_with_parent,
     )
     line = ""
     while "zmq_url" not in line:
@@ -159,16 +164,6 @@ def start_server() -> tuple[subprocess.Popen, str]:
             raise RuntimeError(f"the meshcat server exited at start (code {proc.returncode})")
     proc.stdout.readline()  # its web URL: the viewer asks for it over ZMQ
     return proc, match_zmq_url(line.strip())
-
-
-def _die_with_parent() -> None:
-    """In the child: SIGTERM when the parent dies (Linux prctl PR_SET_PDEATHSIG)."""
-    if sys.platform.startswith("linux"):
-        import ctypes
-
-        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGTERM)
-        if os.getppid() == 1:  # the parent died before prctl: go now
-            os._exit(0)
 
 
 def _rod_transform(p0: np.ndarray, p1: np.ndarray) -> np.ndarray:
@@ -310,9 +305,18 @@ class CornerScene:
         return self.viewer.static_html()
 
     def close(self) -> None:
-        """Stop the meshcat server this scene started."""
+        """Stop the meshcat server this scene started.
+
+        Our ZMQ socket goes first, with no linger: a request still queued for a
+        server that is gone would otherwise hold the process at exit.
+        """
         proc = self.server
-        if proc is not None and proc.poll() is None:
+        if proc is None:
+            return
+        socket = getattr(self.viewer.window, "zmq_socket", None)
+        if socket is not None and not socket.closed:
+            socket.close(linger=0)
+        if proc.poll() is None:
             proc.terminate()
             try:
                 proc.wait(timeout=10)
