@@ -29,7 +29,7 @@ import yaml
 from . import __version__
 from .corner import Corner, Results
 from .errors import PinSuspError, PlausibilityWarning
-from .export import all_or_none, check_output, staged, write_text
+from .export import all_or_none, check_output, csv_text, is_stream, write_text
 from .geometry import load_geometry
 from .metrics import METRIC_BY_NAME, METRICS
 from .sweep import load_sweep
@@ -128,7 +128,7 @@ class _Parser(argparse.ArgumentParser):
         self._negative_number_matcher = re.compile(r"^-\.?[0-9]")
 
     def error(self, message: str):
-        self.exit(EXIT_INPUT, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+        self.exit(EXIT_INPUT, f"pin-susp: error: {message} (see {self.prog} --help)\n")
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -161,7 +161,7 @@ def _geometry_argument(parser: argparse.ArgumentParser) -> None:
 def _numbers(text: str) -> list[float]:
     """Lengths in mm separated by commas: finite, within the 100 m limit of any car."""
     try:
-        values = [float(x) for x in text.split(",") if x.strip()]
+        values = [float(x) for x in text.split(",")]
     except ValueError:
         raise argparse.ArgumentTypeError(
             f"expected numbers separated by commas, got {text!r}"
@@ -221,12 +221,13 @@ def _sweep(args) -> int:
     results = corner.run_sweep(sweep, progress=_progress_bar(sweep.steps, args.quiet))
     _warn_transmission(results)
     plot = args.plot is not None and results["solver_converged"].any()
+    text = csv_text(results)
     with all_or_none():
-        results.to_csv(args.output)
-        if plot:
+        write_text(text, args.output)
+        if plot:  # drawn from the CSV's text: the output may be a stream
             from .plots import ResultsFile, report_figure, save_figure
 
-            written = ResultsFile(staged(args.output), name=args.output)
+            written = ResultsFile(args.output, raw=text.encode())
             save_figure(report_figure([written]), args.plot)
     if args.plot is not None and not plot:
         print(f"pin-susp: no step converged: {args.plot} not drawn", file=sys.stderr)
@@ -263,6 +264,8 @@ def _urdf(args) -> int:
     _check_outputs(args, args.output)
     sidecar = None
     if args.output is not None and args.at is not None:
+        if is_stream(Path(args.output)):
+            raise PinSuspError(f"--at writes a sidecar beside the URDF: {args.output} is a stream")
         sidecar = Path(args.output).with_suffix(".pose.yaml")
         _check_outputs(args, args.output, sidecar)
     corner = Corner(load_geometry(args.geometry))
@@ -394,7 +397,7 @@ def _validate(args) -> int:
             for r in reports
         )
         print(f"  {name:<34}{unit:>6}{cells}")
-    ok = _report_failures(results) == 0
+    ok = _report_failures(results, "are not compared") == 0
     for r in reports:
         if r.note:
             print(f"  {r.engine}: skipped — {r.note}")
@@ -469,8 +472,9 @@ def _demo(args) -> int:
         for name, text in inputs.items():
             write_text(text, out / name)
         write_text(corner.urdf, files["URDF"])
-        results.to_csv(files["results"])
-        _demo_pictures(corner, results, files)
+        text = csv_text(results)
+        write_text(text, files["results"])
+        _demo_pictures(corner, results, files, text)
     print(f"pin_susp demo: {corner.geometry.name}, {sweep.steps}-step bump + steer sweep")
     _summary(results, files["results"])
     for what, path in [("geometry", geometry_path), ("sweep", sweep_path), *files.items()]:
@@ -482,14 +486,14 @@ def _demo(args) -> int:
     return _report_failures(results)
 
 
-def _demo_pictures(corner, results, files) -> None:
+def _demo_pictures(corner, results, files, csv: str) -> None:
     import contextlib
     import io
 
     from .plots import ResultsFile, drawing_figure, report_figure, save_figure
     from .viz import CornerScene
 
-    written = ResultsFile(staged(files["results"]), name=files["results"])
+    written = ResultsFile(files["results"], raw=csv.encode())
     save_figure(report_figure([written]), files["plots"])
     save_figure(drawing_figure(corner), files["drawing"])
     with contextlib.redirect_stdout(io.StringIO()):  # meshcat announces its server
@@ -553,9 +557,9 @@ def _warn_transmission(results: Results) -> None:
     if len(outside):
         worst = outside[np.argmax(np.abs(angle[outside] - 90.0))]
         warnings.warn(
-            f"rocker transmission angle {angle[worst]:.1f} deg at step {worst}: outside "
-            f"{low:g}…{high:g} deg at steps {_list([int(i) for i in outside])} (the rocker nears "
-            "over-centre; its motion ratio falls toward zero and flips)",
+            f"rocker transmission angle outside {low:g}…{high:g} deg at steps "
+            f"{_list([int(i) for i in outside])} (worst {angle[worst]:.1f} deg at step {worst}): "
+            "the rocker nears over-centre, its motion ratio falls toward zero and flips",
             PlausibilityWarning,
             stacklevel=2,
         )
@@ -886,10 +890,13 @@ def _sensitivity(args) -> int:
         print("  (with respect to the as-set hardpoints: shim and adjusters applied)")
     chosen = POINT_GROUPS.get(args.points, ", ".join(points))
     print(f"  moving {chosen}; other points: --points chassis|upright|all|NAME,NAME")
-    unmoved = []
+    unmoved, undefined = [], []
     for name in s.values:
         entries = largest(s, name, args.top, set(points))
         unit = s.units[name].removesuffix("/mm")
+        if not np.isfinite(s.metrics[name]):
+            undefined.append(name)
+            continue
         if not entries:
             unmoved.append(name)
             continue
@@ -903,6 +910,8 @@ def _sensitivity(args) -> int:
             )
     if unmoved:
         print(f"  not moved by these points here: {', '.join(unmoved)}")
+    if undefined:
+        print(f"  undefined here (blank in the results): {', '.join(undefined)}")
     if args.output is not None:
         print(
             f"wrote {args.output}: {len(states)} state(s) x {len(s.values)} metrics x "
@@ -947,6 +956,7 @@ def _plot_command(sub) -> None:
 def _plot(args) -> int:
     from .plots import ResultsFile, report_figure, save_figure
 
+    _check_outputs(args, args.output)
     _check_image(args.output)
     files = [ResultsFile(path) for path in args.results]
     save_figure(report_figure(files), args.output)
@@ -976,6 +986,7 @@ def _draw_command(sub) -> None:
 def _draw(args) -> int:
     from .plots import drawing_figure, save_figure
 
+    _check_outputs(args, args.output)
     _check_image(args.output)
     corner = Corner(load_geometry(args.geometry))
     save_figure(drawing_figure(corner, labels=args.labels), args.output)

@@ -21,7 +21,9 @@ from __future__ import annotations
 import contextvars
 import json
 import os
+import re
 import stat
+import sys
 import tempfile
 from contextlib import contextmanager
 from pathlib import Path
@@ -54,8 +56,10 @@ def _checked(path: Path, text: str, what: str) -> Path:
         raise PinSuspError(f"{text}: the file name is too long for this file system")
     if text.endswith(os.sep) or path.is_dir():
         raise PinSuspError(f"{text}: is a directory; the {what} needs a file name")
+    if is_stream(path):  # /dev/stdout and friends: write through the link, never rename
+        return path
     target = _target(path)
-    if _is_stream(target):
+    if is_stream(target):
         return target
     folder = _existing_ancestor(target.parent)
     if not folder.is_dir():
@@ -72,12 +76,30 @@ def _target(path: Path) -> Path:
     return Path(os.path.realpath(path)) if path.is_symlink() else path
 
 
-def _is_stream(path: Path) -> bool:
+def is_stream(path: Path) -> bool:
+    """A device, pipe or socket — or an existing name for one of this process's open
+    files (/dev/stdout → /proc/self/fd/1, even where that is a regular file)."""
     try:
         mode = path.stat().st_mode
     except OSError:
         return False
-    return stat.S_ISCHR(mode) or stat.S_ISFIFO(mode)
+    if stat.S_ISCHR(mode) or stat.S_ISFIFO(mode) or stat.S_ISSOCK(mode):
+        return True
+    return _open_fd(path) is not None
+
+
+def _open_fd(path: Path) -> int | None:
+    """The file descriptor a path names when it is one of this process's open files
+    (/dev/stdout → /proc/self/fd/1, /dev/fd/3), followed one link at a time."""
+    text = os.fspath(path)
+    for _ in range(8):
+        found = re.fullmatch(r"/(?:proc/(self|\d+)/fd|dev/fd)/(\d+)", text)
+        if found and found.group(1) in (None, "self", str(os.getpid())):
+            return int(found.group(2))
+        if not os.path.islink(text):
+            return None
+        text = os.path.join(os.path.dirname(text), os.readlink(text))
+    return None
 
 
 def _existing_ancestor(folder: Path) -> Path:
@@ -100,9 +122,18 @@ def atomic_write(path: str | Path, binary: bool = False):
     target = check_output(path)
     mode = "wb" if binary else "w"
     newline = None if binary else ""
-    if _is_stream(target):
-        with open(target, mode, newline=newline) as f:
-            yield f
+    if is_stream(target):
+        fd = _open_fd(target)
+        sys.stdout.flush()  # what we printed before comes first
+        try:
+            if fd is None:
+                stream = open(target, mode, newline=newline)
+            else:  # the open file itself (its offset), not the name reopened from 0
+                stream = os.fdopen(os.dup(fd), mode, newline=newline)
+            with stream as f:
+                yield f
+        except BrokenPipeError:
+            raise PinSuspError(f"{path}: the reader closed it before the end") from None
         return
     try:
         target.parent.mkdir(parents=True, exist_ok=True)
@@ -146,15 +177,6 @@ def all_or_none():
             raise
 
 
-def staged(path: str | Path) -> Path:
-    """Where the contents of ``path`` are now: its temporary file inside all_or_none()."""
-    target = _target(Path(path))
-    for tmp, final in _PENDING.get() or ():
-        if final == target:
-            return Path(tmp)
-    return target
-
-
 def _rename(tmp: str, target: Path) -> None:
     try:
         os.replace(tmp, target)
@@ -186,19 +208,24 @@ def format_cell(value) -> str:
     return "" if np.isnan(x) else repr(x)
 
 
-def write_csv(results, path: str | Path) -> None:
-    """Results as CSV: ``#`` comment lines, one header row, one row per step."""
+def csv_text(results) -> str:
+    """Results as CSV text: ``#`` comment lines, one header row, one row per step."""
     names = list(results.columns)
     columns = [results.columns[n] for n in names]
-    with atomic_write(path) as f:
-        f.write(f"# pin_susp {__version__}\n")
-        for what in ("geometry", "sweep"):
-            source, sha = results.meta[what]
-            f.write(f"# {what}: {source}" + (f" sha256={sha}" if sha else "") + "\n")
-        f.write("# units: " + json.dumps(results.units) + "\n")
-        f.write(",".join(names) + "\n")
-        for i in range(len(results)):
-            f.write(",".join(format_cell(c[i]) for c in columns) + "\n")
+    lines = [f"# pin_susp {__version__}"]
+    for what in ("geometry", "sweep"):
+        source, sha = results.meta[what]
+        lines.append(f"# {what}: {source}" + (f" sha256={sha}" if sha else ""))
+    lines.append("# units: " + json.dumps(results.units))
+    lines.append(",".join(names))
+    for i in range(len(results)):
+        lines.append(",".join(format_cell(c[i]) for c in columns))
+    return "\n".join(lines) + "\n"
+
+
+def write_csv(results, path: str | Path) -> None:
+    """Results as a CSV file (csv_text), whole or not at all."""
+    write_text(csv_text(results), path)
 
 
 def write_text(text: str, path: str | Path) -> None:

@@ -70,13 +70,15 @@ class ResultsFile:
     columns are fine (a failed step, an undefined metric) and are not drawn.
     """
 
-    def __init__(self, path: str | Path, name: str | Path | None = None):
-        """``name``: what messages and the legend call the file (default: ``path``)."""
+    def __init__(self, path: str | Path, name: str | Path | None = None, raw: bytes | None = None):
+        """``name``: what messages and the legend call the file (default: ``path``);
+        ``raw``: its contents when they are at hand (a CSV written to a stream)."""
         self.path = Path(path)
         self.source = source = str(path if name is None else name)
         self.label = Path(source).stem
         try:
-            raw = self.path.read_bytes()
+            if raw is None:
+                raw = self.path.read_bytes()
         except OSError as exc:
             raise InputError(source, "", f"cannot be read ({exc.strerror})") from None
         if not raw.strip():
@@ -625,5 +627,7 @@ def save_figure(fig, path: str | Path) -> None:
                 fig.savefig(f, format=_extension(path), dpi=110)
             except OSError as exc:
                 raise PinSuspError(f"{path}: cannot write ({exc.strerror or exc})") from None
+            except (ValueError, OverflowError) as exc:  # e.g. a cell of 1e308: no axis scale
+                raise PinSuspError(f"{path}: cannot draw these values ({exc})") from None
     finally:
         plt.close(fig)

@@ -426,7 +426,11 @@ POINT_GROUPS = {
 
 
 def select_points(corner, spec: str = "designer") -> list[str]:
-    """Hardpoints by group (POINT_GROUPS) or a comma-separated list of names."""
+    """Hardpoints by group (POINT_GROUPS) or names, several separated by commas."""
+    items = [item.strip() for item in spec.split(",") if item.strip()]
+    if len(items) > 1:
+        chosen = [n for item in items for n in select_points(corner, item)]
+        return list(dict.fromkeys(chosen))
     names = list(corner.geometry.hardpoints)
     if spec == "all":
         return names
@@ -455,7 +459,7 @@ def select_points(corner, spec: str = "designer") -> list[str]:
         raise InputError(
             "--points",
             "",
-            f"unknown hardpoint {', '.join(unknown) or repr(spec)} (give {groups} or names "
-            f"of this corner's hardpoints: {', '.join(names)})",
+            f"unknown hardpoint {', '.join(unknown) or repr(spec)} (give groups — {groups} — "
+            f"or names of this corner's hardpoints, separated by commas: {', '.join(names)})",
         )
     return wanted

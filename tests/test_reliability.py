@@ -91,11 +91,14 @@ def test_output_onto_a_fifo_is_written_as_a_stream(tmp_path, capsys):
     received = []
     reader = threading.Thread(target=lambda: received.append(fifo.read_text()))
     reader.start()
-    code, _, _ = run(["sweep", TOE_LINK, BUMP, "-o", fifo, "-q"], capsys)
+    code, _, _ = run(
+        ["sweep", TOE_LINK, BUMP, "-o", fifo, "-q", "--plot", tmp_path / "p.png"], capsys
+    )
     reader.join(timeout=30)
     assert code == 0
     assert stat.S_ISFIFO(fifo.stat().st_mode)  # still a pipe, not replaced by a file
     assert received and received[0].count("\n") > 61  # comments, header and 61 rows
+    assert (tmp_path / "p.png").stat().st_size > 0  # drawn from the text, not read back
 
 
 @pytest.mark.skipif(os.geteuid() != 0, reason="making a device node needs root")
@@ -527,3 +530,52 @@ def test_two_outputs_on_one_path_are_refused(tmp_path, capsys):
 @pytest.mark.parametrize("bad", ["", ".", "/"])
 def test_urdf_at_with_an_empty_or_folder_output(tmp_path, capsys, bad):
     one_line_error(["urdf", GEOMETRY, "-o", bad, "--at", f"{BUMP_STEER}:0"], capsys)
+
+
+# -- found by an independent review ---------------------------------------------------
+
+
+@pytest.mark.parametrize("command", ["draw", "plot"])
+def test_plot_and_draw_refuse_an_output_that_links_to_their_input(tmp_path, capsys, command):
+    g = tmp_path / "g.yaml"
+    g.write_text((EXAMPLES / "double_wishbone.yaml").read_text())
+    source = g
+    if command == "plot":
+        source = tmp_path / "r.csv"
+        assert run(["sweep", g, BUMP_STEER, "-o", source, "-q"], capsys)[0] == 0
+    before = source.read_bytes()
+    link = tmp_path / "link.png"
+    link.symlink_to(source)
+    argv = ["draw", g, "-o", link] if command == "draw" else ["plot", source, "-o", link]
+    one_line_error(argv, capsys, "is an input")
+    assert source.read_bytes() == before
+
+
+def test_dev_stdout_into_a_pipe_or_a_file_is_a_stream(tmp_path):
+    argv = [sys.executable, "-m", "pin_susp.cli", "sweep", TOE_LINK, BUMP, "-o", "/dev/stdout"]
+    piped = subprocess.run(argv + ["-q"], capture_output=True, text=True, cwd=tmp_path)
+    assert piped.returncode == 0, piped.stderr
+    assert piped.stdout.startswith("# pin_susp") and piped.stdout.count("\n") == 66
+    with open(tmp_path / "o.txt", "w") as out:  # stdout a regular file: appended, not replaced
+        assert subprocess.run(argv, stdout=out, cwd=tmp_path).returncode == 0
+    text = (tmp_path / "o.txt").read_text()
+    assert text.startswith("# pin_susp") and "wrote /dev/stdout" in text
+
+
+def test_a_reader_that_closes_early_is_an_error_and_nothing_else_is_written(tmp_path, capsys):
+    fifo = tmp_path / "p.csv"
+    os.mkfifo(fifo)
+
+    def read_a_little():
+        with open(fifo, "rb") as f:
+            f.read(100)
+
+    reader = threading.Thread(target=read_a_little)
+    reader.start()
+    long = example("bump.yaml")
+    long["steps"] = 2000  # ~3 MB of CSV: far more than a pipe holds
+    sweep = write_yaml(tmp_path / "s.yaml", long)
+    code, _, err = run(["sweep", TOE_LINK, sweep, "-o", fifo, "--plot", tmp_path / "p.png"], capsys)
+    reader.join(timeout=30)
+    assert code == 2 and len(err) == 1 and "closed it before the end" in err[0]
+    assert files(tmp_path) == {"p.csv", "s.yaml"}
