@@ -1044,6 +1044,10 @@ def _view(args) -> int:
         if results is not None:
             _report_failures(results, "are not in the animation")
         _print_warnings(args)
+        # A process started in the background of a script inherits SIGINT ignored:
+        # we say "press Ctrl+C", so Ctrl+C must stop us.
+        if threading.current_thread() is threading.main_thread():
+            signal.signal(signal.SIGINT, signal.default_int_handler)
         print("serving; press Ctrl+C to stop", flush=True)
         while True:
             time.sleep(0.5)
