@@ -165,10 +165,6 @@ class LoopBranch:
     def chirality(self, kin: Kinematics) -> float:
         return chirality(*(p.position(kin).tolist() for p in self.points))
 
-    def holds(self, kin: Kinematics) -> bool:
-        """True when the pose in ``kin`` is on the design assembly of this loop."""
-        return self.degenerate or self.chirality(kin) * self.sign > 0.0
-
 
 class BranchGuard:
     """Every loop's branch checked at once, each moving frame read once (a hot path:

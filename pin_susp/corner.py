@@ -9,14 +9,13 @@ The model itself — URDF, Pinocchio model, points, closures — is the
 from __future__ import annotations
 
 import time
-import warnings
 
 import numpy as np
 
 from . import setup
 from .closures import PointTarget
-from .errors import InputError, PlausibilityWarning
-from .geometry import Geometry, load_geometry
+from .errors import InputError
+from .geometry import Geometry, load_geometry, warn_outside
 from .linkage import Linkage
 from .metrics import METRICS, Pose, metric_columns, point_columns
 from .solver import NewtonSolver, Predictor, Solution
@@ -48,14 +47,7 @@ class Corner(Linkage):
             if m.plausible is None or m.name not in columns:
                 continue
             value = columns[m.name][0][0]
-            low, high = m.plausible
-            if value < low or value > high:  # NaN passes: undefined is not implausible
-                warnings.warn(
-                    f"{self.geometry.source}: design {m.name} = {value:.4g} {m.unit} is "
-                    f"outside the plausible {low:g}…{high:g} {m.unit} (a unit mistake?)",
-                    PlausibilityWarning,
-                    stacklevel=3,
-                )
+            warn_outside(f"{self.geometry.source}: design {m.name}", value, *m.plausible, m.unit)
 
     def drive_order(self, targets: list[Target]) -> list[int] | None:
         """Which target is which driver, when the targets are exactly the drivers

@@ -260,15 +260,20 @@ def warn_implausible(g: Geometry) -> None:
     far = max(g.hardpoints, key=lambda n: np.linalg.norm(g.hardpoints[n] - center))
     values["distance from the wheel centre"] = np.linalg.norm(g.hardpoints[far] - center) / MM
     for key, value in values.items():
-        low, high, unit_text = PLAUSIBLE[key]
-        if not low <= value <= high:
-            what = f"hardpoints.{far}: {key}" if key.startswith("distance") else key
-            warnings.warn(
-                f"{g.source}: {what} = {value:.4g} {unit_text} is outside the plausible "
-                f"{low:g}…{high:g} {unit_text} (a unit mistake?)".replace("  ", " "),
-                PlausibilityWarning,
-                stacklevel=3,
-            )
+        what = f"hardpoints.{far}: {key}" if key.startswith("distance") else key
+        warn_outside(f"{g.source}: {what}", value, *PLAUSIBLE[key])
+
+
+def warn_outside(what: str, value: float, low: float, high: float, unit_text: str) -> None:
+    """A PlausibilityWarning when ``value`` is outside low…high (NaN is not: undefined
+    is not implausible)."""
+    if value < low or value > high:
+        warnings.warn(
+            f"{what} = {value:.4g} {unit_text} is outside the plausible "
+            f"{low:g}…{high:g} {unit_text} (a unit mistake?)".replace("  ", " "),
+            PlausibilityWarning,
+            stacklevel=3,
+        )
 
 
 def _parse(data: dict, r: Reader, sha: str | None) -> Geometry:
