@@ -387,7 +387,8 @@ def _validate(args) -> int:
         f"{corner.geometry.name}: {len(results)} steps of {sweep.source}, each re-solved from "
         "the design state; largest |difference| to pin_susp"
     )
-    print(f"  {'column':<34}{'unit':>6}" + "".join(f"{r.engine:>14}" for r in reports))
+    width = max(map(len, names), default=6) + 2
+    print(f"  {'column':<{width}}{'unit':>7}" + "".join(f"{r.engine:>14}" for r in reports))
     for name in names:
         unit = next(r.units[name] for r in reports if name in r.units)
         cells = "".join(
@@ -396,7 +397,7 @@ def _validate(args) -> int:
             else f"{'-':>14}"
             for r in reports
         )
-        print(f"  {name:<34}{unit:>6}{cells}")
+        print(f"  {name:<{width}}{unit:>7}{cells}")
     ok = _report_failures(results, "are not compared") == 0
     for r in reports:
         if r.note:

@@ -36,8 +36,9 @@ class Kinematics:
         pin.framesForwardKinematics(self.model, self.data, q)
 
     def frame_jacobian(self, frame_id: int) -> np.ndarray:
-        """6×nv: linear velocity of the frame origin, then angular velocity, world axes."""
-        return pin.getFrameJacobian(self.model, self.data, frame_id, WORLD)
+        """6×nv: linear velocity of the frame origin, then angular velocity, world axes.
+        (Pinocchio returns a 6-vector when nv = 1: reshaped.)"""
+        return pin.getFrameJacobian(self.model, self.data, frame_id, WORLD).reshape(6, -1)
 
 
 class FramePoint:
@@ -62,12 +63,16 @@ class ContactPatchPoint:
     u = −Ẑ + a_z·â, du = (dâ·Ẑ)·â + a_z·dâ and dd̂ = (I − d̂d̂ᵀ)·du / |u|.
     """
 
-    body = "upright"
-
     def __init__(
-        self, name: str, center: FramePoint, axle_in: FramePoint, axle_out: FramePoint, radius
+        self,
+        name: str,
+        center: FramePoint,
+        axle_in: FramePoint,
+        axle_out: FramePoint,
+        radius,
+        body: str = "upright",
     ):
-        self.name = name
+        self.name, self.body = name, body
         self.center, self.axle_in, self.axle_out = center, axle_in, axle_out
         self.radius = radius
 

@@ -19,21 +19,13 @@ from .yamlio import MAX_LENGTH_MM, Reader, load_yaml
 MM = 1e-3
 INCH = 0.0254
 
-WISHBONE_POINTS = (
-    "lower_wishbone_inboard_front",
-    "lower_wishbone_inboard_rear",
-    "lower_wishbone_outboard",
-    "upper_wishbone_inboard_front",
-    "upper_wishbone_inboard_rear",
-    "upper_wishbone_outboard",
-)
 STEERING_POINTS = {
     "rack": ("trackrod_inboard", "trackrod_outboard"),
     "none": ("toe_link_inboard", "toe_link_outboard"),
 }
 AXLE_POINTS = ("axle_inboard", "axle_outboard")
-PUSHROD_ROCKER_POINTS = ("pushrod_outboard", "pushrod_inboard", "rocker_axis_a", "rocker_axis_b")
 COILOVER_POINTS = ("strut_top", "strut_bottom")
+PUSHROD_ROCKER_POINTS = ("pushrod_outboard", "pushrod_inboard", "rocker_axis_a", "rocker_axis_b")
 
 # Points computed from the upright's hardpoints and the wheel (spec/geometry.md).
 DERIVED_POINTS = (
@@ -89,6 +81,18 @@ class CamberShim:
 
 
 @dataclass(frozen=True)
+class Options:
+    """The choices that decide a corner's hardpoints (a Geometry has them too)."""
+
+    type: str
+    side: str
+    steering: str
+    actuation: str
+    actuation_mount: str
+    spring: str
+
+
+@dataclass(frozen=True)
 class Geometry:
     """One suspension corner at its design condition, SI units, world frame."""
 
@@ -112,6 +116,9 @@ class Geometry:
     # the wheel's move relative to the chassis it caused (m, + = car higher).
     drawn: Geometry | None = None
     ride_height_change: float = 0.0
+    type: str = "double_wishbone"  # the mechanism (pin_susp.mechanisms)
+    strut: dict | None = None  # config.strut (MacPherson): rate N/mm, preload N
+    opposite_axle_axis_height: float | None = None  # m, config (read, for the axle's pitch)
     source: str = "<dict>"
     sha256: str | None = None
     data: dict = field(default_factory=dict, repr=False)
@@ -120,6 +127,13 @@ class Geometry:
     def sign(self) -> float:
         """s = +1 for a left corner, −1 for a right one (spec/results.md)."""
         return 1.0 if self.side == "left" else -1.0
+
+    @property
+    def mechanism(self):
+        """The mechanism module of this corner's ``type`` (pin_susp.mechanisms)."""
+        from . import mechanisms
+
+        return mechanisms.get(self.type)
 
     @property
     def has_pushrod(self) -> bool:
@@ -136,41 +150,18 @@ class Geometry:
         )
 
     @property
-    def steering_points(self) -> tuple[str, str]:
-        """(inboard, outboard) of the trackrod, or of the fixed toe link."""
-        return STEERING_POINTS[self.steering]
+    def steering_points(self) -> tuple[str, str] | tuple[()]:
+        """(inboard, outboard) of the trackrod, or of the fixed toe link; () for a
+        mechanism without one (a trailing arm)."""
+        if "toe_link_inboard" in self.hardpoints or "trackrod_inboard" in self.hardpoints:
+            return STEERING_POINTS[self.steering]
+        return ()
 
     def design_points(self) -> dict[str, np.ndarray]:
         """Every hardpoint and derived point at the design condition."""
         points = dict(self.hardpoints)
         points.update(wheel_points(points["axle_inboard"], points["axle_outboard"], self.wheel))
         return points
-
-
-def hardpoint_names(steering: str, actuation: str, spring: str) -> tuple[str, ...]:
-    """The hardpoints of a double-wishbone corner, in output order."""
-    names = WISHBONE_POINTS + STEERING_POINTS[steering] + AXLE_POINTS
-    if actuation == "pushrod_rocker":
-        names += PUSHROD_ROCKER_POINTS
-    if spring == "coilover":
-        names += COILOVER_POINTS
-    return names
-
-
-def wheel_side_points(steering: str, actuation: str, mount: str, spring: str) -> tuple[str, ...]:
-    """The hardpoints that ride with the wheel: outboard joints and upright mounts."""
-    names = (
-        "lower_wishbone_outboard",
-        "upper_wishbone_outboard",
-        STEERING_POINTS[steering][1],
-        *AXLE_POINTS,
-    )
-    if mount == "upright":
-        if actuation == "pushrod_rocker":
-            names += ("pushrod_outboard",)
-        elif spring == "coilover":
-            names += ("strut_bottom",)
-    return names
 
 
 def unit(v: np.ndarray) -> np.ndarray:
@@ -277,6 +268,8 @@ def warn_outside(what: str, value: float, low: float, high: float, unit_text: st
 
 
 def _parse(data: dict, r: Reader, sha: str | None) -> Geometry:
+    from . import mechanisms
+
     r.mapping(
         data,
         "",
@@ -293,9 +286,8 @@ def _parse(data: dict, r: Reader, sha: str | None) -> Geometry:
             "config",
         ),
     )
-    kind = r.choice(data.get("type", "double_wishbone"), "type", ("double_wishbone", "macpherson"))
-    if kind != "double_wishbone":
-        r.fail("type", "macpherson is not supported yet (this version models double_wishbone)")
+    kind = r.choice(data.get("type", "double_wishbone"), "type", mechanisms.NAMES)
+    mech = mechanisms.get(kind)
     scope = r.choice(data.get("scope", "corner"), "scope", ("corner", "axle"))
     if scope != "corner":
         r.fail("scope", "axle is not supported yet (this version models one corner)")
@@ -304,18 +296,6 @@ def _parse(data: dict, r: Reader, sha: str | None) -> Geometry:
     if "version" in data:
         r.text(data["version"], "version")
     r.choice(data.get("units", "millimeters"), "units", ("millimeters",))
-
-    act = r.mapping(data.get("actuation", {}), "actuation", optional=("type", "mount"))
-    actuation = r.choice(act.get("type", "direct"), "actuation.type", ("direct", "pushrod_rocker"))
-    mount = r.choice(
-        act.get("mount", "lower_wishbone"), "actuation.mount", ("lower_wishbone", "upright")
-    )
-    spring_map = r.mapping(data.get("spring", {}), "spring", optional=("type",))
-    spring = r.choice(
-        spring_map.get("type", "none"), "spring.type", ("none", "coilover", "torsion_bar")
-    )
-    if spring == "torsion_bar" and actuation != "pushrod_rocker":
-        r.fail("spring.type", "a torsion bar needs actuation type pushrod_rocker")
 
     config = r.mapping(
         data.get("config"),
@@ -330,21 +310,37 @@ def _parse(data: dict, r: Reader, sha: str | None) -> Geometry:
             "driven_axle",
             "camber_shim",
             "setup",
+            "strut",
+            "opposite_axle_axis_height",
         ),
     )
-    steer_map = r.mapping(config.get("steering", {}), "config.steering", optional=("type",))
-    steering = r.choice(steer_map.get("type", "rack"), "config.steering.type", ("rack", "none"))
-    wheel = _wheel(config["wheel"], r)
+    for key, why in mech.FORBIDDEN.items():
+        top, _, sub = key.partition(".")
+        if (sub in config) if top == "config" else (key in data):
+            r.fail(key, f"not for a {kind} corner: {why}")
 
-    names = hardpoint_names(steering, actuation, spring)
+    act = r.mapping(data.get("actuation", {}), "actuation", optional=("type", "mount"))
+    actuation = r.choice(act.get("type", mech.ACTUATION[0]), "actuation.type", mech.ACTUATION)
+    mount = r.choice(act.get("mount", mech.MOUNTS[0]), "actuation.mount", mech.MOUNTS)
+    spring_map = r.mapping(data.get("spring", {}), "spring", optional=("type",))
+    spring = r.choice(spring_map.get("type", mech.SPRINGS[0]), "spring.type", mech.SPRINGS)
+    if spring == "torsion_bar" and actuation != "pushrod_rocker":
+        r.fail("spring.type", "a torsion bar needs actuation type pushrod_rocker")
+
+    steer_map = r.mapping(config.get("steering", {}), "config.steering", optional=("type",))
+    steering = r.choice(
+        steer_map.get("type", mech.STEERING[0]), "config.steering.type", mech.STEERING
+    )
+    wheel = _wheel(config["wheel"], r)
+    options = Options(kind, side, steering, actuation, mount, spring)
+
+    names = mech.hardpoint_names(options)
     hp_map = data["hardpoints"]
     if not isinstance(hp_map, dict):
         r.fail("hardpoints", "expected a mapping of point name to {x, y, z}")
     for key in hp_map:
         if key not in names:
-            r.fail(
-                f"hardpoints.{key}", _unknown_point_hint(key, steering, actuation, spring, names)
-            )
+            r.fail(f"hardpoints.{key}", _unknown_point_hint(key, options, names))
     hardpoints = {}
     for key in names:
         if key not in hp_map:
@@ -354,7 +350,7 @@ def _parse(data: dict, r: Reader, sha: str | None) -> Geometry:
     sign = 1.0 if side == "left" else -1.0
     # Chassis pickups may cross the centreline (cross-car dampers, rockers, bars);
     # what rides with the wheel must be on the wheel's side.
-    for key in wheel_side_points(steering, actuation, mount, spring):
+    for key in mech.wheel_side_points(options):
         p = hardpoints[key]
         if sign * p[1] < 0.0:
             want = "y >= 0" if side == "left" else "y <= 0"
@@ -363,11 +359,24 @@ def _parse(data: dict, r: Reader, sha: str | None) -> Geometry:
                 f"y = {p[1] / MM:g} mm on a {side} corner (the points that ride with the "
                 f"wheel have {want}; check 'side' or the sign of y)",
             )
-    _check_linkage(hardpoints, steering, actuation, spring, sign, r)
-    adjusters = _setup_block(config.get("setup", {}), actuation, r)
+    if np.linalg.norm(hardpoints["axle_outboard"] - hardpoints["axle_inboard"]) < COINCIDENT:
+        r.fail(
+            "hardpoints.axle_outboard",
+            "coincides with axle_inboard: the spin axis needs two distinct points",
+        )
+    spin = unit(hardpoints["axle_outboard"] - hardpoints["axle_inboard"])
+    if sign * spin[1] <= 0.0:
+        r.fail(
+            "hardpoints.axle_outboard",
+            "the spin axis axle_inboard→axle_outboard points inboard or straight up/down: "
+            f"axle_outboard must be outboard (toward {'+' if sign > 0 else '-'}y) of axle_inboard",
+        )
+    mech.prepare(hardpoints, options, r)
+    adjusters = _setup_block(config.get("setup", {}), actuation, mech.steering_points(options), r)
 
     cg = config.get("cg_position")
     bias = config.get("front_brake_bias")
+    height = config.get("opposite_axle_axis_height")
     return Geometry(
         name=name,
         side=side,
@@ -399,10 +408,26 @@ def _parse(data: dict, r: Reader, sha: str | None) -> Geometry:
         ),
         trackrod_length_delta=adjusters[0],
         pushrod_length_delta=adjusters[1],
+        type=kind,
+        strut=None if "strut" not in config else _strut(config["strut"], r),
+        opposite_axle_axis_height=(
+            None if height is None else r.length(height, "config.opposite_axle_axis_height") * MM
+        ),
         source=r.source,
         sha256=sha,
         data=data,
     )
+
+
+def _strut(value, r: Reader) -> dict:
+    """config.strut: the MacPherson strut's spring (rate N/mm, preload N), for loads."""
+    s = r.mapping(value, "config.strut", optional=("rate", "preload"))
+    out = {}
+    if "rate" in s:
+        out["rate"] = r.positive(s["rate"], "config.strut.rate")
+    if "preload" in s:
+        out["preload"] = r.number(s["preload"], "config.strut.preload")
+    return out
 
 
 def _wheel(value, r: Reader) -> Wheel:
@@ -469,11 +494,13 @@ def _camber_shim(value, r: Reader) -> CamberShim:
     return CamberShim(a, b, n, design, setup)
 
 
-def _setup_block(value, actuation: str, r: Reader) -> tuple[float, float]:
+def _setup_block(value, actuation: str, link: tuple, r: Reader) -> tuple[float, float]:
     key = "config.setup"
     s = r.mapping(value, key, optional=("trackrod_length_delta", "pushrod_length_delta"))
     trackrod = r.length(s.get("trackrod_length_delta", 0.0), f"{key}.trackrod_length_delta")
     pushrod = r.length(s.get("pushrod_length_delta", 0.0), f"{key}.pushrod_length_delta")
+    if trackrod != 0.0 and not link:
+        r.fail(f"{key}.trackrod_length_delta", "this corner has no trackrod or toe link")
     if pushrod != 0.0 and actuation != "pushrod_rocker":
         r.fail(
             f"{key}.pushrod_length_delta",
@@ -482,65 +509,32 @@ def _setup_block(value, actuation: str, r: Reader) -> tuple[float, float]:
     return trackrod * MM, pushrod * MM
 
 
-def _check_linkage(
-    p: dict[str, np.ndarray], steering: str, actuation: str, spring: str, sign: float, r: Reader
-) -> None:
-    """Reject geometry that defines no mechanism: coincident ends, balls on pivots."""
-    inner, outer = STEERING_POINTS[steering]
-    pairs = [
-        ("lower_wishbone_inboard_front", "lower_wishbone_inboard_rear", "pivot axis"),
-        ("upper_wishbone_inboard_front", "upper_wishbone_inboard_rear", "pivot axis"),
-        ("lower_wishbone_outboard", "upper_wishbone_outboard", "steering axis"),
-        ("axle_inboard", "axle_outboard", "spin axis"),
-        (inner, outer, "link"),
-    ]
-    if spring == "coilover":
-        pairs.append(("strut_top", "strut_bottom", "coilover"))
-    if actuation == "pushrod_rocker":
-        pairs.append(("rocker_axis_a", "rocker_axis_b", "rocker axis"))
-        pairs.append(("pushrod_outboard", "pushrod_inboard", "pushrod"))
-    for a, b, what in pairs:
-        if np.linalg.norm(p[b] - p[a]) < COINCIDENT:
-            r.fail(f"hardpoints.{b}", f"coincides with {a}: the {what} needs two distinct points")
-    spin = unit(p["axle_outboard"] - p["axle_inboard"])
-    if sign * spin[1] <= 0.0:
-        r.fail(
-            "hardpoints.axle_outboard",
-            "the spin axis axle_inboard→axle_outboard points inboard or straight up/down: "
-            f"axle_outboard must be outboard (toward {'+' if sign > 0 else '-'}y) of axle_inboard",
-        )
-    for arm in ("lower_wishbone", "upper_wishbone"):
-        front = p[f"{arm}_inboard_front"]
-        axis = unit(p[f"{arm}_inboard_rear"] - front)
-        arm_vec = p[f"{arm}_outboard"] - front
-        if np.linalg.norm(arm_vec - axis * (arm_vec @ axis)) < COINCIDENT:
-            r.fail(
-                f"hardpoints.{arm}_outboard",
-                f"lies on the {arm} pivot axis (inboard_front→inboard_rear): the arm has no length",
-            )
-    if actuation == "pushrod_rocker":
-        axis = unit(p["rocker_axis_b"] - p["rocker_axis_a"])
-        arm_vec = p["pushrod_inboard"] - p["rocker_axis_a"]
-        if np.linalg.norm(arm_vec - axis * (arm_vec @ axis)) < COINCIDENT:
-            r.fail(
-                "hardpoints.pushrod_inboard",
-                "lies on the rocker axis (rocker_axis_a→rocker_axis_b): the pushrod cannot turn it",
-            )
+def _unknown_point_hint(key: str, o: Options, names: tuple[str, ...]) -> str:
+    from . import mechanisms
 
-
-def _unknown_point_hint(
-    key: str, steering: str, actuation: str, spring: str, names: tuple[str, ...]
-) -> str:
     for other, pts in STEERING_POINTS.items():
-        if key in pts and other != steering:
+        if key in pts and other != o.steering and key not in names:
             return (
-                f"not a point of a corner with config.steering.type {steering}"
+                f"not a point of a corner with config.steering.type {o.steering}"
                 f" (it belongs to {other})"
             )
-    if key in COILOVER_POINTS and spring != "coilover":
+    if key in COILOVER_POINTS and o.spring != "coilover":
         return "not a point of this corner (strut points need spring type coilover)"
-    if key in PUSHROD_ROCKER_POINTS and actuation != "pushrod_rocker":
+    if key in PUSHROD_ROCKER_POINTS and o.actuation != "pushrod_rocker":
         return (
             "not a point of this corner (pushrod and rocker points need actuation pushrod_rocker)"
         )
+    for other in mechanisms.NAMES:
+        if other != o.type:
+            mech = mechanisms.get(other)
+            every = Options(
+                other,
+                o.side,
+                mech.STEERING[0],
+                mech.ACTUATION[-1],
+                mech.MOUNTS[0],
+                "coilover" if "coilover" in mech.SPRINGS else mech.SPRINGS[0],
+            )
+            if key in mech.hardpoint_names(every):
+                return f"not a point of a {o.type} corner (it is a {other} point; check 'type')"
     return f"unknown hardpoint (this corner has: {', '.join(names)})"

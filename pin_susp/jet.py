@@ -197,3 +197,24 @@ _FUNCTIONS = {
     np.linalg.norm: _norm,
     np.where: _where,
 }
+
+
+def rate(x, i: int):
+    """The rate of x along driver ``i``, kept as the same kind of object.
+
+    The drivers (hub z, rack) are the innermost level of the points a sweep
+    or a sensitivity computes: ``Dual(position, rates)`` with rates (k, n, 3),
+    or, for hardpoint sensitivities, that inside a Dual over hardpoints whose
+    derivative part is ``Dual(d position/dh (n_h, 1, n, 3), d rates/dh (n_h, k,
+    n, 3))``. The result has the same nesting, its value the rate along driver
+    i; the rate's own change along the drivers (a second derivative) is not
+    known and is NaN. A plain array has no rates: NaN.
+    """
+    if not isinstance(x, Dual):
+        return np.full(np.shape(x), np.nan)
+    if isinstance(x.val, Dual):
+        outer = x.der
+        return Dual(
+            rate(x.val, i), Dual(outer.der[:, i : i + 1], np.full(np.shape(outer.der), np.nan))
+        )
+    return Dual(x.der[i], np.full(np.shape(x.der), np.nan))

@@ -24,11 +24,13 @@ import numpy as np
 
 from .geometry import Geometry, unit
 from .jet import Dual, value
+from .jet import rate as jet_rate
 
 STEERING_AXIS_FLAT = 1e-6  # |k_z| below this: the axis never meets the ground
 PARALLEL_PLANES = 1e-12  # |n₁ × n₂|² below this (unit normals): no instant axis
 HUB_Z, RACK = "hub_z", "rack_displacement"
 X, Y, Z = 0, 1, 2
+EYE = np.eye(3)
 
 
 @dataclass
@@ -56,42 +58,58 @@ class PointSet:
     def spin_axis(self):
         return self._cached("spin", lambda: unit(self["axle_outboard"] - self["axle_inboard"]))
 
+    def kingpin(self):
+        """(lower, upper) points of the steering axis (the mechanism's), or None."""
+        return self._cached("kingpin", lambda: self.geometry.mechanism.kingpin(self))
+
+    def _undefined(self):
+        """NaN shaped like a point (its rates NaN too): for axes a mechanism lacks."""
+        return self["wheel_center"] * np.nan
+
     def steering_axis(self):
-        return self._cached(
-            "steer", lambda: unit(self["upper_wishbone_outboard"] - self["lower_wishbone_outboard"])
-        )
+        """k̂ = unit(upper − lower) of the kingpin; NaN without one (a trailing arm)."""
+
+        def axis():
+            ends = self.kingpin()
+            return self._undefined() if ends is None else unit(ends[1] - ends[0])
+
+        return self._cached("steer", axis)
 
     def steering_axis_on_ground(self):
-        """G = LBJ + t·K, K = UBJ − LBJ, t = (CP_z − LBJ_z)/K_z: the axis at CP height."""
+        """G = L + t·K, K = U − L, t = (CP_z − L_z)/K_z: the axis at CP height."""
         return self._cached("ground", self._steering_axis_on_ground)
 
     def _steering_axis_on_ground(self):
-        lbj = self["lower_wishbone_outboard"]
-        k = self["upper_wishbone_outboard"] - lbj
+        ends = self.kingpin()
+        if ends is None:
+            return self._undefined()
+        lower, upper = ends
+        k = upper - lower
         flat = np.abs(unit(k)[..., Z]) < STEERING_AXIS_FLAT
         kz = np.where(flat, np.nan, k[..., Z])
-        t = (self["contact_patch_center"][..., Z] - lbj[..., Z]) / kz
-        return lbj + t[..., None] * k
+        t = (self["contact_patch_center"][..., Z] - lower[..., Z]) / kz
+        return lower + t[..., None] * k
 
     def instant_axis_point(self, axis: int):
-        """Where the wishbone planes' line of intersection crosses the plane through WC
-        normal to ``axis`` (Y: side view, X: front view); NaN when the planes are parallel.
+        """Where the instant axis crosses the plane through WC normal to ``axis`` (Y:
+        side view, X: front view); NaN where there is none.
 
-        Solved as two plane equations in the two other coordinates, relative to WC
-        (Cramer's rule; the determinant is a component of n₁ × n₂), so a near-parallel
-        pair gives a large but accurate point.
+        From the mechanism's two planes when it names them (the wishbone planes),
+        solved as two plane equations in the two other coordinates, relative to WC
+        (Cramer's rule; the determinant is a component of n₁ × n₂), so a
+        near-parallel pair gives a large but accurate point. Otherwise from the
+        upright's bump twist: the point of that plane whose velocity has no
+        component in it (the front- or side-view pole).
         """
         return self._cached(("ic", axis), lambda: self._instant_axis_point(axis))
 
     def _instant_axis_point(self, axis: int):
+        planes = self.geometry.mechanism.instant_planes(self)
+        if planes is None:
+            return self._pole(axis)
         wc = self["wheel_center"]
-        normals, offsets = [], []
-        for arm in ("upper_wishbone", "lower_wishbone"):
-            front = self[f"{arm}_inboard_front"]
-            n = unit(np.cross(self[f"{arm}_inboard_rear"] - front, self[f"{arm}_outboard"] - front))
-            normals.append(n)
-            offsets.append(np.sum(n * (front - wc), axis=-1))
-        (n1, n2), (d1, d2) = normals, offsets
+        (n1, p1), (n2, p2) = planes
+        d1, d2 = np.sum(n1 * (p1 - wc), axis=-1), np.sum(n2 * (p2 - wc), axis=-1)
         parallel = np.sum(np.cross(n1, n2) ** 2, axis=-1) < PARALLEL_PLANES
         a, b = (Y, Z) if axis == X else (X, Z)
         det = n1[..., a] * n2[..., b] - n1[..., b] * n2[..., a]
@@ -99,6 +117,61 @@ class PointSet:
         u = (d1 * n2[..., b] - d2 * n1[..., b]) / det
         v = (n1[..., a] * d2 - n2[..., a] * d1) / det
         return u + wc[..., a], v + wc[..., b]
+
+    def twist(self, driver: int):
+        """The wheel body's twist along a driver (0: hub z, 1: rack): (ω, v at WC).
+
+        ω from the rates of the mechanism's upright points (a rigid body:
+        v_i − v_c = ω × (p_i − p_c), solved in the least-squares sense with the
+        3×3 matrix M = Σ(|r|²I − r rᵀ) inverted by its adjugate, so that it runs
+        on jet.Duals); NaN without rates.
+        """
+        return self._cached(("twist", driver), lambda: self._twist(driver))
+
+    def _twist(self, driver: int):
+        names = self.geometry.mechanism.upright_points(self.geometry)
+        pts = [self[n] for n in names]
+        vel = [jet_rate(self[n], driver) for n in names]
+        c = sum(pts[1:], pts[0]) * (1.0 / len(pts))
+        vc = sum(vel[1:], vel[0]) * (1.0 / len(vel))
+        m = [0.0, 0.0, 0.0]  # columns of M
+        b = 0.0
+        for p, v in zip(pts, vel, strict=True):
+            r = p - c
+            rr = np.sum(r * r, axis=-1)[..., None]
+            for j in range(3):
+                m[j] = m[j] + rr * EYE[j] - r * r[..., j][..., None]
+            b = b + np.cross(r, v - vc)
+        rows = (np.cross(m[1], m[2]), np.cross(m[2], m[0]), np.cross(m[0], m[1]))
+        det = np.sum(m[0] * rows[0], axis=-1)[..., None]
+        w = sum(np.sum(rows[j] * b, axis=-1)[..., None] * EYE[j] for j in range(3)) / det
+        v_wc = vc + np.cross(w, self["wheel_center"] - c)
+        return w, v_wc
+
+    def _pole(self, axis: int):
+        """Front view (axis X): FVIC = (WC_y − v_z/ω_x, WC_z + v_y/ω_x); side view:
+        SVIC = (WC_x + v_z/ω_y, WC_z − v_x/ω_y), with the bump twist (ω, v at WC)."""
+        w, v = self.twist(0)
+        wc = self["wheel_center"]
+        if axis == X:
+            wx = w[..., X]
+            return wc[..., Y] - v[..., Z] / wx, wc[..., Z] + v[..., Y] / wx
+        wy = w[..., Y]
+        return wc[..., X] + v[..., Z] / wy, wc[..., Z] - v[..., X] / wy
+
+    def steer_screw(self):
+        """The steer screw axis: unit direction (upward), a point, and the pitch (m/rad),
+        from the upright's twist along the steering driver."""
+
+        def screw():
+            w, v_wc = self.twist(1)
+            v0 = v_wc - np.cross(w, self["wheel_center"])  # the body point at the origin
+            ww = np.sum(w * w, axis=-1)
+            up = np.where(w[..., Z] < 0.0, -1.0, 1.0)[..., None]
+            k = unit(w) * up
+            return k, np.cross(w, v0) / ww[..., None], np.sum(w * v0, axis=-1) / ww
+
+        return self._cached("screw", screw)
 
 
 def camber(ps: PointSet):
@@ -185,6 +258,24 @@ def rack_displacement(ps: PointSet):
     return ps["trackrod_inboard"][..., Y] - ps.design["trackrod_inboard"][..., Y]
 
 
+def isa_caster(ps: PointSet):
+    """The steer screw axis's caster: atan2(−k_x, k_z), k̂ upward."""
+    k = ps.steer_screw()[0]
+    return np.arctan2(-k[..., X], k[..., Z])
+
+
+def isa_kpi(ps: PointSet):
+    """The steer screw axis's inclination: atan2(−s·k_y, k_z)."""
+    k = ps.steer_screw()[0]
+    return np.arctan2(-ps.s * k[..., Y], k[..., Z])
+
+
+def isa_pitch(ps: PointSet):
+    """The steer screw's pitch ω·v₀/|ω|² (mm/rad in the CSV): travel along the axis
+    per radian about it."""
+    return ps.steer_screw()[2]
+
+
 def svic_x(ps: PointSet):
     """Side-view instant centre x: instant axis ∩ plane y = WC_y."""
     return ps.instant_axis_point(Y)[0]
@@ -264,6 +355,11 @@ def _rack(g: Geometry) -> bool:
     return g.steering == "rack"
 
 
+def _steered(g: Geometry) -> bool:
+    """The steer screw axis: along the rack (the toe link's length: not yet a driver)."""
+    return g.steering == "rack"
+
+
 def _anti(axle: str, needs_bias: bool):
     def applies(g: Geometry) -> bool:
         have = g.axle_position == axle and g.wheelbase is not None and g.cg_position is not None
@@ -287,7 +383,7 @@ class Metric:
     """
 
     name: str
-    unit: str  # "deg", "mm" or "%"
+    unit: str  # "deg", "mm", "mm/rad" or "%"
     label: str
     function: Callable[[PointSet], np.ndarray]
     applies: Callable[[Geometry], bool] = field(default=_always)
@@ -296,11 +392,12 @@ class Metric:
     written: bool = True  # False: a point coordinate, already a column, for its derivative
     needs: str = ""  # the inputs an always-written column needs to have values
     plausible: tuple[float, float] | None = None  # at design, in output units (a warning)
+    rates: bool = False  # computed from the points' rates (a twist), not positions alone
 
     @property
     def scale(self) -> float:
         """SI → output unit."""
-        return {"deg": 180.0 / np.pi, "mm": 1e3, "%": 1.0}[self.unit]
+        return {"deg": 180.0 / np.pi, "mm": 1e3, "mm/rad": 1e3, "%": 1.0}[self.unit]
 
 
 BOTH = (HUB_Z, RACK)
@@ -335,7 +432,7 @@ METRICS = (
         "mm",
         "Damper length",
         damper_length,
-        lambda g: g.spring == "coilover",
+        lambda g: "strut_top" in g.hardpoints,
         drivers=(HUB_Z,),
     ),
     Metric(
@@ -362,6 +459,33 @@ METRICS = (
         lambda g: g.has_pushrod,
     ),
     Metric("rack_displacement", "mm", "Rack travel from centre", rack_displacement, _rack),
+    Metric(
+        "isa_caster",
+        "deg",
+        "Steer screw axis caster",
+        isa_caster,
+        _steered,
+        always_written=True,
+        rates=True,
+    ),
+    Metric(
+        "isa_kpi",
+        "deg",
+        "Steer screw axis inclination",
+        isa_kpi,
+        _steered,
+        always_written=True,
+        rates=True,
+    ),
+    Metric(
+        "isa_pitch",
+        "mm/rad",
+        "Steer screw pitch",
+        isa_pitch,
+        _steered,
+        always_written=True,
+        rates=True,
+    ),
     Metric("svic_x", "mm", "Side-view IC x", svic_x, always_written=True),
     Metric("svic_z", "mm", "Side-view IC z", svic_z, always_written=True),
     Metric("fvic_y", "mm", "Front-view IC y", fvic_y, always_written=True),

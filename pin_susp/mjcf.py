@@ -18,7 +18,7 @@ import numpy as np
 
 from .errors import PinSuspError
 from .geometry import unit
-from .urdf import BALL_AXES, Tree, _fmt
+from .urdf import Tree, _fmt
 
 MASS = "0.001"  # kg; kinematics only, but MuJoCo needs moving bodies to have mass
 INERTIA = "1e-06 1e-06 1e-06"
@@ -43,14 +43,16 @@ def tree_to_mjcf(tree: Tree, comment: str = "") -> str:
             continue
         j = body.joint
         parent = body.parent
-        if j.kind == "ball":
-            steps = [
-                (f"{j.name}_link_{k}" if i < 2 else body.name, f"{j.name}_{k}", "hinge", a)
-                for i, (k, a) in enumerate(BALL_AXES)
-            ]
-        else:
-            kind = "slide" if j.kind == "prismatic" else "hinge"
-            steps = [(body.name, j.name, kind, j.axis)]
+        parts = j.steps()
+        steps = [
+            (
+                body.name if i == len(parts) - 1 else f"{j.name}_link{suffix}",
+                f"{j.name}{suffix}",
+                "slide" if kind == "prismatic" else "hinge",
+                axis,
+            )
+            for i, (suffix, kind, axis) in enumerate(parts)
+        ]
         for name, joint, kind, axis in steps:
             el = ET.SubElement(
                 element[parent], "body", {"name": name, "pos": _fmt(j.origin - origin[parent])}

@@ -20,49 +20,37 @@ Y = np.array([0.0, 1.0, 0.0])
 
 
 class PointwiseCorner:
-    """A corner as points and distances (SI units)."""
+    """A corner as points and distances (SI units).
+
+    The mechanism says which points move as one rigid part, which are joined
+    by links, which stay on a line (``Mechanism.pointwise``); here each part
+    becomes every distance between its points, each link one distance, each
+    line condition the cross product (p − a) × unit(b − a) = 0.
+    """
 
     def __init__(self, geometry: Geometry, hardpoints: dict[str, np.ndarray] | None = None):
         g = geometry
         hp = dict(hardpoints or g.hardpoints)
         self.geometry = g
-        self.inner, self.outer = g.steering_points
-        mount = g.actuation_mount
+        spec = g.mechanism.pointwise(g)
+        self.inner = spec.rack
+        fixed = set(spec.fixed)
+        # points of one part that coincide are one point (two links meeting in a ball)
+        self.alias = {}
+        for pts in spec.parts.values():
+            for a, b in itertools.combinations(pts, 2):
+                if b not in self.alias and np.linalg.norm(hp[a] - hp[b]) < 1e-12:
+                    self.alias[b] = self.alias.get(a, a)
         parts = {
-            "lower_wishbone": [
-                "lower_wishbone_inboard_front",
-                "lower_wishbone_inboard_rear",
-                "lower_wishbone_outboard",
-            ],
-            "upper_wishbone": [
-                "upper_wishbone_inboard_front",
-                "upper_wishbone_inboard_rear",
-                "upper_wishbone_outboard",
-            ],
-            "upright": [
-                "lower_wishbone_outboard",
-                "upper_wishbone_outboard",
-                self.outer,
-                "axle_inboard",
-                "axle_outboard",
-            ],
+            k: list(dict.fromkeys(self.alias.get(n, n) for n in pts))
+            for k, pts in spec.parts.items()
         }
-        fixed = {n for n in hp if "inboard_front" in n or "inboard_rear" in n}
-        fixed |= {"strut_top", "rocker_axis_a", "rocker_axis_b"}
-        if g.steering == "none":
-            fixed.add(self.inner)
-        links = [(self.outer, self.inner)]
-        if g.has_pushrod:
-            parts[mount].append("pushrod_outboard")
-            parts["rocker"] = ["rocker_axis_a", "rocker_axis_b", "pushrod_inboard"]
-            if g.spring == "coilover":
-                parts["rocker"].append("strut_bottom")
-            links.append(("pushrod_outboard", "pushrod_inboard"))
-        elif g.spring == "coilover":
-            parts[mount].append("strut_bottom")
-        self.moving = sorted({n for pts in parts.values() for n in pts} - fixed - {self.inner})
+        links = [(self.alias.get(a, a), self.alias.get(b, b)) for a, b in spec.links]
+        self.lines = [tuple(self.alias.get(n, n) for n in line) for line in spec.lines]
+        named = {n for pts in parts.values() for n in pts} | {n for ab in links for n in ab}
+        self.moving = sorted(named - fixed - {self.inner})
         self.column = {n: 3 * i for i, n in enumerate(self.moving)}
-        self.rack = 3 * len(self.moving) if g.steering == "rack" else None
+        self.rack = 3 * len(self.moving) if self.inner is not None else None
         self.pairs = [
             (a, b, float(np.linalg.norm(hp[a] - hp[b])))
             for pts in parts.values()
@@ -80,6 +68,7 @@ class PointwiseCorner:
         """Every hardpoint and derived point for the unknowns x."""
         out = dict(self.hp)
         out.update({n: x[c : c + 3] for n, c in self.column.items()})
+        out.update({b: out[a] for b, a in self.alias.items()})
         if self.rack is not None:
             out[self.inner] = self.hp[self.inner] + x[self.rack] * Y
         wheel = self.geometry.wheel
@@ -100,6 +89,8 @@ class PointwiseCorner:
         p = self.points(x)
         rows = [np.linalg.norm(p[a] - p[b]) - d for a, b, d in self.pairs]
         rows += [p[name] @ d - value for name, d, value in targets]
+        for point, a, b in self.lines:
+            rows += list(np.cross(p[point] - p[a], (p[b] - p[a]) / np.linalg.norm(p[b] - p[a])))
         return np.array(rows)
 
     def jacobian(self, x: np.ndarray, targets) -> np.ndarray:
@@ -107,7 +98,7 @@ class PointwiseCorner:
         upright (through â = unit(AO − AI)); a contact-patch target by central
         differences."""
         p = self.points(x)
-        J = np.zeros((len(self.pairs) + len(targets), len(x)))
+        J = np.zeros((len(self.pairs) + len(targets) + 3 * len(self.lines), len(x)))
         for row, (a, b, _) in enumerate(self.pairs):
             u = (p[a] - p[b]) / np.linalg.norm(p[a] - p[b])
             self._add(J[row], a, u)
@@ -125,12 +116,21 @@ class PointwiseCorner:
                     e = np.zeros(len(x))
                     e[i] = h
                     row[i] = (self.points(x + e)[name] - self.points(x - e)[name]) @ d / (2 * h)
+        if self.lines:  # the line conditions by central differences
+            first, h = len(self.pairs) + len(targets), 1e-7
+            for i in range(len(x)):
+                e = np.zeros(len(x))
+                e[i] = h
+                up, down = self.residual(x + e, targets), self.residual(x - e, targets)
+                J[first:, i] = (up[first:] - down[first:]) / (2 * h)
         return J
 
     def _add(self, row: np.ndarray, name: str, gradient: np.ndarray) -> None:
         """Add d(row)/d(point) = gradient to the row's columns of that point."""
         if name in self.column:
             row[self.column[name] : self.column[name] + 3] += gradient
+        elif name in self.alias:
+            self._add(row, self.alias[name], gradient)
         elif name == self.inner and self.rack is not None:
             row[self.rack] += gradient[1]
 

@@ -91,6 +91,7 @@ class HardpointSensitivity:
             self.points["axle_inboard"],
             self.points["axle_outboard"],
             g.wheel.radius,
+            corner.mechanism.WHEEL_BODY,
         )
         self.B = self._virtual_map()
         # Design positions move with the hardpoints too (relative targets, wheel travel).
@@ -117,12 +118,20 @@ class HardpointSensitivity:
             Dual(g.hardpoints["axle_outboard"], seed["axle_outboard"]),
             g.wheel,
         )
+        # hardpoints placed by others (the MacPherson clamp on its strut line)
+        seeds = {}
+        for h in g.hardpoints:
+            d = np.zeros((n_h, 3))
+            d[[col[h, a] for a in range(3)], range(3)] = 1.0
+            seeds[h] = Dual(g.hardpoints[h], d)
+        settled = g.mechanism.settle(seeds)
         owners = {rec[1] for rec in self.params.values() if rec[0] == "point"}
         for f in owners:
             point = f.split("__")[-1] if f.startswith("anchor__") else f
-            if point in g.hardpoints:
-                d = np.zeros((n_h, 3))
-                d[[col[point, a] for a in range(3)], range(3)] = 1.0
+            if point in settled:
+                d = settled[point].der
+            elif point in g.hardpoints:
+                d = seeds[point].der
             else:
                 d = derived[point].der
             moves[f] = d
@@ -331,20 +340,21 @@ def _augment(tree: Tree) -> tuple[Tree, dict]:
 
     for body in tree.bodies:
         j = body.joint
-        if j is None or j.kind == "prismatic" or not j.defined_by:
+        if j is None or not j.defined_by:
             bodies.append(body)
             continue
+        axis_by_points = j.kind in ("revolute", "prismatic")  # tilts when its ends move
         links = [
             (f"{j.name}{V}o{AXES[a]}", "origin", a, ("origin", j.name, a, j.defined_by))
             for a in range(3)
         ]
-        if j.kind == "revolute":
+        if axis_by_points:
             links += [
                 (f"{j.name}{V}t{AXES[a]}", "tilt", a, ("tilt", j.name, a, j.defined_by))
                 for a in range(3)
             ]
         links.append((f"{j.name}{V}real", "real", 0, j))
-        if j.kind == "revolute":
+        if axis_by_points:
             links += [
                 (f"{j.name}{V}c{AXES[a]}", "tilt_back", a, ("tilt_back", j.name, a, j.defined_by))
                 for a in (2, 1, 0)

@@ -26,7 +26,6 @@ import numpy as np
 import pinocchio as pin
 
 from .closures import DistanceClosure, JointTarget, LoopBranch, PointTarget, chirality
-from .double_wishbone import corner_tree
 from .errors import InputError
 from .geometry import MM, Geometry, load_geometry
 from .jet import Dual
@@ -66,7 +65,7 @@ def apply_setup(g) -> Geometry:
 
 def _check_branches(drawn: Geometry, hardpoints: dict[str, np.ndarray], key: str) -> None:
     """The set-up corner must be the drawn mechanism: every loop on its drawn branch."""
-    for loop in corner_tree(drawn).closures:
+    for loop in drawn.mechanism.tree(drawn).closures:
         if not loop.branch:
             continue
         before = chirality(*(drawn.hardpoints[n] for n in loop.branch))
@@ -89,7 +88,7 @@ def _adjusted_hardpoints(g: Geometry) -> dict[str, np.ndarray]:
         "pushrod": g.pushrod_length_delta,
     }
     closures = [
-        DistanceClosure(c.name, c.a, c.b, c.length + delta[c.name])
+        DistanceClosure(c.name, c.a, c.b, c.length + delta.get(c.name, 0.0))
         if isinstance(c, DistanceClosure)
         else c
         for c in corner.closures
@@ -165,14 +164,17 @@ class SetupModel:
         self.drawn = g.drawn or g
         self.corner = Linkage(self.drawn)
         c = self.corner
-        self.ball = next(x for x in c.closures if x.name == "upper_ball_joint")
         self.links = {x.name: x for x in c.closures if isinstance(x, DistanceClosure)}
-        self.link_name = "trackrod" if "trackrod" in self.links else "toe_link"
+        self.link_name = next((n for n in ("trackrod", "toe_link") if n in self.links), None)
         shim = self.drawn.camber_shim
-        self.normal = shim.normal if shim is not None else np.zeros(3)
-        self.t_design = shim.design_thickness if shim is not None else 0.0
-        anchor = c.model.frames[self.ball.b.frame_id]
-        self.ubj_offset = anchor.placement.translation.copy()
+        # a camber shim (double wishbone): a rigid offset in the upper ball joint
+        self.ball = None
+        if shim is not None:
+            self.ball = next(x for x in c.closures if x.name == "upper_ball_joint")
+            self.normal = shim.normal
+            self.t_design = shim.design_thickness
+            anchor = c.model.frames[self.ball.b.frame_id]
+            self.ubj_offset = anchor.placement.translation.copy()
 
     def _set_shim(self, thickness: float) -> None:
         """The upright's UBJ anchor moves by −Δt·n₀ in the upright's frame."""
@@ -187,56 +189,64 @@ class SetupModel:
         c = self.corner
         kin = c.kin
         p = np.asarray(p, dtype=float)
-        self._set_shim(p[0])
-        link0 = self.links[self.link_name]
+        nv = c.model.nv
 
         # q₁: the shim alone, lower wishbone, rack and rocker held.
-        holds1 = [JointTarget(c.model, "lower_wishbone_pivot")]
-        holds1 += [
-            JointTarget(c.model, j)
-            for j in ("rack_slide", "rocker_pivot")
-            if c.model.existJointName(j)
-        ]
-        s1 = NewtonSolver(kin, [self.ball, link0], holds1, c.branches)
-        q1 = self._solve(
-            s1,
-            c.q_design,
-            PARAMETER_KEYS["shim_thickness"],
-            "the shimmed upright does not assemble",
-        )
-        s1.evaluate(q1)
-        j1 = s1.jacobian.copy()
-        f1_p = np.zeros((s1.nrows, 3))
-        f1_p[:3, 0] = -kin.data.oMf[self.ball.b.frame_id].rotation @ self.normal
-        dq1 = -np.linalg.solve(j1, f1_p)
-        pushrod_q1 = None
+        q1, dq1 = c.q_design, np.zeros((nv, 3))
+        if self.ball is not None:
+            self._set_shim(p[0])
+            holds1 = [JointTarget(c.model, "lower_wishbone_pivot")]
+            holds1 += [
+                JointTarget(c.model, j)
+                for j in ("rack_slide", "rocker_pivot")
+                if c.model.existJointName(j)
+            ]
+            s1 = NewtonSolver(kin, [self.ball, self.links[self.link_name]], holds1, c.branches)
+            q1 = self._solve(
+                s1,
+                c.q_design,
+                PARAMETER_KEYS["shim_thickness"],
+                "the shimmed upright does not assemble",
+            )
+            s1.evaluate(q1)
+            f1_p = np.zeros((s1.nrows, 3))
+            f1_p[:3, 0] = -kin.data.oMf[self.ball.b.frame_id].rotation @ self.normal
+            dq1 = -np.linalg.solve(s1.jacobian.copy(), f1_p)
+        kin.update(q1)
+        length1 = pushrod_q1 = None
         if "pushrod" in self.links:
             pr = self.links["pushrod"]
-            d = pr.b.position(kin) - pr.a.position(kin)
-            length1 = float(np.linalg.norm(d))
+            length1 = float(np.linalg.norm(pr.b.position(kin) - pr.a.position(kin)))
             pushrod_q1 = pr.jacobian(kin)[0]  # ∇_q of the pushrod length at q₁
         wc_q1 = c.points["wheel_center"].jacobian(kin)[2].copy()
 
-        # q₂: the adjusters, the static load path held.
-        closures = [self.ball, DistanceClosure(link0.name, link0.a, link0.b, link0.length + p[1])]
-        if pushrod_q1 is not None:
-            pr = self.links["pushrod"]
-            closures.append(DistanceClosure("pushrod", pr.a, pr.b, length1 + p[2]))
+        # q₂: the adjusters, the static load path held. Rows: the closures in the
+        # corner's order (the adjusted links with their new lengths), then the holds.
+        closures, rows = [], {}
+        for x in c.closures:
+            rows[x.name] = sum(y.size for y in closures)
+            if x.name == self.link_name:
+                x = DistanceClosure(x.name, x.a, x.b, x.length + p[1])
+            elif x.name == "pushrod":
+                x = DistanceClosure(x.name, x.a, x.b, length1 + p[2])
+            closures.append(x)
         s2 = NewtonSolver(kin, closures, _holds(c, q1), c.branches)
         key = PARAMETER_KEYS["pushrod_length" if p[2] else "trackrod_length"]
         q2 = self._solve(s2, q1, key, "the corner does not assemble with these lengths")
         s2.evaluate(q2)
-        j2 = s2.jacobian.copy()
         f2_p = np.zeros((s2.nrows, 3))
-        f2_p[:3, 0] = -kin.data.oMf[self.ball.b.frame_id].rotation @ self.normal
-        f2_p[3, 1] = -1.0
-        f2_q1 = np.zeros((s2.nrows, c.model.nv))
+        f2_q1 = np.zeros((s2.nrows, nv))
+        if self.ball is not None:
+            ball = rows[self.ball.name]
+            f2_p[ball : ball + 3, 0] = -kin.data.oMf[self.ball.b.frame_id].rotation @ self.normal
+        if self.link_name is not None:
+            f2_p[rows[self.link_name], 1] = -1.0
         if pushrod_q1 is not None:
-            f2_p[4, 2] = -1.0
-            f2_q1[4] = -pushrod_q1
+            f2_p[rows["pushrod"], 2] = -1.0
+            f2_q1[rows["pushrod"]] = -pushrod_q1
         else:
             f2_q1[-1] = -wc_q1
-        dq2 = -np.linalg.solve(j2, f2_p + f2_q1 @ dq1)
+        dq2 = -np.linalg.solve(s2.jacobian.copy(), f2_p + f2_q1 @ dq1)
         return self._metrics(q2, dq2, p)
 
     def _solve(self, solver: NewtonSolver, q0, key: str, what: str) -> np.ndarray:
@@ -329,6 +339,10 @@ def solve_setup(g, targets: dict[str, float], max_iterations: int = 25) -> Inver
                 drawn.source,
                 "config.camber_shim",
                 "a camber target needs a camber shim in the geometry",
+            )
+        if name == "roadwheel_angle" and not drawn.steering_points:
+            raise InputError(
+                drawn.source, "hardpoints", "a toe target needs a trackrod or toe link to adjust"
             )
         if name == "ride_height_change" and not drawn.has_pushrod:
             raise InputError(
@@ -425,6 +439,8 @@ def setup_sheet(
         raise InputError(
             drawn.source, "actuation.type", "--pushrod needs a pushrod (actuation pushrod_rocker)"
         )
+    if trackrod and not drawn.steering_points:
+        raise InputError(drawn.source, "hardpoints", "--trackrod needs a trackrod or toe link")
     if any(v < 0 for v in shim):
         raise InputError("--shim", "", "a shim stack cannot be thinner than 0 mm")
     model = SetupModel(drawn)

@@ -24,9 +24,9 @@ import numpy as np
 import pinocchio as pin
 
 from .closures import DistanceClosure, FaceAlignment, FramePoint, Kinematics, ShimGap
-from .double_wishbone import upright_mounts
 from .errors import InputError
 from .geometry import Geometry, unit
+from .mechanisms.double_wishbone import upright_mounts
 from .solver import NewtonSolver
 from .urdf import Body, Joint, Tree, tree_to_urdf
 

@@ -38,12 +38,27 @@ class Joint:
     """A joint placing a body on its parent; origin and axis in world, design state."""
 
     name: str
-    kind: str  # "revolute" | "prismatic" | "ball"
+    kind: str  # "revolute" | "prismatic" | "ball" | "universal"
     origin: np.ndarray
     axis: np.ndarray | None = None
-    # The hardpoints that place it: (origin,) for a ball, (origin, axis end) for
-    # a revolute whose axis runs origin → axis end. Used for hardpoint sensitivities.
+    # The hardpoints that place it: (origin,) for a ball or universal, (origin, axis
+    # end) for a revolute or slide whose axis runs origin → axis end. Used for
+    # hardpoint sensitivities.
     defined_by: tuple[str, ...] = ()
+    axis2: np.ndarray | None = None  # a universal joint's second axis (after ``axis``)
+
+    def steps(self) -> list[tuple[str, str, np.ndarray]]:
+        """The one-freedom joints it is made of: (name suffix, URDF type, axis).
+
+        A ball is three revolutes about z, y, x; a universal two revolutes (axis,
+        then axis2); the links between them are massless. Names: the ball's end
+        in _z/_y/_x, the universal's in _a/_b; others are one joint of their name.
+        """
+        if self.kind == "ball":
+            return [(f"_{k}", "revolute", np.array(a)) for k, a in BALL_AXES]
+        if self.kind == "universal":
+            return [("_a", "revolute", self.axis), ("_b", "revolute", self.axis2)]
+        return [("", self.kind, self.axis)]
 
 
 @dataclass(frozen=True)
@@ -117,26 +132,16 @@ def tree_to_urdf(tree: Tree, comment: str = "") -> str:
             continue
         j = body.joint
         parent = body.parent
-        if j.kind == "ball":
-            # Three revolutes at one point; the two links between are massless.
-            for i, (letter, axis) in enumerate(BALL_AXES):
-                child = body.name if i == 2 else f"{j.name}_link_{letter}"
-                links[child] = ET.SubElement(robot, "link", {"name": child})
-                _joint(
-                    robot,
-                    f"{j.name}_{letter}",
-                    "revolute",
-                    parent,
-                    child,
-                    j.origin - origin_of[parent],
-                    np.array(axis),
-                )
-                origin_of[child] = j.origin
-                parent = child
-        else:
-            links[body.name] = ET.SubElement(robot, "link", {"name": body.name})
-            _joint(robot, j.name, j.kind, parent, body.name, j.origin - origin_of[parent], j.axis)
-            origin_of[body.name] = j.origin
+        steps = j.steps()
+        for i, (suffix, kind, axis) in enumerate(steps):
+            # several freedoms at one point: massless links between them
+            child = body.name if i == len(steps) - 1 else f"{j.name}_link{suffix}"
+            links[child] = ET.SubElement(robot, "link", {"name": child})
+            _joint(
+                robot, f"{j.name}{suffix}", kind, parent, child, j.origin - origin_of[parent], axis
+            )
+            origin_of[child] = j.origin
+            parent = child
 
     for v in tree.visuals:
         _visual(links[v.body], v, origin_of[v.body])

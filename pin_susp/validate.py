@@ -6,8 +6,12 @@
 - ``pointwise``: hardpoints as unknowns, rigid distances, scipy least_squares.
 
 Each engine starts every step from the design state (no warm start), so a
-step is checked on its own. The metrics are then computed from each engine's
-points and compared with pin_susp's, metric by metric and point by point.
+step is checked on its own. The rates along the drivers (hub z, rack) come
+from four more solves per driver around the engine's pose (±h, ±2h,
+Richardson's central difference): with them the derivative columns, the
+steer screw axis and the instant centres of a bump twist are checked too.
+The metrics are then computed from each engine's points and compared with
+pin_susp's, metric by metric and point by point.
 """
 
 from __future__ import annotations
@@ -19,6 +23,7 @@ import numpy as np
 
 from .closures import ContactPatchPoint
 from .errors import PinSuspError
+from .jet import Dual
 from .metrics import metric_columns
 from .pointwise import PointwiseCorner
 
@@ -27,6 +32,7 @@ TOLERANCE = 1e-6  # mm and deg
 # difference of 1e-13 m in a ball joint moves them by micrometres: besides the
 # absolute tolerance, a column may differ by this fraction of its value.
 RELATIVE = 1e-9
+STEP = 1e-4  # m: the drivers' step for the engines' rates (±STEP, ±2·STEP)
 
 
 @dataclass
@@ -64,12 +70,13 @@ def compare(
             continue
         if not results["solver_converged"][i]:
             continue
-        columns = metric_columns(corner.geometry, {k: v[None] for k, v in points.items()}, design)
+        columns = metric_columns(corner.geometry, points, design, corner.spring_sense)
         for name, (values, unit) in columns.items():
             _record(report, name, unit, values[0], results[name][i])
         for name in corner.point_names:
             for a, axis in enumerate("xyz"):
-                _record(report, "points", "mm", points[name][a] * 1e3, results[f"{name}_{axis}"][i])
+                position = points[name].val[0, a] * 1e3
+                _record(report, "points", "mm", position, results[f"{name}_{axis}"][i])
     return report
 
 
@@ -92,12 +99,45 @@ def step_targets(corner, sweep) -> list[list[tuple[str, np.ndarray, float]]]:
     ]
 
 
+def with_rates(corner, solve, points: dict | None) -> dict[str, Dual] | None:
+    """An engine's points at one step as Duals: position (1, 3), rates (k, 1, 3) along
+    the corner's drivers — wheel-centre z with the rack held, the rack with the
+    wheel centre held — from the engine's own solves at ±STEP and ±2·STEP
+    (Richardson: (8(p₊ − p₋) − (p₊₂ − p₋₂)) / 12h, error O(h⁴))."""
+    if points is None:
+        return None
+    held = [("wheel_center", np.array([0.0, 0.0, 1.0]), points["wheel_center"][2])]
+    if corner.geometry.steering == "rack":
+        inner = corner.geometry.steering_points[0]
+        held.append((inner, np.array([0.0, 1.0, 0.0]), points[inner][1]))
+    rates = {name: np.zeros((len(held), 3)) for name in points}
+    for j in range(len(held)):
+        at = {}
+        for s in (-2, -1, 1, 2):
+            targets = [(n, d, v + s * STEP * (i == j)) for i, (n, d, v) in enumerate(held)]
+            at[s] = solve(targets)
+            if at[s] is None:
+                return None
+        for name in points:
+            rates[name][j] = (8.0 * (at[1][name] - at[-1][name]) - (at[2][name] - at[-2][name])) / (
+                12.0 * STEP
+            )
+    return {name: Dual(p[None], rates[name][:, None]) for name, p in points.items()}
+
+
 def pointwise_points(corner, sweep) -> list[dict | None]:
+    """The point-based formulation's points (with rates) at every step; None where it
+    did not converge."""
     model = PointwiseCorner(corner.geometry)
+
+    def solve(targets, x0=None):
+        x, residual = model.solve(targets, x0)
+        return (x, model.points(x)) if residual < 1e-12 else (None, None)
+
     out = []
     for targets in step_targets(corner, sweep):
-        x, residual = model.solve(targets)
-        out.append(model.points(x) if residual < 1e-12 else None)
+        x, points = solve(targets)
+        out.append(with_rates(corner, lambda t, x=x: solve(t, x)[1], points))
     return out
 
 
@@ -129,11 +169,13 @@ class MujocoCorner:
             self.sites["axle_inboard"],
             self.sites["axle_outboard"],
             corner.geometry.wheel.radius,
+            corner.mechanism.WHEEL_BODY,
         )
 
-    def solve(self, targets, iterations: int = 30) -> dict | None:
+    def solve(self, targets, iterations: int = 30, qpos=None) -> dict | None:
+        """Newton from qpos (default: the design state) to the targets."""
         m, d, mj = self.model, self.data, self.mj
-        d.qpos[:] = m.qpos0
+        d.qpos[:] = m.qpos0 if qpos is None else qpos
         for _ in range(iterations + 1):
             mj.mj_forward(m, d)
             eq = d.efc_type[: d.nefc] == mj.mjtConstraint.mjCNSTR_EQUALITY
@@ -229,7 +271,11 @@ def _mujoco_points(corner, sweep, mjcf_text: str, source: str):
     with quiet_mujoco(mujoco) as counter:
         try:
             engine = MujocoCorner(mjcf_text, corner, source)
-            points = [engine.solve(targets) for targets in step_targets(corner, sweep)]
+            points = []
+            for targets in step_targets(corner, sweep):
+                at = engine.solve(targets)
+                qpos = engine.data.qpos.copy()
+                points.append(with_rates(corner, lambda t, q=qpos: engine.solve(t, qpos=q), at))
         except (mujoco.FatalError, mujoco.UnexpectedError) as exc:
             detail = " ".join(str(exc).split())
             raise PinSuspError(f"{source}: MuJoCo failed on it: {detail}") from None

@@ -137,7 +137,7 @@ def test_flat_steering_axis_leaves_scrub_and_trail_empty():
 def test_registry_gives_every_column_a_unit_and_label():
     assert len({m.name for m in METRICS}) == len(METRICS)
     for m in METRICS:
-        assert m.unit in ("deg", "mm", "%") and m.label and m.function.__doc__
+        assert m.unit in ("deg", "mm", "mm/rad", "%") and m.label and m.function.__doc__
 
 
 @pytest.mark.parametrize("side", ["left", "right"])
@@ -163,7 +163,7 @@ def test_every_metric_derivative_matches_central_differences(side):
     h = 1e-7
     dual = {k: Dual(v, rates[k]) for k, v in points.items()}
     for m in METRICS:
-        if not m.applies(corner.geometry):
+        if not m.applies(corner.geometry) or m.rates:  # a twist: not a function of positions
             continue
         exact = m.function(PointSet(dual, design, corner.geometry)).der[0]
         plus = {k: v + h * rates[k] for k, v in points.items()}
