@@ -193,11 +193,12 @@ class Corner(Linkage):
                 )
         moving_rack = [i for i, t in enumerate(targets) if self.body_of(t.point) == "rack"]
         if len(targets) != self.mobility:
-            what = (
-                "bump and steer: a wheel target and one trackrod_inboard target along y"
-                if self.actuators
-                else "bump: one wheel target (the fixed toe link leaves no steer)"
-            )
+            if self.actuators:
+                what = "bump and steer: a wheel target and one trackrod_inboard target along y"
+            elif self.geometry.steering_points:
+                what = "bump: one wheel target (the fixed toe link leaves no steer)"
+            else:
+                what = "bump: one wheel target (no steering)"
             raise InputError(
                 source,
                 "targets",

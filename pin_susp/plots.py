@@ -322,7 +322,7 @@ def _mm(c) -> dict[str, np.ndarray]:
 
 def _draw_corner(front, side, c, alpha, style) -> None:
     """Bodies (the URDF's rods), links and steering axis, tyre, hardpoints."""
-    from .viz import LINKS, segments
+    from .viz import links, segments
 
     colours = dict(c.tree.materials)
     for v in c.tree.visuals:
@@ -331,7 +331,7 @@ def _draw_corner(front, side, c, alpha, style) -> None:
             _both(front, side, v.start, v.end, style, color=colour, alpha=alpha, lw=2)
     for name, (a, b) in segments(c, c.design_positions).items():
         axis = name == "steering_axis"
-        colour = "goldenrod" if axis else f"#{LINKS[name][1]:06x}"
+        colour = "goldenrod" if axis else f"#{links(c)[name][1]:06x}"
         _both(front, side, a, b, ":" if axis else style, alpha=alpha, lw=1.5, color=colour)
     p = _mm(c)
     for ax, view in ((front, FRONT), (side, SIDE)):
@@ -391,30 +391,40 @@ def _above(polygon: np.ndarray, ground: float) -> np.ndarray:
 def _instant_centres(front, side, corner) -> tuple[list[str], list[np.ndarray]]:
     """Draw the FVIC and SVIC constructions; which were drawn, and the points (mm) the
     view should keep."""
-    positions = corner.design_positions
-    ps = PointSet(positions, positions, corner.geometry)
+    from .jet import value
+
+    design = {k: v[None] for k, v in corner.design_positions.items()}
+    # with the rates at design: a mechanism's instant centres may come from its twist
+    ps = PointSet(corner.motion([corner.q_design]), design, corner.geometry)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ends = ps.kingpin()
+    if ends is None:  # no kingpin (a trailing arm): the chassis points of the wheel's body
+        names = corner.mechanism.upright_points(corner.geometry)
+        ends = [design[n] for n in names if corner.body_of(n) == "chassis"][:2]
+    rays = [value(e)[0] * 1e3 for e in ends]
     p = _mm(corner)
     drawn, keep = [], []
     for ax, axis, view, name in ((front, X, FRONT, "FVIC"), (side, Y, SIDE, "SVIC")):
         with np.errstate(invalid="ignore", divide="ignore"):
-            ic = np.array(ps.instant_axis_point(axis), dtype=float) * 1e3
+            ic = np.array([value(x)[0] for x in ps.instant_axis_point(axis)], dtype=float) * 1e3
         far = float(np.linalg.norm(ic - p["wheel_center"][list(view)]))
         if not np.all(np.isfinite(ic)):
             _note(ax, PARALLEL)
         elif far > IC_FAR:
             _note(ax, f"arms nearly parallel: {name} {far / 1e3:.0f} m away, not drawn")
         else:
-            keep += _construction(ax, p, view, ic, name)
+            keep += _construction(ax, p, rays, view, ic, name)
             drawn.append(name)
     return drawn, keep
 
 
-def _construction(ax, p, view, ic, name) -> list[np.ndarray]:
-    """Ball joints to the IC (dashed), the contact patch through it; front view: on to
-    the centreline, the roll centre of a symmetric axle. Returns the roll centre, if any."""
+def _construction(ax, p, rays, view, ic, name) -> list[np.ndarray]:
+    """From the kingpin's ends (ball joints, virtual or the top mount) to the IC
+    (dashed), the contact patch through it; front view: on to the centreline, the roll
+    centre of a symmetric axle. Returns the roll centre, if any."""
     v = list(view)
-    for joint in ("upper_wishbone_outboard", "lower_wishbone_outboard"):
-        line = np.array([p[joint][v], ic])
+    for end in rays:
+        line = np.array([end[v], ic])
         ax.plot(*line.T, "--", color=CONSTRUCTION, lw=0.9, gid=f"{name.lower()}_arm")
     ax.plot(*ic, "o", color=CONSTRUCTION, ms=4, gid=name.lower())
     ax.annotate(
@@ -563,7 +573,7 @@ def _legend(fig, corner, ghost: bool, construction: bool) -> None:
     """The colours: bodies, links, steering axis, tyre, construction."""
     from matplotlib.lines import Line2D
 
-    from .viz import LINKS, segments
+    from .viz import links, segments
 
     colours = dict(corner.tree.materials)
     bodies = dict.fromkeys(
@@ -572,7 +582,7 @@ def _legend(fig, corner, ghost: bool, construction: bool) -> None:
     handles = [Line2D([], [], color=colours[m][:3], lw=2, label=m) for m in bodies]
     for name in segments(corner, corner.design_positions):
         if name != "steering_axis":
-            colour = f"#{LINKS[name][1]:06x}"
+            colour = f"#{links(corner)[name][1]:06x}"
             handles.append(Line2D([], [], color=colour, lw=1.5, label=name.replace("_", " ")))
     handles += [
         Line2D([], [], color="goldenrod", ls=":", lw=1.5, label="steering axis"),

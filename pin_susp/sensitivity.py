@@ -449,19 +449,17 @@ def select_points(corner, spec: str = "designer") -> list[str]:
     if spec == "chassis":
         return [n for n in names if corner.body_of(n) == "chassis"]
     if spec == "upright":
+        wheel = corner.mechanism.WHEEL_BODY
         joints = {
-            p
-            for b in corner.tree.bodies
-            if b.name == "upright" and b.joint
-            for p in b.joint.defined_by
+            p for b in corner.tree.bodies if b.name == wheel and b.joint for p in b.joint.defined_by
         }
         on_upright = {
             point
             for c in corner.tree.closures
-            if any(link == "upright" for link, _ in c.anchors)
+            if any(link == wheel for link, _ in c.anchors)
             for point in c.points
         }
-        return [n for n in names if corner.body_of(n) == "upright" or n in joints | on_upright]
+        return [n for n in names if corner.body_of(n) == wheel or n in joints | on_upright]
     wanted = [n.strip() for n in spec.split(",") if n.strip()]
     unknown = [n for n in wanted if n not in names]
     if unknown or not wanted:

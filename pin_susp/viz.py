@@ -28,12 +28,13 @@ import numpy as np
 import pinocchio as pin
 
 ROOT = "pin_susp"
-LINKS = {  # name: (ends, colour, radius)
+LINKS = {  # name: (ends, colour, radius); other distance closures (links) as LINK
     "trackrod": (("trackrod_inboard", "trackrod_outboard"), 0x2E9E4F, 0.006),
     "toe_link": (("toe_link_inboard", "toe_link_outboard"), 0x2E9E4F, 0.006),
     "pushrod": (("pushrod_outboard", "pushrod_inboard"), 0xB0B0B0, 0.007),
     "coilover": (("strut_top", "strut_bottom"), 0xD02828, 0.012),
 }
+LINK = (0x1F6BD9, 0.007)  # a multilink's links: the wishbones' blue
 AXIS_COLOUR, PATCH_COLOUR = 0xE8C020, 0xE83070
 GHOST = [0.55, 0.55, 0.6, 0.35]
 GROUND_COLOUR, GROUND_OPACITY = 0xB4B4A8, 0.3
@@ -51,14 +52,31 @@ def segments(corner, positions: dict[str, np.ndarray]) -> dict[str, tuple[np.nda
     (the contact patch's height), where scrub and trail are measured.
     """
     out = {}
-    for name, ((a, b), _, _) in LINKS.items():
+    for name, ((a, b), _, _) in links(corner).items():
         if a in positions and b in positions:
             out[name] = (positions[a], positions[b])
-    lbj, ubj = positions["lower_wishbone_outboard"], positions["upper_wishbone_outboard"]
-    k = ubj - lbj
-    ground = positions["contact_patch_center"][2]
-    if abs(k[2]) > 1e-9:
-        out["steering_axis"] = (ubj, lbj + (ground - lbj[2]) / k[2] * k)
+    from .metrics import PointSet
+
+    ps = PointSet({k: v[None] for k, v in positions.items()}, {}, corner.geometry)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ends = ps.kingpin()
+    if ends is not None:
+        lower, upper = ends[0][0], ends[1][0]
+        k = upper - lower
+        ground = positions["contact_patch_center"][2]
+        if abs(k[2]) > 1e-9 and np.all(np.isfinite(k)):
+            out["steering_axis"] = (upper, lower + (ground - lower[2]) / k[2] * k)
+    return out
+
+
+def links(corner) -> dict[str, tuple[tuple[str, str], int, float]]:
+    """The corner's links drawn between their ends: its distance closures and a coilover."""
+    out = {}
+    for c in corner.tree.closures:
+        if c.kind == "distance":
+            out[c.name] = (c.points, *LINKS.get(c.name, (None, *LINK))[1:])
+    if "strut_top" in corner.geometry.hardpoints:
+        out["coilover"] = LINKS["coilover"]
     return out
 
 
@@ -203,7 +221,7 @@ class CornerScene:
         self.robots.append(self._robot(corner, "corner", None))
 
         present = segments(corner, corner.design_positions)
-        for name, (_, colour, radius) in LINKS.items():
+        for name, (_, colour, radius) in links(corner).items():
             if name in present:
                 self.viewer[f"{ROOT}/links/{name}"].set_object(
                     mg.Cylinder(1.0, radius), mg.MeshLambertMaterial(color=colour)
