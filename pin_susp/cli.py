@@ -405,6 +405,11 @@ def _validate(args) -> int:
             continue
         if r.failed_steps:
             print(f"  {r.engine}: did not converge at steps {r.failed_steps}")
+        if r.not_compared:
+            print(
+                f"  {r.engine}: {', '.join(sorted(r.not_compared))} not compared (they need the "
+                "toe link's length changed, which this engine's model cannot do)"
+            )
         if getattr(r, "warnings", 0):
             print(f"  {r.engine}: {r.warnings} warnings (first: {r.first_warning})")
         if r.agrees:

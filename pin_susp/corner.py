@@ -17,7 +17,7 @@ from .closures import PointTarget
 from .errors import InputError
 from .geometry import Geometry, load_geometry, warn_outside
 from .linkage import Linkage
-from .metrics import METRICS, Pose, metric_columns, point_columns
+from .metrics import METRICS, TOE_LINK, Pose, metric_columns, point_columns
 from .solver import NewtonSolver, Predictor, Solution
 from .sweep import Sweep, Target, load_sweep
 
@@ -52,6 +52,8 @@ class Corner(Linkage):
     def drive_order(self, targets: list[Target]) -> list[int] | None:
         """Which target is which driver, when the targets are exactly the drivers
         (wheel-centre z, then the rack along y, in any order); None otherwise."""
+        if TOE_LINK in self.drivers:  # a driver no sweep target is: motion() solves it
+            return None
         wanted = [Target("wheel_center", "z").key]
         if self.geometry.steering == "rack":
             wanted.append(Target(self.geometry.steering_points[0], "y").key)

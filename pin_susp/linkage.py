@@ -29,7 +29,7 @@ from .closures import (
 from .errors import InputError
 from .geometry import DERIVED_POINTS, Geometry, contact_patch, unit
 from .jet import Dual
-from .metrics import HUB_Z, RACK, metric_columns
+from .metrics import HUB_Z, RACK, TOE_LINK, metric_columns
 from .solver import NewtonSolver
 from .urdf import read_closures, tree_to_urdf
 
@@ -88,12 +88,26 @@ class Linkage:
         self.actuators = ("rack",) if geometry.steering == "rack" else ()
         self._check_mobility()
         self.design_positions = self.positions(self.q_design)
-        # The drivers of the derivative columns: wheel-centre z, and the rack.
-        self.drivers = (HUB_Z, RACK) if geometry.steering == "rack" else (HUB_Z,)
+        # The drivers: wheel-centre z, and the rack or the fixed toe link's length (which
+        # steers a toe-link corner: its steer screw axis). Each is a column of the
+        # drive solver's right-hand side: the wheel-centre row, the rack row, or the
+        # toe link's closure row (J·dq = e: the row's value changed by one).
         drive = [PointTarget(self.points["wheel_center"], np.array([0.0, 0.0, 1.0]))]
         if geometry.steering == "rack":
             drive.append(JointTarget(self.model, "rack_slide"))
         self._drive = NewtonSolver(self.kin, self.closures, drive, self.branches)
+        self.drivers = (HUB_Z, RACK) if geometry.steering == "rack" else (HUB_Z,)
+        self.drive_rhs = self._drive._unit_rhs
+        if geometry.steering == "none" and geometry.steering_points:
+            self.drivers = (HUB_Z, TOE_LINK)
+            row = 0
+            for c in self.closures:
+                if c.name == "toe_link":
+                    break
+                row += c.size
+            toe = np.zeros((self._drive.nrows, 1))
+            toe[row] = 1.0
+            self.drive_rhs = np.hstack([self._drive._unit_rhs, toe])
         # Points grouped by the joint that carries them: (joint id, columns, offsets).
         frames = [name for name in self.point_names if name != "contact_patch_center"]
         groups = {}
@@ -147,7 +161,8 @@ class Linkage:
 
         name → Dual(position (n, 3) m, rates (k, n, 3) m/m) for the k drivers
         of ``self.drivers``: hub z (wheel-centre z with the rack held) and rack
-        displacement (rack with wheel-centre z held). Each rate column is the
+        displacement (rack with wheel-centre z held), or the toe link's length
+        (wheel-centre z held) on a toe-link corner. Each rate column is the
         tangent of the solution manifold, J·dq = e_j (from ``tangents`` where
         the sweep's solve already has it, else solved here), pushed through the
         joint Jacobians: a point p on joint j moves at v_j + ω_j × (p − o_j).
@@ -172,7 +187,7 @@ class Linkage:
                 self.kin.update(q)
             else:
                 self._drive.evaluate(q)
-                tangent = self._drive.tangent()
+                tangent = self._drive.tangent(self.drive_rhs)
             oMi = data.oMi
             for g, (joint, _, _) in enumerate(moving):
                 placement = oMi[joint]

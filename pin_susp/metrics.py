@@ -29,6 +29,7 @@ from .jet import rate as jet_rate
 STEERING_AXIS_FLAT = 1e-6  # |k_z| below this: the axis never meets the ground
 PARALLEL_PLANES = 1e-12  # |n₁ × n₂|² below this (unit normals): no instant axis
 HUB_Z, RACK = "hub_z", "rack_displacement"
+TOE_LINK = "toe_link_length"  # steers a toe-link corner (no derivative columns)
 X, Y, Z = 0, 1, 2
 EYE = np.eye(3)
 
@@ -119,7 +120,8 @@ class PointSet:
         return u + wc[..., a], v + wc[..., b]
 
     def twist(self, driver: int):
-        """The wheel body's twist along a driver (0: hub z, 1: rack): (ω, v at WC).
+        """The wheel body's twist along a driver (0: hub z, 1: the rack or the toe
+        link's length): (ω, v at WC).
 
         ω from the rates of the mechanism's upright points (a rigid body:
         v_i − v_c = ω × (p_i − p_c), solved in the least-squares sense with the
@@ -356,8 +358,8 @@ def _rack(g: Geometry) -> bool:
 
 
 def _steered(g: Geometry) -> bool:
-    """The steer screw axis: along the rack (the toe link's length: not yet a driver)."""
-    return g.steering == "rack"
+    """The steer screw axis: along the rack, or the fixed toe link's length."""
+    return bool(g.steering_points)
 
 
 def _anti(axle: str, needs_bias: bool):

@@ -401,7 +401,7 @@ def _instant_centres(front, side, corner) -> tuple[list[str], list[np.ndarray]]:
     if ends is None:  # no kingpin (a trailing arm): the chassis points of the wheel's body
         names = corner.mechanism.upright_points(corner.geometry)
         ends = [design[n] for n in names if corner.body_of(n) == "chassis"][:2]
-    rays = [value(e)[0] * 1e3 for e in ends]
+    rays = [value(e)[0] * 1e3 for e in reversed(ends)]  # upper first
     p = _mm(corner)
     drawn, keep = [], []
     for ax, axis, view, name in ((front, X, FRONT, "FVIC"), (side, Y, SIDE, "SVIC")):

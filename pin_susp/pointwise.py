@@ -152,13 +152,26 @@ class PointwiseCorner:
         return {"axle_outboard": np.eye(3) + k * D, "axle_inboard": -k * D}
 
     def solve(
-        self, targets, x0: np.ndarray | None = None, jacobian: str = "analytic"
+        self,
+        targets,
+        x0: np.ndarray | None = None,
+        jacobian: str = "analytic",
+        longer: tuple[tuple[str, str], float] | None = None,
     ) -> tuple[np.ndarray, float]:
         """Hold each (point, unit direction, absolute value m); returns x and max |residual|.
 
-        ``jacobian="2-point"`` lets scipy difference the residuals instead.
+        ``jacobian="2-point"`` lets scipy difference the residuals instead;
+        ``longer`` = ((a, b), δ): the link between points a and b made δ (m) longer.
         """
         x0 = self.x0 if x0 is None else x0
+        if longer is not None:
+            (a, b), delta = longer
+            saved = self.pairs
+            self.pairs = [(p, q, d + delta if {p, q} == {a, b} else d) for p, q, d in saved]
+            try:
+                return self.solve(targets, x0, jacobian)
+            finally:
+                self.pairs = saved
         sol = least_squares(
             self.residual,
             x0,

@@ -222,9 +222,7 @@ class HardpointSensitivity:
             drive.append(JointTarget(m, "rack_slide"))
         Jd = np.vstack([row.jacobian(kin) for row in drive])
         k = len(c.drivers)
-        rhs = np.zeros((len(Jd), k))
-        rhs[-k:] = np.eye(k)
-        tangent = np.linalg.solve(Jd[:, self.real], rhs)  # (nv_real, k)
+        tangent = np.linalg.solve(Jd[:, self.real], c.drive_rhs)  # (nv_real, k): same rows
 
         pos = {f: self.points[f].position(kin).copy() for f in self.frames}
         anchors = [p for cl in self.closures for p in (cl.a, cl.b) if p.name not in self.points]

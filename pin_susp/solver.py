@@ -101,10 +101,12 @@ class NewtonSolver:
             if jacobian:
                 self.jacobian[i : i + row.size] = row.jacobian(self.kin)
 
-    def tangent(self) -> np.ndarray:
-        """dq per unit of each target value, at the last evaluated state: J·T = [0; I]."""
-        _, _, T, info = lapack.dgesv(self.jacobian, self._unit_rhs)
-        return T if info == 0 else np.full((self.jacobian.shape[1], len(self.targets)), np.nan)
+    def tangent(self, rhs: np.ndarray | None = None) -> np.ndarray:
+        """dq per unit of each target value, at the last evaluated state: J·T = [0; I]
+        (or J·T = ``rhs``: a column per change of the rows' values, e.g. a link's length)."""
+        rhs = self._unit_rhs if rhs is None else rhs
+        _, _, T, info = lapack.dgesv(self.jacobian, rhs)
+        return T if info == 0 else np.full((self.jacobian.shape[1], rhs.shape[1]), np.nan)
 
     def newton(self, q: np.ndarray) -> Solution:
         """Iterate from q with the current target values."""

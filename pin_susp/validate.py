@@ -6,10 +6,10 @@
 - ``pointwise``: hardpoints as unknowns, rigid distances, scipy least_squares.
 
 Each engine starts every step from the design state (no warm start), so a
-step is checked on its own. The rates along the drivers (hub z, rack) come
-from four more solves per driver around the engine's pose (±h, ±2h,
-Richardson's central difference): with them the derivative columns, the
-steer screw axis and the instant centres of a bump twist are checked too.
+step is checked on its own. The rates along the drivers (hub z, rack, a toe
+link's length) come from each engine's own Jacobian at its pose: with them
+the derivative columns, the steer screw axis and the instant centres of a
+bump twist are checked too.
 The metrics are then computed from each engine's points and compared with
 pin_susp's, metric by metric and point by point.
 """
@@ -24,7 +24,8 @@ import numpy as np
 from .closures import ContactPatchPoint
 from .errors import PinSuspError
 from .jet import Dual
-from .metrics import metric_columns
+from .jet import value as plain
+from .metrics import METRICS, metric_columns
 from .pointwise import PointwiseCorner
 
 TOLERANCE = 1e-6  # mm and deg
@@ -32,7 +33,8 @@ TOLERANCE = 1e-6  # mm and deg
 # difference of 1e-13 m in a ball joint moves them by micrometres: besides the
 # absolute tolerance, a column may differ by this fraction of its value.
 RELATIVE = 1e-9
-STEP = 1e-4  # m: the drivers' step for the engines' rates (±STEP, ±2·STEP)
+RATE_METRICS = {m.name for m in METRICS if m.rates}
+STEP = 1e-3  # m: the drivers' step for the engines' rates (±STEP, ±2·STEP)
 
 
 @dataclass
@@ -45,6 +47,7 @@ class EngineReport:
     units: dict[str, str] = field(default_factory=dict)
     failed_steps: list[int] = field(default_factory=list)
     disagree: set[str] = field(default_factory=set)
+    not_compared: set[str] = field(default_factory=set)  # the engine could not compute them
     note: str = ""
     warnings: int = 0  # how many warnings the engine raised (MuJoCo's: silenced, counted)
     first_warning: str = ""
@@ -72,6 +75,13 @@ def compare(
             continue
         columns = metric_columns(corner.geometry, points, design, corner.spring_sense)
         for name, (values, unit) in columns.items():
+            if (
+                np.isnan(values[0])
+                and name in RATE_METRICS
+                and np.isnan(plain(points["wheel_center"].der)).any()
+            ):
+                report.not_compared.add(name)  # the engine cannot move one of the drivers
+                continue
             _record(report, name, unit, values[0], results[name][i])
         for name in corner.point_names:
             for a, axis in enumerate("xyz"):
@@ -99,45 +109,63 @@ def step_targets(corner, sweep) -> list[list[tuple[str, np.ndarray, float]]]:
     ]
 
 
-def with_rates(corner, solve, points: dict | None) -> dict[str, Dual] | None:
+def held_drivers(corner, points: dict) -> list[tuple[str, np.ndarray, float]]:
+    """The drivers as targets held where the engine's pose is: wheel-centre z, and the
+    rack (trackrod_inboard y) on a rack corner."""
+    held = [("wheel_center", np.array([0.0, 0.0, 1.0]), float(points["wheel_center"][2]))]
+    g = corner.geometry
+    if g.steering == "rack":
+        inner = g.steering_points[0]
+        held.append((inner, np.array([0.0, 1.0, 0.0]), float(points[inner][1])))
+    return held
+
+
+def with_rates(corner, points: dict | None, rates) -> dict[str, Dual] | None:
     """An engine's points at one step as Duals: position (1, 3), rates (k, 1, 3) along
-    the corner's drivers — wheel-centre z with the rack held, the rack with the
-    wheel centre held — from the engine's own solves at ±STEP and ±2·STEP
-    (Richardson: (8(p₊ − p₋) − (p₊₂ − p₋₂)) / 12h, error O(h⁴))."""
+    the corner's drivers, ``rates``: name → (k, 3), from the engine's own Jacobian."""
     if points is None:
         return None
-    held = [("wheel_center", np.array([0.0, 0.0, 1.0]), points["wheel_center"][2])]
-    if corner.geometry.steering == "rack":
-        inner = corner.geometry.steering_points[0]
-        held.append((inner, np.array([0.0, 1.0, 0.0]), points[inner][1]))
-    rates = {name: np.zeros((len(held), 3)) for name in points}
-    for j in range(len(held)):
-        at = {}
-        for s in (-2, -1, 1, 2):
-            targets = [(n, d, v + s * STEP * (i == j)) for i, (n, d, v) in enumerate(held)]
-            at[s] = solve(targets)
-            if at[s] is None:
-                return None
-        for name in points:
-            rates[name][j] = (8.0 * (at[1][name] - at[-1][name]) - (at[2][name] - at[-2][name])) / (
-                12.0 * STEP
-            )
     return {name: Dual(p[None], rates[name][:, None]) for name, p in points.items()}
 
 
 def pointwise_points(corner, sweep) -> list[dict | None]:
-    """The point-based formulation's points (with rates) at every step; None where it
-    did not converge."""
+    """The point-based formulation's points at every step, with their rates along the
+    drivers; None where it did not converge.
+
+    The rates: the tangent of its own equations, J·dx = e for the driver's row
+    (the held target's, or the toe link's distance), solved in the least-squares
+    sense (its rigid-part distances are redundant, the system is consistent);
+    the points then move along dx (Richardson differences of the explicit point
+    formulas, error ~1e-12).
+    """
     model = PointwiseCorner(corner.geometry)
-
-    def solve(targets, x0=None):
-        x, residual = model.solve(targets, x0)
-        return (x, model.points(x)) if residual < 1e-12 else (None, None)
-
+    g = corner.geometry
     out = []
     for targets in step_targets(corner, sweep):
-        x, points = solve(targets)
-        out.append(with_rates(corner, lambda t, x=x: solve(t, x)[1], points))
+        x, residual = model.solve(targets)
+        if not residual < 1e-12:
+            out.append(None)
+            continue
+        points = model.points(x)
+        held = held_drivers(corner, points)
+        J = model.jacobian(x, held)
+        rhs = np.zeros((len(J), len(corner.drivers)))
+        first = len(model.pairs)
+        for j in range(len(held)):
+            rhs[first + j, j] = 1.0
+        if len(held) < len(corner.drivers):  # the toe link's length
+            a, b = g.steering_points
+            row = next(i for i, (p, q, _) in enumerate(model.pairs) if {p, q} == {a, b})
+            rhs[row, len(held)] = 1.0
+        dx = np.linalg.lstsq(J, rhs, rcond=None)[0]
+        rates = {name: np.zeros((len(corner.drivers), 3)) for name in points}
+        h = 1e-4
+        for j in range(len(corner.drivers)):
+            at = {s: model.points(x + s * h * dx[:, j]) for s in (-2, -1, 1, 2)}
+            for name in points:
+                d1, d2 = at[1][name] - at[-1][name], at[2][name] - at[-2][name]
+                rates[name][j] = (8.0 * d1 - d2) / (12.0 * h)
+        out.append(with_rates(corner, points, rates))
     return out
 
 
@@ -172,10 +200,10 @@ class MujocoCorner:
             corner.mechanism.WHEEL_BODY,
         )
 
-    def solve(self, targets, iterations: int = 30, qpos=None) -> dict | None:
-        """Newton from qpos (default: the design state) to the targets."""
+    def solve(self, targets, iterations: int = 30) -> dict | None:
+        """Newton from the design state to the targets."""
         m, d, mj = self.model, self.data, self.mj
-        d.qpos[:] = m.qpos0 if qpos is None else qpos
+        d.qpos[:] = m.qpos0
         for _ in range(iterations + 1):
             mj.mj_forward(m, d)
             eq = d.efc_type[: d.nefc] == mj.mjtConstraint.mjCNSTR_EQUALITY
@@ -196,6 +224,26 @@ class MujocoCorner:
             dv = np.linalg.lstsq(J, -r, rcond=None)[0]
             mj.mj_integratePos(m, d.qpos, dv, 1.0)
         return None
+
+    def rates(self, held, k: int) -> dict[str, np.ndarray]:
+        """At the solved pose: each point's rate along the first len(held) of k drivers,
+        J·dv = e (equality rows and the held targets' rows, least squares), through
+        the sites' Jacobians; NaN for a driver it cannot move (a toe link's length:
+        its links are rigid bodies closed by connects)."""
+        m, d, mj = self.model, self.data, self.mj
+        mj.mj_forward(m, d)
+        eq = d.efc_type[: d.nefc] == mj.mjtConstraint.mjCNSTR_EQUALITY
+        jac = [d.efc_J.reshape(d.nefc, m.nv)[eq]] if d.nefc else []
+        jac += [direction @ self.sites[name].jacobian(self) for name, direction, _ in held]
+        J = np.vstack(jac)
+        rhs = np.zeros((len(J), len(held)))
+        rhs[len(J) - len(held) :] = np.eye(len(held))
+        dv = np.linalg.lstsq(J, rhs, rcond=None)[0]
+        out = {}
+        for name, site in self.sites.items():
+            out[name] = np.full((k, 3), np.nan)
+            out[name][: len(held)] = (site.jacobian(self) @ dv).T
+        return out
 
 
 class _Warnings:
@@ -274,8 +322,10 @@ def _mujoco_points(corner, sweep, mjcf_text: str, source: str):
             points = []
             for targets in step_targets(corner, sweep):
                 at = engine.solve(targets)
-                qpos = engine.data.qpos.copy()
-                points.append(with_rates(corner, lambda t, q=qpos: engine.solve(t, qpos=q), at))
+                rates = None
+                if at is not None:
+                    rates = engine.rates(held_drivers(corner, at), len(corner.drivers))
+                points.append(with_rates(corner, at, rates))
         except (mujoco.FatalError, mujoco.UnexpectedError) as exc:
             detail = " ".join(str(exc).split())
             raise PinSuspError(f"{source}: MuJoCo failed on it: {detail}") from None
