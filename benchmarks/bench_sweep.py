@@ -2,8 +2,10 @@
 
     python benchmarks/bench_sweep.py [--repeat N] [--quick] [--json OUT.json]
 
-For the example corner (combined bump + steer), the shimmed corner and the
-pushrod-rocker corner it prints:
+For the example corner (combined bump + steer), the shimmed corner, the
+pushrod-rocker corner and one example of every other mechanism (MacPherson,
+multilink with a rack and with a toe link, semi-trailing arm; bump alone
+where there is no rack, against the fixed-toe-link double wishbone) it prints:
 
 - per-step solve time: median, p10, p90 over every step of every repetition
   (after a warm-up), Newton iterations per step, worst residual;
@@ -12,7 +14,9 @@ pushrod-rocker corner it prints:
   scipy least_squares, (a) finite-difference and (b) analytic Jacobians, and
   the ratios baseline / pin_susp per step;
 - per-step time for sweeps of 11, 101, 1 001 and 10 001 steps;
-- a 51 × 41 bump × steer grid solved by continuation along rows.
+- a 51 × 41 bump × steer grid solved by continuation along rows;
+- each mechanism's per-step time as a ratio to the double wishbone's on the
+  same kind of sweep (target: MacPherson and multilink <= 1.5x).
 
 Timing lives here, never in the tests (a test runs ``--quick`` and checks
 only iterations and residuals).
@@ -35,6 +39,14 @@ from pin_susp.sweep import Sweep, Target
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 CORNERS = ("double_wishbone.yaml", "camber_shim.yaml", "pushrod_rocker.yaml")
+# every other mechanism, and the double wishbone each is compared with (same sweep kind)
+MECHANISMS = {
+    "macpherson.yaml": "double_wishbone.yaml",
+    "multilink_front.yaml": "double_wishbone.yaml",
+    "fixed_toe_link.yaml": None,
+    "multilink_rear.yaml": "fixed_toe_link.yaml",
+    "semi_trailing_arm.yaml": "fixed_toe_link.yaml",
+}
 
 
 def bump_steer(steps: int) -> Sweep:
@@ -46,6 +58,11 @@ def bump_steer(steps: int) -> Sweep:
         ],
         "bump+steer",
     )
+
+
+def bump(steps: int) -> Sweep:
+    """−40…60 mm of bump alone (a corner without a rack)."""
+    return Sweep([Target("wheel_center", "z", np.linspace(-40, 60, steps))], "bump")
 
 
 def percentiles(samples) -> dict:
@@ -103,11 +120,11 @@ def baseline(corner, sweep, jacobian: str, repeat: int) -> dict:
     return {"time_us_per_step": float(np.median(times)) * 1e6, "max_residual_mm": worst * 1e3}
 
 
-def scaling(corner, sizes, repeat: int) -> dict:
+def scaling(corner, sizes, repeat: int, kind=bump_steer) -> dict:
     out = {}
     for n in sizes:
-        sweep = bump_steer(n)
-        corner.solve_steps(bump_steer(11))
+        sweep = kind(n)
+        corner.solve_steps(kind(11))
         times = []
         for _ in range(max(1, repeat // max(1, n // 101))):
             t0 = time.perf_counter()
@@ -156,10 +173,11 @@ def run(repeat: int, quick: bool) -> dict:
         "corners": {},
     }
     sizes = (11, 101) if quick else (11, 101, 1001, 10001)
-    for name in CORNERS:
+    for name in (*CORNERS, *MECHANISMS):
         corner = pin_susp.Corner(EXAMPLES / name)
-        sweep = bump_steer(41)
-        sweep101 = bump_steer(101)
+        kind = bump_steer if corner.geometry.steering == "rack" else bump
+        sweep = kind(41)
+        sweep101 = kind(101)
         entry = {
             "per_step": per_step(corner, sweep, repeat),
             "sweep_101": whole_sweep(corner, sweep101, max(3, repeat // 4)),
@@ -172,10 +190,16 @@ def run(repeat: int, quick: bool) -> dict:
         }
         for key in ("a_fd_jacobian", "b_analytic_jacobian"):
             entry["baselines"][key]["ratio"] = entry["baselines"][key]["time_us_per_step"] / ours
-        entry["scaling_us_per_step"] = scaling(corner, sizes, repeat)
+        entry["scaling_us_per_step"] = scaling(corner, sizes, repeat, kind)
         if name == "double_wishbone.yaml":
             entry["grid"] = grid(corner, *((11, 9) if quick else (51, 41)))
+        entry["sweep"] = sweep.source
         report["corners"][name] = entry
+    for name, reference in MECHANISMS.items():
+        if reference is not None:
+            ours = report["corners"][name]["per_step"]["time_us"]["median"]
+            theirs = report["corners"][reference]["per_step"]["time_us"]["median"]
+            report["corners"][name]["vs"] = {"corner": reference, "ratio": ours / theirs}
     return report
 
 
@@ -197,7 +221,7 @@ def show(report: dict) -> None:
     for name, e in report["corners"].items():
         s, w, b = e["per_step"], e["sweep_101"], e["baselines"]
         t = s["time_us"]
-        print(f"\n{name}")
+        print(f"\n{name} ({e['sweep']})")
         print(
             f"  per-step solve            median {t['median']:7.1f} us   p10 {t['p10']:6.1f}"
             f"   p90 {t['p90']:6.1f}   (target <= 60 us)"
@@ -222,6 +246,11 @@ def show(report: dict) -> None:
         )
         scale = ", ".join(f"{n}: {v:.1f}" for n, v in e["scaling_us_per_step"].items())
         print(f"  scaling, us per step by sweep length: {scale}")
+        if "vs" in e:
+            print(
+                f"  per-step time / {e['vs']['corner']}'s on the same sweep kind: "
+                f"{e['vs']['ratio']:.2f}x (target <= 1.5x for MacPherson and multilink)"
+            )
         if "grid" in e:
             g = e["grid"]
             print(

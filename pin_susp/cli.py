@@ -786,7 +786,9 @@ def _setup(args) -> int:
 
 
 def _link(geometry) -> str:
-    """The length adjuster that sets toe: the trackrod, or a fixed toe link."""
+    """The length adjuster that sets toe: the trackrod, a fixed toe link, or none."""
+    if not geometry.steering_points:
+        return "no link"
     return "trackrod" if geometry.steering == "rack" else "toe link"
 
 
@@ -803,18 +805,24 @@ def _sheet(rows, labels, link: str = "trackrod") -> None:
         line = f"  {label:9}" + "".join(
             f"{v + 0.0:>{w}.3f}" for v, w in zip(row.setup, (8, 9, 8), strict=True)
         )
-        line += "".join(f"{row.metrics[name] + 0.0:>12.4f}" for name, _, _ in SHEET_METRICS)
+        line += "".join(
+            f"{row.metrics[name] + 0.0:>12.4f}" if np.isfinite(row.metrics[name]) else f"{'-':>12}"
+            for name, _, _ in SHEET_METRICS
+        )
         print(line)
 
 
 def _sensitivities(state, geometry, pitch) -> None:
     drawn = geometry.drawn or geometry
-    have = (drawn.camber_shim is not None, True, drawn.has_pushrod)
+    have = (drawn.camber_shim is not None, bool(drawn.steering_points), drawn.has_pushrod)
     link = _link(drawn)
     columns = [("per mm shim", 0, 1.0), (f"per mm {link}", 1, 1.0), ("per mm pushrod", 2, 1.0)]
     if pitch:
         columns += [(f"per turn {link}", 1, pitch), ("per turn pushrod", 2, pitch)]
     columns = [c for c in columns if have[c[1]]]
+    if not columns:
+        print("  exact sensitivities: this corner has no setup adjuster (shim, link or pushrod)")
+        return
     print("  exact sensitivities at the static state:")
     print(f"  {'':26}" + "".join(f"{c[0]:>19}" for c in columns))
     for name, unit in (("camber", "deg"), ("roadwheel_angle", "deg"), ("ride_height_change", "mm")):

@@ -28,6 +28,11 @@ def test_benchmark_quick_mode_runs_with_few_iterations_and_tiny_residuals(tmp_pa
         "double_wishbone.yaml",
         "camber_shim.yaml",
         "pushrod_rocker.yaml",
+        "macpherson.yaml",
+        "multilink_front.yaml",
+        "fixed_toe_link.yaml",
+        "multilink_rear.yaml",
+        "semi_trailing_arm.yaml",
     }
     for entry in report["corners"].values():
         step = entry["per_step"]
