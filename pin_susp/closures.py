@@ -144,6 +144,19 @@ def chirality(a, b, c, d) -> float:
     return det / scale if scale > 0.0 else 0.0
 
 
+def alignment(a, b, c, d) -> float:
+    """cos of the angle between b − a and d − c: which way along a line a point lies
+    (a telescopic strut's top mount stays on the clamp's side of the lower ball
+    joint). Works on plain 3-sequences."""
+    u = (b[0] - a[0], b[1] - a[1], b[2] - a[2])
+    w = (d[0] - c[0], d[1] - c[1], d[2] - c[2])
+    scale = math.sqrt((u[0] ** 2 + u[1] ** 2 + u[2] ** 2) * (w[0] ** 2 + w[1] ** 2 + w[2] ** 2))
+    return (u[0] * w[0] + u[1] * w[1] + u[2] * w[2]) / scale if scale > 0.0 else 0.0
+
+
+MEASURES = {"chirality": chirality, "alignment": alignment}
+
+
 class LoopBranch:
     """Which assembly of a closed loop a pose is on: the sign of its chirality.
 
@@ -160,15 +173,16 @@ class LoopBranch:
     # |chirality| at design below this: the loop sits at its toggle, no side to keep
     DEGENERATE = 1e-6
 
-    def __init__(self, name: str, points: list, kin: Kinematics):
+    def __init__(self, name: str, points: list, kin: Kinematics, kind: str = "chirality"):
         self.name = name
         self.points = points
+        self.measure = MEASURES[kind]  # or "alignment": a point's side along a line
         value = self.chirality(kin)
         self.sign = math.copysign(1.0, value)
         self.degenerate = abs(value) < self.DEGENERATE
 
     def chirality(self, kin: Kinematics) -> float:
-        return chirality(*(p.position(kin).tolist() for p in self.points))
+        return self.measure(*(p.position(kin).tolist() for p in self.points))
 
 
 class BranchGuard:
@@ -189,7 +203,8 @@ class BranchGuard:
         self.moving = moving
         self.fixed = fixed
         self.ids = [
-            ([p.frame_id for p in loop.points], loop.sign, loop.name) for loop in self.loops
+            ([p.frame_id for p in loop.points], loop.sign, loop.name, loop.measure)
+            for loop in self.loops
         ]
 
     def left(self, kin: Kinematics) -> str | None:
@@ -200,8 +215,8 @@ class BranchGuard:
         at = dict(self.fixed)
         for f in self.moving:
             at[f] = oMf[f].translation.tolist()
-        for frames, sign, name in self.ids:
-            if chirality(*(at[f] for f in frames)) * sign <= 0.0:
+        for frames, sign, name, measure in self.ids:
+            if measure(*(at[f] for f in frames)) * sign <= 0.0:
                 return name
         return None
 

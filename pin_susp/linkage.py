@@ -80,13 +80,12 @@ class Linkage:
                 length = float(np.linalg.norm(b.position(self.kin) - a.position(self.kin)))
                 self.closures.append(DistanceClosure(spec.name, a, b, length))
         self.branches = [
-            LoopBranch(c.name, [self.points[n] for n in c.branch], self.kin)
+            LoopBranch(c.name, [self.points[n] for n in c.branch], self.kin, c.branch_kind)
             for c in self.tree.closures
             if c.branch
         ]
         self.mobility = self.model.nv - sum(c.size for c in self.closures)
         self.actuators = ("rack",) if geometry.steering == "rack" else ()
-        self._check_mobility()
         self.design_positions = self.positions(self.q_design)
         # The drivers: wheel-centre z, and the rack or the fixed toe link's length (which
         # steers a toe-link corner: its steer screw axis). Each is a column of the
@@ -96,6 +95,7 @@ class Linkage:
         if geometry.steering == "rack":
             drive.append(JointTarget(self.model, "rack_slide"))
         self._drive = NewtonSolver(self.kin, self.closures, drive, self.branches)
+        self._check_mobility()
         self.drivers = (HUB_Z, RACK) if geometry.steering == "rack" else (HUB_Z,)
         self.drive_rhs = self._drive._unit_rhs
         if geometry.steering == "none" and geometry.steering_points:
@@ -131,18 +131,28 @@ class Linkage:
     def _check_mobility(self) -> None:
         """The closures must be independent at design, and the wheel must move in bump:
         otherwise the file describes no suspension (one clear error, not a singular solve)."""
-        if not self.closures:
-            return
-        self.kin.update(self.q_design)
-        rows = np.vstack([c.jacobian(self.kin) for c in self.closures])
+        self._drive.evaluate(self.q_design)
+        rows = self._drive.jacobian
+        n = len(rows) - len(self._drive.targets)
+        if n:
+            s = np.linalg.svd(rows[:n], compute_uv=False)
+            if s[-1] < 1e-9 * s[0]:
+                raise InputError(
+                    self.geometry.source,
+                    "hardpoints",
+                    "the linkage's closures are dependent at the design state (a link that "
+                    "adds no constraint, or a loop at its toggle): the corner has more "
+                    f"freedoms than {self.mobility} and no pose can be solved",
+                )
         s = np.linalg.svd(rows, compute_uv=False)
         if s[-1] < 1e-9 * s[0]:
+            held = " with the rack held" if self.geometry.steering == "rack" else ""
             raise InputError(
                 self.geometry.source,
                 "hardpoints",
-                "the linkage's closures are dependent at the design state (a link that "
-                "adds no constraint, or a loop at its toggle): the corner has more freedoms "
-                f"than {self.mobility} and no pose can be solved",
+                f"the linkage locks the wheel for bump: its one motion{held} does not move "
+                "the wheel centre up or down (the links' lines allow only a motion about "
+                "the wheel centre)",
             )
 
     def _add_anchor(self, name: str, link: str, offset: np.ndarray) -> FramePoint:

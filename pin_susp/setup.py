@@ -25,7 +25,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import pinocchio as pin
 
-from .closures import DistanceClosure, JointTarget, LoopBranch, PointTarget, chirality
+from .closures import MEASURES, DistanceClosure, JointTarget, LoopBranch, PointTarget
 from .errors import InputError
 from .geometry import MM, Geometry, load_geometry
 from .jet import Dual
@@ -68,8 +68,9 @@ def _check_branches(drawn: Geometry, hardpoints: dict[str, np.ndarray], key: str
     for loop in drawn.mechanism.tree(drawn).closures:
         if not loop.branch:
             continue
-        before = chirality(*(drawn.hardpoints[n] for n in loop.branch))
-        after = chirality(*(hardpoints[n] for n in loop.branch))
+        measure = MEASURES[loop.branch_kind]
+        before = measure(*(drawn.hardpoints[n] for n in loop.branch))
+        after = measure(*(hardpoints[n] for n in loop.branch))
         if abs(before) >= LoopBranch.DEGENERATE and before * after <= 0.0:
             raise InputError(
                 drawn.source,

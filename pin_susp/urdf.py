@@ -81,8 +81,10 @@ class Closure:
     anchors: tuple[tuple[str, np.ndarray], tuple[str, np.ndarray]]
     points: tuple[str, str] = ()  # the named points the anchors sit at
     # Four named points whose chirality tells this loop's two assemblies apart
-    # (closures.LoopBranch): the pose keeps the sign it has at design.
+    # (closures.LoopBranch): the pose keeps the sign it has at design. With
+    # branch_kind "alignment": the sign of (b − a)·(d − c) instead.
     branch: tuple[str, str, str, str] | tuple[()] = ()
+    branch_kind: str = "chirality"
 
 
 @dataclass(frozen=True)

@@ -141,7 +141,16 @@ def tree(g) -> Tree:
     } | wheel_mounts("upright")
     points = {name: (body, p[name]) for name, body in body_of.items()}
     closures = [
-        Closure("strut_top_mount", "ball", ((TOP, p[TOP]), ("strut_rod", p[TOP])), (TOP, TOP)),
+        # the strut's two assemblies: the top mount on the clamp's side of the LBJ, or
+        # (the upright turned end for end) on the other
+        Closure(
+            "strut_top_mount",
+            "ball",
+            ((TOP, p[TOP]), ("strut_rod", p[TOP])),
+            (TOP, TOP),
+            branch=(LBJ, TOP, LBJ, CLAMP),
+            branch_kind="alignment",
+        ),
         steering_link(g, p, (LBJ, TOP, inner, outer)),
     ]
     rods = [

@@ -53,7 +53,6 @@ FORBIDDEN = {
 LINKS = ("upper_front_link", "upper_rear_link", "lower_front_link", "lower_rear_link")
 TREE_LINK = "lower_front_link"  # the link that carries the upright in the tree
 RANK_TOLERANCE = 1e-9  # relative singular value below which the link lines are dependent
-LOCKED = 1e-6  # |vertical velocity| of the wheel centre per unit twist below this: no bump
 
 
 def ends(link: str) -> tuple[str, str]:
@@ -86,8 +85,9 @@ def settle(p: dict) -> dict:
 
 
 def prepare(p: dict[str, np.ndarray], o, r) -> None:
-    """Distinct link ends; five link lines that leave the upright exactly one
-    motion (with the rack held), and one that moves the wheel up and down."""
+    """Distinct link ends, and five link lines that leave the upright exactly one
+    motion with the rack held (that it moves the wheel up and down is checked on
+    the model: Linkage._check_mobility)."""
     inner, outer = STEERING_POINTS[o.steering]
     pairs = [(*ends(link), "link") for link in LINKS] + [(inner, outer, "link")]
     if o.spring == "coilover":
@@ -110,16 +110,6 @@ def prepare(p: dict[str, np.ndarray], o, r) -> None:
             f"the five links leave the upright free: their lines are dependent (rank {rank} "
             f"of 5; this link adds no constraint the others do not), so the upright has "
             f"{6 - rank} freedoms with the rack held, not 1",
-        )
-    twist = np.linalg.svd(lines)[2][-1]  # (ω, v₀): the one motion the links allow
-    w, v0 = twist[:3], twist[3:]
-    wc = p["axle_outboard"]
-    v = v0 + np.cross(w, wc)
-    if abs(v[2]) < LOCKED * max(np.linalg.norm(w), 1.0):
-        r.fail(
-            "hardpoints",
-            "the five links lock the upright for bump: the one motion they allow does not "
-            "move the wheel up or down (check the links' inboard and outboard points)",
         )
 
 
