@@ -273,9 +273,10 @@ def isa_kpi(ps: PointSet):
 
 
 def isa_pitch(ps: PointSet):
-    """The steer screw's pitch ω·v₀/|ω|² (mm/rad in the CSV): travel along the axis
-    per radian about it."""
-    return ps.steer_screw()[2]
+    """s·ω·v₀/|ω|² (mm/rad in the CSV): the steer screw's travel along its axis per
+    radian about it; positive = right-handed on a left corner (its mirror image on
+    a right one), so both sides of a symmetric car read the same."""
+    return ps.s * ps.steer_screw()[2]
 
 
 def svic_x(ps: PointSet):

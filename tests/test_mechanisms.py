@@ -327,7 +327,9 @@ def test_steer_screw_axis_is_the_uprights_twist_along_the_rack(geometry):
             m = at.metrics
             assert np.degrees(np.arctan2(-k[0], k[2])) == pytest.approx(m["isa_caster"], abs=1e-6)
             assert np.degrees(np.arctan2(-s * k[1], k[2])) == pytest.approx(m["isa_kpi"], abs=1e-6)
-            assert pitch * 1e3 == pytest.approx(m["isa_pitch"], abs=1e-5)  # mm/rad
+            assert corner.geometry.sign * pitch * 1e3 == pytest.approx(
+                m["isa_pitch"], abs=1e-5
+            )  # mm/rad
             np.testing.assert_allclose(foot * 1e3, point.val[0] * 1e3, atol=1e-5)
         # the screw axis is not the kingpin (spec: about 0.1° apart on a double wishbone)
         assert abs(m["isa_caster"] - m["caster"]) + abs(m["isa_kpi"] - m["kpi"]) > 1e-3
@@ -488,9 +490,10 @@ SIDE_FREE = (
 
 @pytest.mark.parametrize("geometry", EXAMPLE_FILES, ids=IDS)
 def test_mirrored_corner_gives_the_same_metrics_and_mirrored_points(geometry):
-    """A right corner drawn as the mirror image of a left one. The steer screw's pitch
-    changes sign: a mirror image of a right-handed screw is a left-handed one (ω is an
-    axial vector, v a polar one, so ω·v flips), which is what pin_susp writes."""
+    """A right corner drawn as the mirror image of a left one. The steer screw's own
+    pitch changes sign under the mirror (a right-handed screw's image is left-handed:
+    ω is an axial vector, v a polar one), so isa_pitch is written with the side's
+    sign s, like kpi: both sides of a symmetric car read the same."""
     left_data = example(geometry)
     left_corner = pin_susp.Corner(left_data)
     sweep = short_sweep(left_corner)
@@ -503,7 +506,7 @@ def test_mirrored_corner_gives_the_same_metrics_and_mirrored_points(geometry):
         if name in left.columns:
             assert_close(right[name], left[name], 1e-9, 1e-9, name)
     assert_close(right["fvic_y"], -left["fvic_y"], 1e-9, 1e-9, "fvic_y")
-    assert_close(right["isa_pitch"], -left["isa_pitch"], 1e-9, 1e-9, "isa_pitch")
+    assert_close(right["isa_pitch"], left["isa_pitch"], 1e-9, 1e-9, "isa_pitch")
     if has_rack(left_corner):
         assert np.isfinite(left["isa_pitch"]).all() and np.abs(left["isa_pitch"]).min() > 1e-3
     for name in left.columns:
