@@ -2,8 +2,9 @@
 
 Loads urdf/double_wishbone.urdf (or the file given) in Pinocchio and in
 yourdfpy, reads the loop closures from its <pin_susp:loop_closure> elements,
-solves one pose — wheel centre 20 mm up, rack at 0 — by Newton on the
-closures, and checks yourdfpy's forward kinematics at those joint values.
+solves one pose — wheel centre 20 mm up, rack at 0 where there is one — by
+Newton on the closures, and checks yourdfpy's forward kinematics at those
+joint values. Works for every mechanism's URDF (urdf/*.urdf).
 
     python examples/urdf_without_pin_susp.py [corner.urdf]
 """
@@ -47,22 +48,24 @@ def load(path):
 
 
 def solve_pose(model, closures, lengths, wheel_center_dz=0.02, rack=0.0):
-    """Newton: ball closures (3 rows), distance closures (1 row), wheel-centre z, rack."""
+    """Newton: ball closures (3 rows), distance closures (1 row), wheel-centre z, and
+    the rack where the model has one."""
     data = model.createData()
     q = pin.neutral(model)
     wc = model.getFrameId("wheel_center")
     pin.framesForwardKinematics(model, data, q)
     wc_goal = data.oMf[wc].translation[2] + wheel_center_dz
-    rack_v = model.joints[model.getJointId("rack_slide")].idx_v
+    has_rack = model.existJointName("rack_slide")
+    rack_v = model.joints[model.getJointId("rack_slide")].idx_v if has_rack else None
     for _ in range(20):
         pin.computeJointJacobians(model, data, q)
         pin.updateFramePlacements(model, data)
         rows, jac = [], []
         for name, kind, (a, b) in closures:
             d = data.oMf[b].translation - data.oMf[a].translation
-            J = (
-                pin.getFrameJacobian(model, data, b, WORLD)[:3]
-                - pin.getFrameJacobian(model, data, a, WORLD)[:3]
+            J = (  # (a model with one joint returns a 6-vector: reshaped)
+                pin.getFrameJacobian(model, data, b, WORLD).reshape(6, -1)[:3]
+                - pin.getFrameJacobian(model, data, a, WORLD).reshape(6, -1)[:3]
             )
             if kind == "ball":
                 rows.extend(d)
@@ -71,9 +74,10 @@ def solve_pose(model, closures, lengths, wheel_center_dz=0.02, rack=0.0):
                 rows.append(np.linalg.norm(d) - lengths[name])
                 jac.append(d / np.linalg.norm(d) @ J)
         rows.append(data.oMf[wc].translation[2] - wc_goal)
-        jac.append(pin.getFrameJacobian(model, data, wc, WORLD)[2])
-        rows.append(q[rack_v] - rack)
-        jac.append(np.eye(model.nv)[rack_v])
+        jac.append(pin.getFrameJacobian(model, data, wc, WORLD).reshape(6, -1)[2])
+        if has_rack:
+            rows.append(q[rack_v] - rack)
+            jac.append(np.eye(model.nv)[rack_v])
         r = np.array(rows)
         if np.max(np.abs(r)) < 1e-13:
             return q
@@ -94,11 +98,12 @@ def main(path):
     data = model.createData()
     pin.framesForwardKinematics(model, data, q)
     values = {model.names[j]: q[model.joints[j].idx_q] for j in range(1, model.njoints)}
-    names = ["wheel_center", "upper_wishbone_outboard", "trackrod_outboard"]
+    names = ["wheel_center", "axle_inboard", "axle_outboard"]
     frames = yourdfpy_frames(path, values, names)
     ai = data.oMf[model.getFrameId("axle_inboard")].translation
     ao = data.oMf[model.getFrameId("axle_outboard")].translation
     a = (ao - ai) / np.linalg.norm(ao - ai)
+    a[1] = abs(a[1])  # a right corner's spin axis points to −y: its side's sign
     print(f"{Path(path).name}: {len(closures)} loop closures, {model.nv} joints")
     print(
         f"wheel centre 20 mm up: camber {-np.degrees(np.arctan2(a[2], a[1])):.4f} deg, "

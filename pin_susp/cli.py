@@ -542,7 +542,8 @@ def _summary(results: Results, path) -> None:
         line = f"  {name:<32}{results.units[name]:>7}{v[0]:>13.6g}{v[-1]:>13.6g}"
         far = np.flatnonzero(np.abs(v) > FAR)
         if name in CENTRES and len(far):
-            line += f"   at infinity (arms parallel) near step {far[np.argmax(np.abs(v[far]))]}"
+            step = far[np.argmax(np.abs(v[far]))]
+            line += f"   at infinity (instant axis parallel to the view) near step {step}"
         else:
             line += f"{np.nanmin(v):>13.6g}{np.nanmax(v):>13.6g}"
         print(line)

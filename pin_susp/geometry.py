@@ -512,6 +512,10 @@ def _setup_block(value, actuation: str, link: tuple, r: Reader) -> tuple[float, 
 def _unknown_point_hint(key: str, o: Options, names: tuple[str, ...]) -> str:
     from . import mechanisms
 
+    if key in STEERING_POINTS["rack"] + STEERING_POINTS["none"] and not any(
+        n in names for pts in STEERING_POINTS.values() for n in pts
+    ):
+        return f"not a point of a {o.type} corner (it has no trackrod or toe link)"
     for other, pts in STEERING_POINTS.items():
         if key in pts and other != o.steering and key not in names:
             return (

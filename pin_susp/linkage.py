@@ -151,8 +151,7 @@ class Linkage:
                 self.geometry.source,
                 "hardpoints",
                 f"the linkage locks the wheel for bump: its one motion{held} does not move "
-                "the wheel centre up or down (the links' lines allow only a motion about "
-                "the wheel centre)",
+                "the wheel centre up or down",
             )
 
     def _add_anchor(self, name: str, link: str, offset: np.ndarray) -> FramePoint:

@@ -155,11 +155,13 @@ class PointSet:
         SVIC = (WC_x + v_z/ω_y, WC_z − v_x/ω_y), with the bump twist (ω, v at WC)."""
         w, v = self.twist(0)
         wc = self["wheel_center"]
+        ww = np.sum(w * w, axis=-1)
+        # ω (nearly) in the view's plane: the pole is at infinity (as for parallel planes)
+        c = w[..., axis]
+        c = np.where(c * c < PARALLEL_PLANES * ww, np.nan, c)
         if axis == X:
-            wx = w[..., X]
-            return wc[..., Y] - v[..., Z] / wx, wc[..., Z] + v[..., Y] / wx
-        wy = w[..., Y]
-        return wc[..., X] + v[..., Z] / wy, wc[..., Z] - v[..., X] / wy
+            return wc[..., Y] - v[..., Z] / c, wc[..., Z] + v[..., Y] / c
+        return wc[..., X] + v[..., Z] / c, wc[..., Z] - v[..., X] / c
 
     def steer_screw(self):
         """The steer screw axis: unit direction (upward), a point, and the pitch (m/rad),

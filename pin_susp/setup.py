@@ -339,7 +339,8 @@ def solve_setup(g, targets: dict[str, float], max_iterations: int = 25) -> Inver
             raise InputError(
                 drawn.source,
                 "config.camber_shim",
-                "a camber target needs a camber shim in the geometry",
+                "a camber target needs a camber shim in the geometry"
+                + ("" if drawn.type == "double_wishbone" else " (a double-wishbone option)"),
             )
         if name == "roadwheel_angle" and not drawn.steering_points:
             raise InputError(

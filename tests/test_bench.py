@@ -43,6 +43,10 @@ def test_benchmark_quick_mode_runs_with_few_iterations_and_tiny_residuals(tmp_pa
         assert step["iterations_first_step"] <= 5
         for baseline in ("a_fd_jacobian", "b_analytic_jacobian"):
             assert entry["baselines"][baseline]["max_residual_mm"] <= 1e-9
-        assert entry["sweep_101"]["derivative_columns"] >= 15
+        # bump and steer: 15 or more exact derivative columns; bump alone: 9 or more
+        rack = entry["sweep"] == "bump+steer"
+        assert entry["sweep_101"]["derivative_columns"] >= (15 if rack else 9)
+    for name in ("macpherson.yaml", "multilink_front.yaml", "multilink_rear.yaml"):
+        assert report["corners"][name]["vs"]["ratio"] > 0  # measured, never asserted
     grid = report["corners"]["double_wishbone.yaml"]["grid"]
     assert grid["converged"] == grid["points"] and grid["max_residual_mm"] <= 1e-9

@@ -145,3 +145,22 @@ def test_mjcf_of_a_pushrod_corner_has_rod_bodies():
     text = tree_to_mjcf(corner.tree)
     for name in ("trackrod_rod", "pushrod_rod", "rocker"):
         assert f'<body name="{name}"' in text
+
+
+@pytest.mark.parametrize("name", sorted(p.stem for p in (ROOT / "urdf").glob("*.urdf")))
+def test_plain_script_solves_every_mechanisms_urdf_as_pin_susp_does(name):
+    """The URDF alone (no pin_susp) solves the pose that pin_susp solves: wheel centre
+    20 mm up, rack at design where there is one."""
+    plain = plain_script()
+    model, closures, lengths = plain.load(ROOT / "urdf" / f"{name}.urdf")
+    q = plain.solve_pose(model, closures, lengths, wheel_center_dz=0.02)
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, q)
+    corner = pin_susp.Corner(EXAMPLES / f"{name}.yaml")
+    targets = [pin_susp.Target("wheel_center", "z", 20.0)]
+    if corner.geometry.steering == "rack":
+        targets.append(pin_susp.Target("trackrod_inboard", "y", 0.0))
+    pose = corner.solve_pose(targets)
+    for point in ("wheel_center", "axle_inboard", "axle_outboard"):
+        theirs = data.oMf[model.getFrameId(point)].translation * 1e3
+        np.testing.assert_allclose(theirs, pose.points[point], atol=1e-9, err_msg=point)

@@ -109,7 +109,8 @@ def prepare(p: dict[str, np.ndarray], o, r) -> None:
             f"hardpoints.{redundant}",
             f"the five links leave the upright free: their lines are dependent (rank {rank} "
             f"of 5; this link adds no constraint the others do not), so the upright has "
-            f"{6 - rank} freedoms with the rack held, not 1",
+            f"{6 - rank} freedoms{' with the rack held' if o.steering == 'rack' else ''}, "
+            "not 1",
         )
 
 
