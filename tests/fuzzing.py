@@ -9,8 +9,9 @@ process through ``pin_susp.cli.main()`` in a fresh temporary directory, and
 
 1. exit 0 only when every written row converged on the design branch with
    ``solver_max_residual <= 1e-9`` mm (and, independently, the rows' points
-   keep every rigid distance, meet the targets and stay on the design side
-   of every loop);
+   keep every rigid distance, meet the targets, keep every point-on-line
+   condition and stay on the design side of every loop, per mechanism:
+   double wishbone, MacPherson, multilink, trailing arm — ``bodies()``);
 2. exit 1 only with the failing steps named on stderr (the steps flagged
    ``False`` in the CSV are the ones named, at least the first 10);
 3. exit 2 with exactly one non-empty stderr line starting with ``pin-susp``
@@ -47,8 +48,23 @@ GEOMETRY_FILES = (
     "fixed_toe_link.yaml",
     "pushrod_rocker.yaml",
     "camber_shim.yaml",
+    "macpherson.yaml",  # rack
+    "multilink_rear.yaml",  # fixed toe link, coilover
+    "multilink_front.yaml",  # rack, the upper links meeting in one ball joint
+    "semi_trailing_arm.yaml",  # coilover, no steering
 )
 BASES = {name: yaml.safe_load((EXAMPLES / name).read_text()) for name in GEOMETRY_FILES}
+
+# The geometry file's ``type:`` values (spec/mechanisms.md) and the steering each takes
+# when config.steering is left out (the first of the mechanism's allowed values).
+MECHANISMS = ("double_wishbone", "macpherson", "multilink", "trailing_arm")
+DEFAULT_STEERING = {
+    "double_wishbone": "rack",
+    "macpherson": "rack",
+    "multilink": "rack",
+    "trailing_arm": "none",  # the only one it takes: no steering
+}
+LINKS = ("upper_front_link", "upper_rear_link", "lower_front_link", "lower_rear_link")
 
 RESIDUAL_LIMIT = 1e-9  # mm: what a converged row promises
 GEOMETRIC_TOLERANCE = 1e-7  # mm: rigid distances and targets checked from the CSV's points
@@ -56,6 +72,10 @@ SOLVER_COLUMNS = ("step_index", "solver_converged", "solver_max_residual", "solv
 
 # Per (command, exit code, or the exception's name): filled by run_case, printed by the test.
 COUNTS: Counter = Counter()
+# Per (mechanism of the drawn geometry, exit code): filled by run_case.
+BY_MECHANISM: Counter = Counter()
+# Per mechanism: converged rows checked independently from their points (bodies()).
+ROWS_CHECKED: Counter = Counter()
 # Per failure signature(), when failures are collected rather than raised.
 FOUND: Counter = Counter()
 # (seconds in main(), command line) of the slowest runs.
@@ -257,6 +277,15 @@ class Inputs:
     changes: list[str] = field(default_factory=list)
 
 
+def _kind(data) -> str | None:
+    """The mechanism a geometry's data names (``type:``, double_wishbone when left out),
+    or None when it names none."""
+    if not isinstance(data, dict):
+        return None
+    kind = data.get("type", "double_wishbone")
+    return str(kind) if isinstance(kind, str) and kind in MECHANISMS else None
+
+
 def _hardpoint_names(data) -> list[str]:
     hp = data.get("hardpoints") if isinstance(data, dict) else None
     return list(hp) if isinstance(hp, dict) else []
@@ -320,13 +349,69 @@ STRUT_POINTS = {k: BASES["pushrod_rocker.yaml"]["hardpoints"][k] for k in (
 )}  # fmt: skip
 
 
+def _as_multilink(data) -> str:
+    """A double wishbone rewritten as the multilink it is: each wishbone two links that
+    meet in its ball joint (spec/mechanisms.md: a valid corner, the same motion)."""
+    hp = data.get("hardpoints")
+    if not isinstance(hp, dict):
+        return "as multilink (no hardpoints)"
+    data["type"] = "multilink"
+    for level in ("upper", "lower"):
+        outboard = hp.pop(f"{level}_wishbone_outboard", None)
+        for end in ("front", "rear"):
+            inboard = hp.pop(f"{level}_wishbone_inboard_{end}", None)
+            if inboard is not None:
+                hp[f"{level}_{end}_link_inboard"] = inboard
+            if outboard is not None:
+                hp[f"{level}_{end}_link_outboard"] = copy.deepcopy(outboard)
+    act = data.get("actuation")
+    if isinstance(act, dict) and act.get("type", "direct") == "direct":
+        del data["actuation"]  # a coilover on the lower wishbone now sits on the upright
+    return "as multilink (wishbones as link pairs)"
+
+
+def _onto_strut_line(data) -> str:
+    """A MacPherson's strut_bottom put back on its strut line LBJ→strut_top (the foot of
+    its perpendicular), after the points moved."""
+    hp = data["hardpoints"]
+    a, b, c = (
+        _numeric_point(hp.get(n)) for n in ("lower_wishbone_outboard", "strut_top", "strut_bottom")
+    )
+    if a is None or b is None or c is None or a == b:
+        return "strut_bottom (no strut line)"
+    u = _unit([b[i] - a[i] for i in range(3)])
+    along = sum((c[i] - a[i]) * u[i] for i in range(3))
+    hp["strut_bottom"] = dict(
+        zip("xyz", (round(a[i] + along * u[i], 9) for i in range(3)), strict=True)
+    )
+    return "strut_bottom onto the strut line"
+
+
+def _clamp(draw, data) -> str:
+    """A MacPherson's strut_bottom moved along its strut line LBJ→strut_top (maybe
+    outside the two ends) and off it (the file may put it up to 1 mm off)."""
+    hp = data.get("hardpoints")
+    hp = hp if isinstance(hp, dict) else {}
+    a = _numeric_point(hp.get("lower_wishbone_outboard"))
+    b = _numeric_point(hp.get("strut_top"))
+    if a is None or b is None:
+        return "clamp (no strut line)"
+    t = draw(st.sampled_from((0.3, 0.5, 0.9, 0.0, 1.0, -0.2, 1.2, 1e-6, 0.999999)))
+    off = draw(st.sampled_from((0.0, 1e-6, 0.5, 0.999, 1.001, 3.0)))
+    d = [b[i] - a[i] for i in range(3)]
+    normal = _unit((d[1], -d[0], 0.0)) if abs(d[0]) + abs(d[1]) > 0 else (1.0, 0.0, 0.0)
+    new = [round(a[i] + t * d[i] + off * normal[i], 9) for i in range(3)]
+    hp["strut_bottom"] = dict(zip("xyz", new, strict=True))
+    return f"strut_bottom at {t:g} of LBJ→strut_top, {off:g} mm off the line"
+
+
 @st.composite
 def _mutate_geometry(draw, data) -> str:
     """One structural change to a geometry dict, in place; its label."""
     kinds = (
         "drop_key drop_hardpoint unknown_key retype wild_coordinate wild_point mirror "
         "side_only steering actuation mount spring shim adjuster wheel restyle_number "
-        "points_as_lists degenerate degenerate scale translate"
+        "points_as_lists degenerate degenerate scale translate mechanism clamp as_multilink"
     ).split()
     kind = draw(st.sampled_from(kinds))
     if kind == "drop_key":
@@ -510,6 +595,14 @@ def _mutate_geometry(draw, data) -> str:
                     zip("xyz", (round(move(v, i), 9) for i, v in enumerate(point)), strict=True)
                 )
         return f"{kind} {k if kind == 'scale' else d}"
+    if kind == "mechanism":  # another type: (mostly) points it does not have, one error
+        value = draw(st.sampled_from(MECHANISMS + ("Multilink", "strut", "")))
+        data["type"] = value
+        return f"type = {value!r}"
+    if kind == "as_multilink" and _kind(data) == "double_wishbone":
+        return _as_multilink(data)
+    if kind == "clamp" and _kind(data) == "macpherson":
+        return _clamp(draw, data)
     if kind == "points_as_lists":
         for name in _hardpoint_names(data):
             point = data["hardpoints"][name]
@@ -600,6 +693,8 @@ def geometries(draw) -> Inputs:
         for path, d in moves:
             put(data, path, round(get(data, path) + d, 6))
             changes.append(f"{'.'.join(map(str, path))} {d:+g}")
+    if mode != "none" and _kind(data) == "macpherson" and not chance(draw, 15):
+        changes.append(_onto_strut_line(data))  # else mostly > 1 mm off it: an error
     count = draw(st.sampled_from((0, 0, 0, 0, 0, 0, 1, 1, 2, 3)))
     for _ in range(count):
         changes.append(draw(_mutate_geometry(data)))
@@ -629,22 +724,42 @@ def _design_point(geometry, name: str):
 
 
 def _is_rack(geometry) -> bool | None:
-    if not isinstance(geometry, dict):
+    """Whether the corner is steered by a rack (a sweep then takes a wheel and a rack
+    target) or not (a fixed toe link, a trailing arm: one wheel target); None when the
+    data does not say (broken on purpose)."""
+    mechanism = _kind(geometry)
+    if mechanism is None:
         return None
+    if mechanism == "trailing_arm":
+        return False  # no rack whatever the file says (a rack there is an error)
     config = geometry.get("config")
-    steering = config.get("steering") if isinstance(config, dict) else None
-    kind = steering.get("type") if isinstance(steering, dict) else None
+    if not isinstance(config, dict):
+        return None
+    steering = config.get("steering", {"type": DEFAULT_STEERING[mechanism]})
+    if not isinstance(steering, dict):
+        return None
+    kind = steering.get("type", DEFAULT_STEERING[mechanism])
     return {"rack": True, "none": False}.get(kind) if isinstance(kind, str) else None
 
 
-WHEEL_POINTS = ("wheel_center",) * 6 + (
-    "contact_patch_center",
-    "axle_outboard",
-    "axle_midpoint",
-    "lower_wishbone_outboard",
-    "upper_wishbone_outboard",
-)
-CHASSIS_POINTS = ("lower_wishbone_inboard_front", "upper_wishbone_inboard_rear", "rocker_axis_a")
+# Bump targets: mostly the wheel centre, sometimes another point that rides with the wheel.
+WHEEL_POINTS = ("wheel_center",) * 6 + ("contact_patch_center", "axle_outboard", "axle_midpoint")
+UPRIGHT_POINTS = {  # per mechanism: its lower and upper points on the wheel's body
+    "double_wishbone": ("lower_wishbone_outboard", "upper_wishbone_outboard"),
+    "macpherson": ("lower_wishbone_outboard", "strut_bottom"),
+    "multilink": ("lower_front_link_outboard", "upper_rear_link_outboard"),
+    "trailing_arm": ("axle_inboard", "axle_inboard"),
+}
+CHASSIS_POINTS = {  # a target on one of these cannot move: an error
+    "double_wishbone": (
+        "lower_wishbone_inboard_front",
+        "upper_wishbone_inboard_rear",
+        "rocker_axis_a",
+    ),
+    "macpherson": ("lower_wishbone_inboard_front", "strut_top", "lower_wishbone_inboard_rear"),
+    "multilink": ("upper_front_link_inboard", "lower_rear_link_inboard", "toe_link_inboard"),
+    "trailing_arm": ("arm_pivot_inboard", "arm_pivot_outboard", "strut_top"),
+}
 UNKNOWN_POINTS = ("wheel_centre", "hub", "", "trackrod_inboard_y", "Wheel_Center")
 
 
@@ -668,7 +783,8 @@ def _target(draw, geometry, steps: int, rack: bool):
         if form == "minus":
             axis = (0.0, -1.0, 0.0)
     else:
-        point = draw(st.sampled_from(WHEEL_POINTS))
+        upright = UPRIGHT_POINTS[_kind(geometry) or "double_wishbone"]
+        point = draw(st.sampled_from(WHEEL_POINTS + upright))
         limit = 600 if chance(draw, 10) else 60  # sometimes beyond the mechanism's reach
         form = draw(st.sampled_from(("axis",) * 6 + ("vector", "tilted", "sideways")))
         if form == "axis":
@@ -708,8 +824,9 @@ def _target(draw, geometry, steps: int, rack: bool):
 
 
 @st.composite
-def _mutate_sweep(draw, data, steps: int) -> str:
+def _mutate_sweep(draw, data, steps: int, geometry=None) -> str:
     targets = data.get("targets")
+    mechanism = _kind(geometry) or "double_wishbone"
     kinds = (
         "drop_target extra_target chassis_point unknown_point lengths wild_value "
         "wild_steps no_steps direction mode unknown_key drop_key targets restyle_number "
@@ -724,11 +841,11 @@ def _mutate_sweep(draw, data, steps: int) -> str:
     if kind == "extra_target" and t is not None:
         twin = copy.deepcopy(t)
         if draw(st.booleans()):
-            twin["point"] = draw(st.sampled_from(("axle_outboard", "upper_wishbone_outboard")))
+            twin["point"] = draw(st.sampled_from(("axle_outboard", UPRIGHT_POINTS[mechanism][1])))
         targets.append(twin)
         return f"extra target on {twin['point']}"
     if kind == "chassis_point" and t:
-        t["point"] = draw(st.sampled_from(CHASSIS_POINTS))
+        t["point"] = draw(st.sampled_from(CHASSIS_POINTS[mechanism]))
         return f"target on {t['point']}"
     if kind == "unknown_point" and t:
         t["point"] = draw(st.sampled_from(UNKNOWN_POINTS + (None, 5, ["wheel_center"])))
@@ -838,7 +955,7 @@ def sweeps(draw, geometry, max_steps: int = 60):
         return Inputs(None, text, [*changes, f"garbage {text[:30]!r}"]), None
     if chance(draw, 20):
         for _ in range(draw(st.integers(1, 2))):
-            changes.append(draw(_mutate_sweep(data, steps)))
+            changes.append(draw(_mutate_sweep(data, steps, geometry)))
         plans = None
     text = to_yaml(data).encode()
     return Inputs(data, text, changes), plans
@@ -1014,14 +1131,16 @@ def cases(draw, pictures: bool | None = None) -> Case:
 
 
 def _has(geometry, what: str) -> bool:
-    """Whether the geometry data (as drawn, maybe broken) has a shim, a rack or a pushrod."""
+    """Whether the geometry data (as drawn, maybe broken) has a shim, a trackrod or fixed
+    toe link (every mechanism but the trailing arm: the ``--trackrod`` adjuster), or a
+    pushrod."""
     if not isinstance(geometry, dict):
         return False
     config = geometry.get("config") if isinstance(geometry.get("config"), dict) else {}
     if what == "shim":
         return isinstance(config.get("camber_shim"), dict)
-    if what == "rack":
-        return _is_rack(geometry) is True
+    if what == "link":
+        return _kind(geometry) != "trailing_arm" and _is_rack(geometry) is not None
     actuation = geometry.get("actuation")
     return isinstance(actuation, dict) and actuation.get("type") == "pushrod_rocker"
 
@@ -1036,7 +1155,7 @@ def _setup_arguments(draw, geometry) -> list[str]:
     if draw(st.booleans()):  # rows
         for flag, low, high, part in (
             ("--shim", 0, 60, "shim"),
-            ("--trackrod", -10, 10, "rack"),
+            ("--trackrod", -10, 10, "link"),
             ("--pushrod", -10, 10, "pushrod"),
         ):
             if (anything or _has(geometry, part)) and chance(draw, 50):
@@ -1054,7 +1173,7 @@ def _setup_arguments(draw, geometry) -> list[str]:
     else:  # targets
         for flag, low, high, part in (
             ("--camber", -6, 2, "shim"),
-            ("--toe", -1, 1, "rack"),
+            ("--toe", -1, 1, "link"),
             ("--ride-height-change", -20, 20, "pushrod"),
         ):
             if (anything or _has(geometry, part)) and chance(draw, 60):
@@ -1132,6 +1251,7 @@ def run_case(case: Case):
                 code = main(list(case.argv))
         except Exception as exc:
             COUNTS[case.command, type(exc).__name__] += 1
+            BY_MECHANISM[_kind(case.geometry.data) or "(none)", type(exc).__name__] += 1
             exc.add_note(f"escaped pin_susp.cli.main() (invariant 4, never a traceback)\n{case!r}")
             exc.add_note(f"stderr: {err.getvalue()!r}")
             raise
@@ -1141,6 +1261,7 @@ def run_case(case: Case):
             SLOWEST.sort(reverse=True)
             del SLOWEST[3:]
         COUNTS[case.command, code] += 1
+        BY_MECHANISM[_kind(case.geometry.data) or "(none)", code] += 1
         after = _snapshot(run_dir)
         texts = {
             name: (run_dir / name).read_bytes()
@@ -1354,8 +1475,29 @@ def chirality(a, b, c, d) -> float:
     return det / scale if scale > 0 else 0.0
 
 
-def bodies(g) -> tuple[list[str], list[list[str]], list[tuple[str, str, str, str]]]:
-    """(chassis points, rigid groups incl. rods, branch loops) of an as-set Geometry."""
+Loop = tuple[str, str, str, str]
+Line = tuple[str, str, str]
+WHEEL_MOUNTED = ("axle_inboard", "axle_outboard", "wheel_center", "axle_midpoint")
+WHEEL_MOUNTED += ("wheel_inboard", "wheel_outboard")
+
+
+def bodies(g) -> tuple[list[str], list[list[str]], list[Loop], list[Line]]:
+    """(chassis points, rigid groups incl. rods, branch loops, point-on-line conditions)
+    of an as-set Geometry, per mechanism as spec/mechanisms.md describes it (written
+    here, not read from pin_susp.mechanisms: an independent check). A loop's four
+    points keep the sign of their chirality; a line (p, a, b) keeps p on the line
+    through a and b, on a's design side."""
+    kind = getattr(g, "type", "double_wishbone")
+    if kind == "macpherson":
+        return _macpherson(g)
+    if kind == "multilink":
+        return _multilink(g)
+    if kind == "trailing_arm":
+        return _trailing_arm(g)
+    return (*_double_wishbone(g), [])
+
+
+def _double_wishbone(g) -> tuple[list[str], list[list[str]], list[Loop]]:
     inner, outer = g.steering_points
     pushrod = g.has_pushrod
     mount = g.actuation_mount
@@ -1397,6 +1539,56 @@ def bodies(g) -> tuple[list[str], list[list[str]], list[tuple[str, str, str, str
     return chassis, groups, loops
 
 
+def _macpherson(g) -> tuple[list[str], list[list[str]], list[Loop], list[Line]]:
+    """Lower arm on two chassis pivots, the upright on its ball joint carrying the strut
+    (clamped at strut_bottom) whose axis passes through the top mount; the trackrod or
+    fixed toe link."""
+    inner, outer = g.steering_points
+    lbj = "lower_wishbone_outboard"
+    chassis = ["lower_wishbone_inboard_front", "lower_wishbone_inboard_rear", "strut_top"]
+    lower = chassis[:2] + [lbj]
+    upright = [lbj, "strut_bottom", outer, *WHEEL_MOUNTED]
+    if g.steering == "none":
+        chassis.append(inner)
+    loops = [(lbj, "strut_top", inner, outer)]
+    return chassis, [lower, upright, [inner, outer]], loops, [("strut_top", lbj, "strut_bottom")]
+
+
+def _multilink(g) -> tuple[list[str], list[list[str]], list[Loop], list[Line]]:
+    """Five rods (four links and the trackrod or fixed toe link) between the chassis (or
+    the rack) and the upright."""
+    inner, outer = g.steering_points
+    uf, ur, lf, lr = ((f"{link}_inboard", f"{link}_outboard") for link in LINKS)
+    chassis = [uf[0], ur[0], lf[0], lr[0]]
+    upright = [uf[1], ur[1], lf[1], lr[1], outer, *WHEEL_MOUNTED]
+    if g.spring == "coilover":
+        chassis.append("strut_top")
+        upright.append("strut_bottom")
+    if g.steering == "none":
+        chassis.append(inner)
+    groups = [list(uf), list(ur), list(lf), list(lr), [inner, outer], upright]
+    # the tree's declared branches (pin_susp/mechanisms/multilink.py, the file's contract)
+    loops = [
+        (ur[0], uf[0], lf[1], uf[1]),
+        (uf[0], ur[0], lf[1], ur[1]),
+        (lf[0], lr[0], uf[1], lr[1]),
+        (lf[1], uf[1], inner, outer),
+    ]
+    return chassis, groups, loops, []
+
+
+def _trailing_arm(g) -> tuple[list[str], list[list[str]], list[Loop], list[Line]]:
+    """One arm turning about its two chassis pivots, carrying the spindle (and the
+    coilover's bottom)."""
+    pivots = ["arm_pivot_inboard", "arm_pivot_outboard"]
+    chassis = list(pivots)
+    arm = pivots + list(WHEEL_MOUNTED)
+    if g.spring == "coilover":
+        chassis.append("strut_top")
+        arm.append("strut_bottom")
+    return chassis, [arm], [], []
+
+
 def design_points(g) -> dict[str, list[float]]:
     """Every point of the as-set geometry at its design state, mm (docs/geometry.md)."""
     p = {name: [1000.0 * x for x in v] for name, v in g.hardpoints.items()}
@@ -1420,6 +1612,19 @@ def _dist(a, b) -> float:
     return math.sqrt(sum((a[i] - b[i]) ** 2 for i in range(3)))
 
 
+def _off_line(p, a, b) -> tuple[float, float, float]:
+    """(distance of p from the line through a and b, |p − a| / |b − a|: how much an
+    error in a or b grows at p, (p − a)·(b − a)/|b − a|: where along the line p is)."""
+    d = [b[i] - a[i] for i in range(3)]
+    n = math.sqrt(sum(x * x for x in d))
+    if n == 0.0:
+        return _dist(p, a), math.inf, 0.0
+    w, u = [p[i] - a[i] for i in range(3)], [x / n for x in d]
+    cross = (w[1] * u[2] - w[2] * u[1], w[2] * u[0] - w[0] * u[2], w[0] * u[1] - w[1] * u[0])
+    along = sum(w[i] * u[i] for i in range(3))
+    return math.sqrt(sum(x * x for x in cross)), _dist(p, a) / n, along
+
+
 def _check_geometry_of_rows(case: Case, o: Outcome, header, rows, context) -> None:
     """Independently of the solver's own flags: converged rows close the loops, meet the
     targets and stay on the design branch, read from the CSV's point columns."""
@@ -1433,7 +1638,8 @@ def _check_geometry_of_rows(case: Case, o: Outcome, header, rows, context) -> No
         g = Corner(str(Path(o.directory) / "g.yaml")).geometry
     design = design_points(g)
     col = {name: i for i, name in enumerate(header)}
-    chassis, groups, loops = bodies(g)
+    chassis, groups, loops, lines = bodies(g)
+    ROWS_CHECKED[g.type] += len(converged)
     scale = max(abs(x) for v in design.values() for x in v)
     tol = GEOMETRIC_TOLERANCE + 1e-12 * scale
     signs = {}
@@ -1450,6 +1656,16 @@ def _check_geometry_of_rows(case: Case, o: Outcome, header, rows, context) -> No
                 return None
             return [float(r[i]) for i in cells]
 
+        for point, a, b in lines:  # before the chassis: a strut_top moved off its line
+            p, pa, pb = at(point), at(a), at(b)
+            if None in (p, pa, pb):
+                continue
+            off, lever, along = _off_line(p, pa, pb)
+            err = tol * max(1.0, lever)  # the line's direction from two CSV points
+            assert off <= err, f"step {step}: {point} {off} mm off the line {a}→{b}" + context
+            # and on the design side of a along it (the other side: the strut end for end)
+            side = _off_line(design[point], design[a], design[b])[2]
+            assert along * side > 0.0, f"step {step}: {point} crossed {a} on {a}→{b}" + context
         for name in chassis:
             p = at(name)
             if p is not None:
@@ -1486,7 +1702,8 @@ def _check_geometry_of_rows(case: Case, o: Outcome, header, rows, context) -> No
 
 
 def summary() -> str:
-    """Counts per exit code and per command."""
+    """Counts per exit code, per command and per mechanism (as the geometry file names
+    it, before it is read: a file that names none is "(none)")."""
     by_code: Counter = Counter()
     by_command: dict[str, Counter] = {}
     for (command, code), n in COUNTS.items():
@@ -1501,6 +1718,16 @@ def summary() -> str:
         c = by_command[command]
         counts = ", ".join(f"exit {k}: {v}" for k, v in sorted(c.items(), key=str))
         lines.append(f"  {command:<12} {sum(c.values()):>6}  ({counts})")
+    by_mechanism: dict[str, Counter] = {}
+    for (mechanism, code), n in BY_MECHANISM.items():
+        by_mechanism.setdefault(mechanism, Counter())[code] += n
+    for mechanism in sorted(by_mechanism):
+        c = by_mechanism[mechanism]
+        counts = ", ".join(f"exit {k}: {v}" for k, v in sorted(c.items(), key=str))
+        rows = (
+            f"; {ROWS_CHECKED[mechanism]} converged rows checked" if mechanism in MECHANISMS else ""
+        )
+        lines.append(f"  {mechanism:<16} {sum(c.values()):>6}  ({counts}{rows})")
     if SLOWEST:
         slow = ", ".join(f"{t:.2f} s ({argv[:60]})" for t, argv in SLOWEST)
         lines.append(f"  slowest: {slow}")

@@ -18,15 +18,19 @@ from pathlib import Path
 import hypothesis.configuration
 import pytest
 from fuzzing import (
+    BY_MECHANISM,
     COUNTS,
     FOUND,
     ROOT,
+    ROWS_CHECKED,
     SLOWEST,
     Case,
     Inputs,
     Plan,
+    bodies,
     cases,
     check_case,
+    parse_csv,
     run_case,
     save_case,
     signature,
@@ -83,8 +87,8 @@ if SEED:
 
 
 def test_cli_holds_its_invariants():
-    COUNTS.clear()
-    FOUND.clear()
+    for counter in (COUNTS, BY_MECHANISM, ROWS_CHECKED, FOUND):
+        counter.clear()
     SLOWEST.clear()
     try:
         _fuzz()
@@ -117,6 +121,72 @@ def _known_good_sweep() -> Case:
         plans,
         quiet=True,
     )
+
+
+def _bump_sweep(geometry_file: str, rack: bool) -> Case:
+    """A good 3-step sweep of an example: bump, and steer when it has a rack."""
+    geometry = (ROOT / "examples" / geometry_file).read_bytes()
+    sweep = b"version: 1\nsteps: 3\ntargets:\n"
+    sweep += b"  - {point: wheel_center, direction: {axis: z}, start: -20, stop: 20}\n"
+    plans = [Plan("wheel_center", (0.0, 0.0, 1.0), "relative", [-20.0, 0.0, 20.0])]
+    if rack:
+        sweep += b"  - {point: trackrod_inboard, direction: {axis: y}, start: -8, stop: 8}\n"
+        plans.append(Plan("trackrod_inboard", (0.0, 1.0, 0.0), "relative", [-8.0, 0.0, 8.0]))
+    return Case(
+        "sweep",
+        ["sweep", "g.yaml", "s.yaml", "-o", "out.csv", "-q"],
+        {"g.yaml": geometry, "s.yaml": sweep},
+        ["out.csv"],
+        Inputs(None, geometry, []),
+        Inputs(None, sweep, []),
+        plans,
+        quiet=True,
+    )
+
+
+def _shift(csv: bytes, row: int, column: str, delta: float) -> bytes:
+    _, rows = parse_csv(csv.decode())
+    header = next(line for line in csv.decode().splitlines() if not line.startswith("#"))
+    value = float(rows[row][header.split(",").index(column)])
+    return _edit(csv, row, column, repr(value + delta))
+
+
+@pytest.mark.parametrize(
+    "geometry_file, rack, column, broken",
+    [
+        ("macpherson.yaml", True, "strut_top_y", "off the line lower_wishbone_outboard"),
+        ("macpherson.yaml", True, "strut_bottom_z", "strut_bottom"),
+        ("macpherson.yaml", True, "lower_wishbone_outboard_x", "lower_wishbone_outboard"),
+        ("multilink_rear.yaml", False, "upper_rear_link_outboard_x", "upper_rear_link"),
+        ("multilink_rear.yaml", False, "toe_link_outboard_z", "toe_link_outboard"),
+        ("multilink_rear.yaml", False, "strut_top_z", "chassis point strut_top"),
+        ("multilink_front.yaml", True, "lower_rear_link_outboard_y", "lower_rear_link"),
+        ("semi_trailing_arm.yaml", False, "strut_bottom_x", "strut_bottom"),
+        ("semi_trailing_arm.yaml", False, "arm_pivot_inboard_z", "arm_pivot_inboard"),
+    ],
+)
+def test_the_checker_knows_every_mechanism(geometry_file, rack, column, broken):
+    """Each mechanism's bodies() names only points of its CSV (a misspelt name would skip
+    its check), has loops to keep when it has closures, and a point moved 1 µm off its
+    body (or its line) in one converged row is caught."""
+    from pin_susp import Corner
+
+    case = _bump_sweep(geometry_file, rack)
+    with run_case(case) as good:
+        check_case(case, good)
+        assert good.code == 0
+        csv = good.texts["out.csv"]
+        header, _ = parse_csv(csv.decode())
+        chassis, groups, loops, lines = bodies(Corner(ROOT / "examples" / geometry_file).geometry)
+        names = set(chassis) | {n for g in groups for n in g} | {n for x in loops for n in x}
+        names |= {n for x in lines for n in x}
+        missing = sorted(n for n in names if f"{n}_x" not in header)
+        assert not missing, f"bodies() names points the CSV does not have: {missing}"
+        assert bool(loops) == ("trailing_arm" not in geometry_file)
+        assert bool(lines) == ("macpherson" in geometry_file)
+        tampered = dataclasses.replace(good, texts={"out.csv": _shift(csv, 2, column, 1e-6)})
+        with pytest.raises(AssertionError, match=broken):
+            check_case(case, tampered)
 
 
 def _edit(csv: bytes, row: int, column: str, value: str) -> bytes:
