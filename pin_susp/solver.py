@@ -21,6 +21,7 @@ Newton iteration usually suffices.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -267,24 +268,30 @@ class _Batch:
             else:
                 self.others.append((i, row))
             i += row.size
+        self.fixed = [model.frames[f].parentJoint == 0 for f in self.frames]
+        self.zero = np.zeros((3, model.nv))
 
     def fill(self, kin: Kinematics, q: np.ndarray, r: np.ndarray, J: np.ndarray | None) -> None:
         """Residual rows, and their Jacobian rows unless J is None."""
         model, data = self.model, kin.data
         oMf = data.oMf
         P = [oMf[f].translation for f in self.frames]  # fresh arrays: no copy needed
-        if J is not None:
-            Jf = [pin.getFrameJacobian(model, data, f, WORLD)[:3] for f in self.frames]
+        if J is not None:  # a frame on the chassis does not move: its Jacobian is zero
+            Jf = [
+                self.zero if fixed else pin.getFrameJacobian(model, data, f, WORLD)[:3]
+                for f, fixed in zip(self.frames, self.fixed, strict=True)
+            ]
         for rows, a, b in self.balls:
             r[rows] = P[b] - P[a]
             if J is not None:
                 J[rows] = Jf[b] - Jf[a]
+        fixed = self.fixed
         for i, a, b, row in self.distances:
             d = P[b] - P[a]
-            n = float(np.sqrt(d @ d))
+            n = math.sqrt(d @ d)
             r[i] = n - row.length
-            if J is not None:
-                J[i] = (d / n) @ (Jf[b] - Jf[a])
+            if J is not None:  # an end on the chassis adds nothing to the row
+                J[i] = (d / n) @ (Jf[b] if fixed[a] else Jf[b] - Jf[a] if not fixed[b] else -Jf[a])
         for i, f, d, axis, row in self.targets:
             if axis is None:
                 r[i] = d @ P[f] - row.value
