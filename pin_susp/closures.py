@@ -203,7 +203,7 @@ class BranchGuard:
         self.moving = moving
         self.fixed = fixed
         self.ids = [
-            ([p.frame_id for p in loop.points], loop.sign, loop.name, loop.measure)
+            (*(p.frame_id for p in loop.points), loop.sign, loop.name, loop.measure)
             for loop in self.loops
         ]
 
@@ -215,8 +215,8 @@ class BranchGuard:
         at = dict(self.fixed)
         for f in self.moving:
             at[f] = oMf[f].translation.tolist()
-        for frames, sign, name, measure in self.ids:
-            if measure(*(at[f] for f in frames)) * sign <= 0.0:
+        for a, b, c, d, sign, name, measure in self.ids:
+            if measure(at[a], at[b], at[c], at[d]) * sign <= 0.0:
                 return name
         return None
 
