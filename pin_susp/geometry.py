@@ -510,35 +510,35 @@ def _setup_block(value, actuation: str, link: tuple, r: Reader) -> tuple[float, 
 
 
 def _unknown_point_hint(key: str, o: Options, names: tuple[str, ...]) -> str:
+    """Why ``key`` is not a point of this corner: another option of its mechanism
+    (steering, spring, actuation) would have it, or another mechanism does."""
     from . import mechanisms
 
-    if key in STEERING_POINTS["rack"] + STEERING_POINTS["none"] and not any(
-        n in names for pts in STEERING_POINTS.values() for n in pts
-    ):
-        return f"not a point of a {o.type} corner (it has no trackrod or toe link)"
-    for other, pts in STEERING_POINTS.items():
-        if key in pts and other != o.steering and key not in names:
-            return (
-                f"not a point of a corner with config.steering.type {o.steering}"
-                f" (it belongs to {other})"
-            )
-    if key in COILOVER_POINTS and o.spring != "coilover":
+    def points(mech, kind: str, **change) -> set[str]:
+        every = set()
+        for steering in change.get("steering", mech.STEERING):
+            for actuation in change.get("actuation", mech.ACTUATION):
+                for spring in change.get("spring", mech.SPRINGS):
+                    options = Options(kind, o.side, steering, actuation, mech.MOUNTS[0], spring)
+                    every |= set(mech.hardpoint_names(options))
+        return every
+
+    mech = mechanisms.get(o.type)
+    if key in points(mech, o.type, actuation=[o.actuation], spring=[o.spring]):
+        other = "rack" if o.steering == "none" else "none"
+        return (
+            f"not a point of a corner with config.steering.type {o.steering}"
+            f" (it belongs to {other})"
+        )
+    if key in points(mech, o.type, actuation=[o.actuation], steering=[o.steering]):
         return "not a point of this corner (strut points need spring type coilover)"
-    if key in PUSHROD_ROCKER_POINTS and o.actuation != "pushrod_rocker":
+    if key in points(mech, o.type):
         return (
             "not a point of this corner (pushrod and rocker points need actuation pushrod_rocker)"
         )
+    if key in STEERING_POINTS["rack"] + STEERING_POINTS["none"]:
+        return f"not a point of a {o.type} corner (it has no trackrod or toe link)"
     for other in mechanisms.NAMES:
-        if other != o.type:
-            mech = mechanisms.get(other)
-            every = Options(
-                other,
-                o.side,
-                mech.STEERING[0],
-                mech.ACTUATION[-1],
-                mech.MOUNTS[0],
-                "coilover" if "coilover" in mech.SPRINGS else mech.SPRINGS[0],
-            )
-            if key in mech.hardpoint_names(every):
-                return f"not a point of a {o.type} corner (it is a {other} point; check 'type')"
+        if other != o.type and key in points(mechanisms.get(other), other):
+            return f"not a point of a {o.type} corner (it is a {other} point; check 'type')"
     return f"unknown hardpoint (this corner has: {', '.join(names)})"
