@@ -6,7 +6,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 DEMO_DIR ?= demo_output
-GEOMETRIES := $(shell grep -l '^hardpoints:' examples/*.yaml)
+GEOMETRIES := $(shell grep -l '^hardpoints:' examples/*.yaml | xargs grep -L '^scope: axle')
 
 .PHONY: demo test fuzz bench urdf lint format clean
 

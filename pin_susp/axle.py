@@ -9,20 +9,27 @@ is parsed from the composed URDF like a corner's (:class:`linkage.Built`).
 
 from __future__ import annotations
 
-from dataclasses import replace
+import copy
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pinocchio as pin
 
 from . import __version__
 from .closures import ContactPatchPoint, JointTarget, PointTarget
-from .geometry import DERIVED_POINTS, Geometry
+from .errors import InputError
+from .geometry import DERIVED_POINTS, MM, Geometry
 from .linkage import Built
 from .solver import NewtonSolver
-from .urdf import Body, Tree
+from .urdf import Body, Closure, Tree, Visual
+from .yamlio import Reader, load_yaml
 
 SIDES = ("left", "right")
 SHARED = ("chassis", "rack")  # bodies both corners hang from
+
+
+def _xml(name: str) -> str:
+    return "".join(c if c.isalnum() or c in "-_." else "_" for c in name) or "axle"
 
 
 def prefixed(tree: Tree, side: str) -> Tree:
@@ -65,8 +72,9 @@ def prefixed(tree: Tree, side: str) -> Tree:
     return Tree(f"{side}_{tree.name}", bodies, points, closures, visuals, dict(tree.materials))
 
 
-def axle_tree(left: Geometry, right: Geometry, name: str = "axle") -> Tree:
-    """Both corners' trees under one chassis, the rack shared."""
+def axle_tree(left: Geometry, right: Geometry, name: str = "axle", elements=None) -> Tree:
+    """Both corners' trees under one chassis, the rack shared; ``elements`` (an
+    AxleGeometry) adds the anti-roll bar and the heave link's points."""
     trees = {
         side: prefixed(g.mechanism.tree(g), side)
         for side, g in zip(SIDES, (left, right), strict=True)
@@ -83,16 +91,80 @@ def axle_tree(left: Geometry, right: Geometry, name: str = "axle") -> Tree:
         closures += tree.closures
         visuals += tree.visuals
         materials |= tree.materials
+    if elements is not None:
+        _add_elements(elements, bodies, points, closures, visuals, materials)
     return Tree(name, bodies, points, closures, visuals, materials)
+
+
+def _add_elements(a: AxleGeometry, bodies, points, closures, visuals, materials) -> None:
+    """The U-bar (an arm per side turning on the bar's axis, a rigid droplink from the
+    rocker or the named body to the arm) and the heave link's ends (measured only)."""
+    from .mechanisms import BALL, ROD, pivot
+
+    materials.setdefault("bar", (0.85, 0.75, 0.15, 1.0))
+    for name, p in a.center.items():
+        points[name] = ("chassis", p)
+    if a.anti_roll == "u_bar":
+        axis = ("arb_u_bar_axis_a", "arb_u_bar_axis_b")
+        for side in SIDES:
+            arm = f"{side}_arb_arm"
+            bodies.append(Body(arm, "chassis", pivot(f"{side}_arb_arm_pivot", *axis, a.center)))
+            sp = a.side_points[side]
+            upper = "droplink_rocker" if "droplink_rocker" in sp else "droplink_lower"
+            carrier = f"{side}_rocker" if upper == "droplink_rocker" else _mount(a, side)
+            points[f"{side}_droplink_u_bar"] = (arm, sp["droplink_u_bar"])
+            points[f"{side}_{upper}"] = (carrier, sp[upper])
+            ends = (f"{side}_{upper}", f"{side}_droplink_u_bar")
+            closures.append(
+                Closure(
+                    f"{side}_droplink",
+                    "distance",
+                    tuple((n, points[n][1]) for n in ends),
+                    ends,
+                    branch=(*axis, *ends),
+                )
+            )
+            foot = _foot(a.center[axis[0]], a.center[axis[1]], sp["droplink_u_bar"])
+            visuals.append(Visual(arm, "rod", "bar", foot, sp["droplink_u_bar"], ROD))
+            visuals.append(Visual(arm, "ball", "bar", sp["droplink_u_bar"], radius=BALL))
+        visuals.append(
+            Visual("chassis", "rod", "bar", a.center[axis[0]], a.center[axis[1]], 1.5 * ROD)
+        )
+    if a.heave_link != "none":
+        for side in SIDES:
+            points[f"{side}_heave_link_rocker"] = (
+                f"{side}_rocker",
+                a.side_points[side]["heave_link_rocker"],
+            )
+
+
+def _mount(a: AxleGeometry, side: str) -> str:
+    """The body that carries a droplink's lower end when there is no rocker."""
+    g = a.corner(side)
+    body = {"arm": g.mechanism.WHEEL_BODY}.get(a.anti_roll_mount, a.anti_roll_mount)
+    return f"{side}_{body}"
+
+
+def _foot(a: np.ndarray, b: np.ndarray, p: np.ndarray) -> np.ndarray:
+    axis = (b - a) / np.linalg.norm(b - a)
+    return a + axis * ((p - a) @ axis)
 
 
 class AxleModel:
     """The composed model: its URDF, Pinocchio model, points (``left_…``, ``right_…``,
-    contact patches included), closures and branches, at the design state."""
+    contact patches included), closures and branches, at the design state.
 
-    def __init__(self, left: Geometry, right: Geometry, name: str = "axle"):
+    ``AxleModel(axle)`` for an AxleGeometry (its bar and heave link included), or
+    ``AxleModel(left, right)`` for two corner Geometries."""
+
+    def __init__(self, left, right: Geometry | None = None, name: str = "axle"):
+        elements = None
+        if right is None:  # an AxleGeometry
+            elements, name = left, left.name
+            left, right = elements.left, elements.right
+        self.axle = elements
         self.geometries = dict(zip(SIDES, (left, right), strict=True))
-        self.tree = axle_tree(left, right, name)
+        self.tree = axle_tree(left, right, _xml(name), elements)
         built = Built(self.tree, f"generated by pin_susp {__version__}: an axle")
         self.urdf, self.model, self.kin = built.urdf, built.model, built.kin
         self.points = dict(built.points)
@@ -143,3 +215,247 @@ class AxleModel:
         start = np.array([t.residual(self.kin)[0] + t.value for t in targets])  # at q
         solver = NewtonSolver(self.kin, self.closures, targets, self.branches)
         return solver.solve(q, start, goal)
+
+
+# ---------------------------------------------------------------- the axle file
+
+ANTI_ROLL = ("none", "u_bar", "t_bar")
+HEAVE_LINK = ("none", "rocker_to_rocker")
+# per-side points of the axle elements (not the corner's), by what needs them
+SIDE_EXTRAS = {
+    "u_bar": ("droplink_rocker", "droplink_u_bar"),
+    "u_bar_direct": ("droplink_lower", "droplink_u_bar"),
+    "t_bar": ("droplink_rocker", "droplink_t_bar"),
+    "t_bar_direct": ("droplink_lower", "droplink_t_bar"),
+    "rocker_to_rocker": ("heave_link_rocker",),
+}
+CENTER = {"u_bar": ("arb_u_bar_axis_a", "arb_u_bar_axis_b"), "t_bar": ("arb_t_bar_pivot",)}
+VEHICLE_KEYS = ("cg_position", "wheelbase", "front_brake_bias", "driven_axle")
+AXLE_KEYS = (
+    "axle_position",
+    "steering",
+    "wheel",
+    "actuation",
+    "spring",
+    "anti_roll",
+    "heave_link",
+    "left_setup",
+    "right_setup",
+)
+
+
+@dataclass(frozen=True)
+class AxleGeometry:
+    """Both corners (their Geometry, as set), the axle elements' points and options."""
+
+    name: str
+    left: Geometry
+    right: Geometry
+    anti_roll: str
+    anti_roll_mount: str | None  # the body a droplink's lower end rides on (no rocker)
+    heave_link: str
+    side_points: dict  # side → {point: (3,) m}: droplinks, heave link ends
+    center: dict  # point → (3,) m: the bar's axis or pivot
+    mirrored: bool  # the right side drawn as the left mirrored
+    source: str = "<dict>"
+    sha256: str | None = None
+    data: dict = field(default_factory=dict, repr=False)
+
+    def corner(self, side: str) -> Geometry:
+        return self.left if side == "left" else self.right
+
+
+class _AxleReader(Reader):
+    """A Reader of a corner assembled from the axle file: each key it blames is named
+    as it stands in the axle file (``config.wheel`` → ``axle_config.wheel``)."""
+
+    def __init__(self, source: str, side: str):
+        super().__init__(source)
+        self.renames = [
+            ("hardpoints", f"hardpoints.{side}"),
+            ("config.camber_shim", f"axle_config.{side}_setup.camber_shim"),
+            ("config.setup", f"axle_config.{side}_setup"),
+            ("config.steering", "axle_config.steering"),
+            ("config.wheel", "axle_config.wheel"),
+            ("config.axle_position", "axle_config.axle_position"),
+            *((f"config.{k}", f"vehicle_config.{k}") for k in VEHICLE_KEYS),
+            ("actuation", "axle_config.actuation"),
+            ("spring", "axle_config.spring"),
+            ("config", "axle_config"),
+        ]
+
+    def fail(self, key: str, problem: str):
+        for old, new in self.renames:
+            if key == old or key.startswith(old + ".") or key.startswith(old + "["):
+                key = new + key[len(old) :]
+                break
+        raise InputError(self.source, key, problem)
+
+
+def load_axle(source) -> AxleGeometry:
+    """Read and validate an axle file (``scope: axle``, spec/axle.md): a path or a dict."""
+    from .geometry import _parse, warn_implausible
+
+    data, name, sha = load_yaml(source)
+    r = Reader(name)
+    r.mapping(
+        data,
+        "",
+        required=("hardpoints", "axle_config"),
+        optional=("type", "scope", "name", "version", "units", "vehicle_config"),
+    )
+    if r.choice(data.get("scope", "corner"), "scope", ("corner", "axle")) != "axle":
+        r.fail("scope", "this is a corner file (scope: corner): load it with load_geometry")
+    vehicle = r.mapping(data.get("vehicle_config", {}), "vehicle_config", optional=VEHICLE_KEYS)
+    config = r.mapping(
+        data["axle_config"], "axle_config", required=("axle_position", "wheel"), optional=AXLE_KEYS
+    )
+    anti = r.mapping(
+        config.get("anti_roll", {}),
+        "axle_config.anti_roll",
+        optional=("type", "mount", "stiffness"),
+    )
+    anti_roll = r.choice(anti.get("type", "none"), "axle_config.anti_roll.type", ANTI_ROLL)
+    heave_map = r.mapping(
+        config.get("heave_link", {}), "axle_config.heave_link", optional=("type",)
+    )
+    heave = r.choice(heave_map.get("type", "none"), "axle_config.heave_link.type", HEAVE_LINK)
+    hp = r.mapping(
+        data["hardpoints"], "hardpoints", required=("left",), optional=("right", "center")
+    )
+    mirrored = "right" not in hp
+    if mirrored and "right_setup" in config:
+        r.fail(
+            "axle_config.right_setup",
+            "a right_setup needs the right corner's own points (hardpoints.right): a "
+            "mirrored right side takes the left's setup",
+        )
+    actuation = config.get("actuation", {})
+    has_rocker = isinstance(actuation, dict) and actuation.get("type") == "pushrod_rocker"
+    extras = ()
+    if anti_roll != "none":
+        extras += SIDE_EXTRAS[anti_roll if has_rocker else f"{anti_roll}_direct"]
+    if heave != "none":
+        if not has_rocker:
+            r.fail(
+                "axle_config.heave_link.type",
+                "a rocker-to-rocker heave link needs pushrod_rocker actuation",
+            )
+        extras += SIDE_EXTRAS[heave]
+    mount = None
+    if anti_roll != "none" and not has_rocker:
+        mount = r.text(anti.get("mount", "upright"), "axle_config.anti_roll.mount")
+
+    corners, side_points = {}, {}
+    for side in SIDES:
+        points = hp["left"] if side == "left" or mirrored else hp["right"]
+        key = "hardpoints.left" if side == "left" or mirrored else "hardpoints.right"
+        if not isinstance(points, dict):
+            r.fail(key, "expected a mapping of point name to {x, y, z}")
+        corner_points = {k: v for k, v in points.items() if k not in extras}
+        missing = [k for k in extras if k not in points]
+        if missing:
+            r.fail(
+                f"{key}.{missing[0]}",
+                "missing point (the axle's anti-roll bar or heave link needs it)",
+            )
+        setup = config.get("right_setup" if side == "right" and not mirrored else "left_setup", {})
+        setup_key = f"axle_config.{'right' if side == 'right' and not mirrored else 'left'}_setup"
+        setup = r.mapping(
+            setup,
+            setup_key,
+            optional=("camber_shim", "trackrod_length_delta", "pushrod_length_delta"),
+        )
+        corner_config = {
+            k: config[k] for k in ("steering", "wheel", "axle_position") if k in config
+        }
+        corner_config |= {k: vehicle[k] for k in VEHICLE_KEYS if k in vehicle}
+        if "camber_shim" in setup:
+            corner_config["camber_shim"] = setup["camber_shim"]
+        adjusters = {
+            k: setup[k] for k in ("trackrod_length_delta", "pushrod_length_delta") if k in setup
+        }
+        if adjusters:
+            corner_config["setup"] = adjusters
+        corner = {
+            "type": data.get("type", "double_wishbone"),
+            "side": "left",
+            "name": f"{data.get('name', 'unnamed axle')} ({side})",
+            "units": data.get("units", "millimeters"),
+            "hardpoints": corner_points,
+            "config": corner_config,
+        }
+        corner |= {k: config[k] for k in ("actuation", "spring") if k in config}
+        if side == "right":
+            corner["side"] = "right"
+            if mirrored:
+                corner = _mirror(corner)
+        reader = _AxleReader(name, "left" if side == "left" or mirrored else "right")
+        corners[side] = _parse(corner, reader, sha)
+        sign = 1.0 if side == "left" else -1.0
+        side_points[side] = {
+            k: reader.point(points[k], f"{key}.{k}")
+            * MM
+            * np.array([1.0, sign if mirrored and side == "right" else 1.0, 1.0])
+            for k in extras
+        }
+    center = {}
+    wanted = CENTER.get(anti_roll, ())
+    center_map = r.mapping(hp.get("center", {}), "hardpoints.center", optional=wanted)
+    for k in wanted:
+        if k not in center_map:
+            r.fail(
+                f"hardpoints.center.{k}", f"missing point (a {anti_roll} anti-roll bar needs it)"
+            )
+        center[k] = r.point(center_map[k], f"hardpoints.center.{k}") * MM
+    if anti_roll == "t_bar" and abs(center["arb_t_bar_pivot"][1]) > 1e-6:
+        r.fail("hardpoints.center.arb_t_bar_pivot", "must lie on the centreline (y = 0)")
+    if anti_roll == "t_bar":
+        r.fail("axle_config.anti_roll.type", "t_bar is not modelled yet (u_bar and none are)")
+    if anti_roll == "u_bar":
+        a, b = center["arb_u_bar_axis_a"], center["arb_u_bar_axis_b"]
+        if np.linalg.norm(b - a) < 1e-6:
+            r.fail(
+                "hardpoints.center.arb_u_bar_axis_b",
+                "coincides with arb_u_bar_axis_a: the bar's axis needs two points",
+            )
+    for g in corners.values():
+        warn_implausible(g)
+    return AxleGeometry(
+        name=r.text(data.get("name", "unnamed axle"), "name"),
+        left=corners["left"],
+        right=corners["right"],
+        anti_roll=anti_roll,
+        anti_roll_mount=mount,
+        heave_link=heave,
+        side_points=side_points,
+        center=center,
+        mirrored=mirrored,
+        source=name,
+        sha256=sha,
+        data=data,
+    )
+
+
+def _mirror(corner: dict) -> dict:
+    """A corner dict mirrored through y = 0: points' y and the shim normal's y negated."""
+    out = copy.deepcopy(corner)
+
+    def flip(p):
+        if isinstance(p, dict) and "y" in p:
+            p["y"] = (
+                -p["y"]
+                if isinstance(p["y"], int | float) and not isinstance(p["y"], bool)
+                else p["y"]
+            )
+        elif isinstance(p, list) and len(p) == 3 and isinstance(p[1], int | float):
+            p[1] = -p[1]
+
+    for p in out["hardpoints"].values():
+        flip(p)
+    shim = out.get("config", {}).get("camber_shim")
+    if isinstance(shim, dict):
+        for k in ("shim_face_point_a", "shim_face_point_b", "shim_face_normal"):
+            if k in shim:
+                flip(shim[k])
+    return out

@@ -290,7 +290,11 @@ def _parse(data: dict, r: Reader, sha: str | None) -> Geometry:
     mech = mechanisms.get(kind)
     scope = r.choice(data.get("scope", "corner"), "scope", ("corner", "axle"))
     if scope != "corner":
-        r.fail("scope", "axle is not supported yet (this version models one corner)")
+        r.fail(
+            "scope",
+            "an axle file: the commands read corner files only so far (the Python API "
+            "reads axles: pin_susp.axle.load_axle)",
+        )
     side = r.choice(data.get("side", "left"), "side", ("left", "right"))
     name = r.text(data.get("name", "unnamed corner"), "name")
     if "version" in data:

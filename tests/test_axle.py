@@ -6,13 +6,16 @@ corner at +z and the right the mirrored corner at −z; the shared rack moves
 both trackrods' inboard ends together.
 """
 
+from pathlib import Path
+
 import numpy as np
 import pytest
+import yaml
 import yourdfpy
-from conftest import example, mirrored
+from conftest import ROOT, example, mirrored
 
 import pin_susp
-from pin_susp.axle import AxleModel
+from pin_susp.axle import AxleModel, load_axle
 from pin_susp.geometry import load_geometry
 
 EXAMPLES = ["double_wishbone.yaml", "macpherson.yaml", "multilink_front.yaml"]
@@ -78,3 +81,84 @@ def test_yourdfpy_reads_the_axle_urdf_and_agrees_with_pinocchio(tmp_path, name):
         np.testing.assert_allclose(
             robot.get_transform(name, "chassis")[:3, 3], at[name], atol=1e-12
         )
+
+
+def axle_file(tmp_path, change=None) -> Path:
+    data = yaml.safe_load((ROOT / "examples" / "axle_front.yaml").read_text())
+    if change:
+        change(data)
+    path = tmp_path / "axle.yaml"
+    path.write_text(yaml.safe_dump(data))
+    return path
+
+
+def test_axle_file_mirrors_the_left_corner_and_adds_the_bar(tmp_path):
+    a = load_axle(axle_file(tmp_path))
+    assert (
+        a.mirrored and a.anti_roll == "u_bar" and a.left.side == "left" and a.right.side == "right"
+    )
+    for name, p in a.left.hardpoints.items():
+        np.testing.assert_array_equal(a.right.hardpoints[name], p * [1, -1, 1], err_msg=name)
+    np.testing.assert_array_equal(
+        a.side_points["right"]["droplink_u_bar"],
+        a.side_points["left"]["droplink_u_bar"] * [1, -1, 1],
+    )
+    model = AxleModel(a)
+    names = [c.name for c in model.closures]
+    assert "left_droplink" in names and "right_droplink" in names
+    # one rack, a bump per side: the bar's arms turn freely (the bar twists)
+    assert model.mobility == 3
+
+
+def test_explicit_right_points_equal_the_mirror(tmp_path):
+    def explicit(data):
+        data["hardpoints"]["right"] = {
+            k: {"x": v["x"], "y": -v["y"], "z": v["z"]}
+            for k, v in data["hardpoints"]["left"].items()
+        }
+
+    mirrored_model = AxleModel(load_axle(axle_file(tmp_path)))
+    explicit_model = AxleModel(load_axle(axle_file(tmp_path, explicit)))
+    wc = {s: mirrored_model.design_positions[f"{s}_wheel_center"][2] for s in ("left", "right")}
+    heights = {"left": wc["left"] + 0.015, "right": wc["right"] - 0.02}
+    a = mirrored_model.positions(mirrored_model.solve(heights, 0.002).q)
+    b = explicit_model.positions(explicit_model.solve(heights, 0.002).q)
+    for name in a:
+        np.testing.assert_allclose(a[name], b[name], atol=1e-15, err_msg=name)
+
+
+def t_bar_off_centre(data):
+    """A T-bar whose pivot is not on the car's centreline."""
+    data["axle_config"]["anti_roll"] = {"type": "t_bar"}
+    left = data["hardpoints"]["left"]
+    left["droplink_t_bar"] = left.pop("droplink_u_bar")
+    data["hardpoints"]["center"] = {"arb_t_bar_pivot": {"x": 0, "y": 10, "z": 300}}
+
+
+@pytest.mark.parametrize(
+    ("change", "key"),
+    [
+        (lambda d: d["axle_config"].update(right_setup={}), "axle_config.right_setup"),
+        (lambda d: d["hardpoints"]["left"].pop("droplink_u_bar"), "hardpoints.left.droplink_u_bar"),
+        (lambda d: d["hardpoints"]["left"].pop("axle_inboard"), "hardpoints.left.axle_inboard"),
+        (lambda d: d["axle_config"]["wheel"].pop("tire"), "axle_config.wheel.tire"),
+        (lambda d: d["vehicle_config"].update(wheelbase=-1), "vehicle_config.wheelbase"),
+        (
+            lambda d: d["hardpoints"]["center"].pop("arb_u_bar_axis_b"),
+            "hardpoints.center.arb_u_bar_axis_b",
+        ),
+        (t_bar_off_centre, "hardpoints.center.arb_t_bar_pivot"),
+        (
+            lambda d: d["axle_config"].update(
+                left_setup={"camber_shim": {"shim_face_point_a": [0, 0, 0]}}
+            ),
+            "axle_config.left_setup.camber_shim",
+        ),
+    ],
+)
+def test_bad_axle_file_names_the_key_as_it_stands_in_the_file(tmp_path, change, key):
+    path = axle_file(tmp_path, change)
+    with pytest.raises(pin_susp.InputError) as info:
+        load_axle(path)
+    assert info.value.source == str(path)
+    assert info.value.key.startswith(key), (info.value.key, str(info.value))

@@ -12,7 +12,12 @@ from conftest import EXAMPLES, ROOT
 import pin_susp
 from pin_susp.urdf import read_closures
 
-GEOMETRIES = sorted(p for p in EXAMPLES.glob("*.yaml") if "hardpoints" in p.read_text())
+# corner files (an axle file, scope: axle, has no corner URDF of its own yet)
+GEOMETRIES = sorted(
+    p
+    for p in EXAMPLES.glob("*.yaml")
+    if "hardpoints" in p.read_text() and "scope: axle" not in p.read_text()
+)
 
 
 def test_examples_exist():
