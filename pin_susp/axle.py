@@ -459,3 +459,134 @@ def _mirror(corner: dict) -> dict:
             if k in shim:
                 flip(shim[k])
     return out
+
+
+# ---------------------------------------------------------------- sweeps
+
+Z = np.array([0.0, 0.0, 1.0])
+
+
+class HeaveTarget:
+    """½(ΔWC_z,L + ΔWC_z,R) held at a value (m): 1 row."""
+
+    size = 1
+    name = "target heave"
+
+    def __init__(self, left, right, design: float, value: float = 0.0):
+        self.left, self.right, self.design, self.value = left, right, design, value
+
+    def residual(self, kin) -> np.ndarray:
+        z = self.left.position(kin)[2] + self.right.position(kin)[2]
+        return np.array([0.5 * z - self.design - self.value])
+
+    def jacobian(self, kin) -> np.ndarray:
+        return (0.5 * (self.left.jacobian(kin)[2] + self.right.jacobian(kin)[2]))[None]
+
+
+class RollTarget:
+    """atan2(ΔWC_z,L − ΔWC_z,R, CP_y,L − CP_y,R) held at a value (rad): 1 row
+    (open-kinematics' roll: + = the left wheel higher relative to the chassis)."""
+
+    size = 1
+    name = "target roll"
+
+    def __init__(self, wheels, patches, design: float, value: float = 0.0):
+        self.wheels, self.patches = wheels, patches  # (left, right) each
+        self.design, self.value = design, value  # design: ΔWC_z,L − ΔWC_z,R offset (m)
+
+    def _parts(self, kin):
+        (wl, wr), (cl, cr) = self.wheels, self.patches
+        a = wl.position(kin)[2] - wr.position(kin)[2] - self.design
+        b = cl.position(kin)[1] - cr.position(kin)[1]
+        return a, b
+
+    def residual(self, kin) -> np.ndarray:
+        a, b = self._parts(kin)
+        return np.array([np.arctan2(a, b) - self.value])
+
+    def jacobian(self, kin) -> np.ndarray:
+        a, b = self._parts(kin)
+        (wl, wr), (cl, cr) = self.wheels, self.patches
+        da = wl.jacobian(kin)[2] - wr.jacobian(kin)[2]
+        db = cl.jacobian(kin)[1] - cr.jacobian(kin)[1]
+        return ((b * da - a * db) / (a * a + b * b))[None]
+
+
+def axle_rows(model: AxleModel, targets, source: str = "<targets>") -> list:
+    """The solver's rows for a sweep's targets on an axle (one value each, set later)."""
+    rows = []
+    p = model.points
+    d = model.design_positions
+    for i, t in enumerate(targets):
+        if t.quantity == "heave":
+            z0 = 0.5 * (d["left_wheel_center"][2] + d["right_wheel_center"][2])
+            rows.append(HeaveTarget(p["left_wheel_center"], p["right_wheel_center"], z0))
+        elif t.quantity == "roll":
+            z0 = d["left_wheel_center"][2] - d["right_wheel_center"][2]
+            wheels = (p["left_wheel_center"], p["right_wheel_center"])
+            patches = (p["left_contact_patch_center"], p["right_contact_patch_center"])
+            rows.append(RollTarget(wheels, patches, z0))
+        else:
+            if t.side is None:
+                raise InputError(
+                    source,
+                    f"targets[{i}].side",
+                    "missing: an axle's point targets name their corner (side: left|right)",
+                )
+            name = f"{t.side}_{t.point}"
+            if name not in p:
+                known = ", ".join(model.point_names[t.side])
+                raise InputError(
+                    source, f"targets[{i}].point", f"unknown point {t.point!r} (points: {known})"
+                )
+            rows.append(PointTarget(p[name], t.unit_direction))
+    return rows
+
+
+def target_values(model: AxleModel, targets) -> np.ndarray:
+    """Each step's target values in SI: heave m, roll rad, points m (absolute)."""
+    cols = []
+    for t in targets:
+        v = np.asarray(t.values, dtype=float)
+        if t.quantity == "heave":
+            cols.append(v * 1e-3)
+        elif t.quantity == "roll":
+            cols.append(np.radians(v))
+        else:
+            v = v * 1e-3
+            if t.mode == "relative":
+                v = v + model.design_positions[f"{t.side}_{t.point}"] @ t.unit_direction
+            cols.append(v)
+    return np.column_stack(cols)
+
+
+def solve_axle_sweep(model: AxleModel, sweep, source: str | None = None) -> list:
+    """Solve every step in order, each from the last solution (halving on failure);
+    the targets must fix the pose (as many as the axle's freedoms, independent)."""
+    source = source or sweep.source
+    rows = axle_rows(model, sweep.targets, source)
+    if len(rows) != model.mobility:
+        raise InputError(
+            source,
+            "targets",
+            f"{len(rows)} target(s) given, this axle needs exactly {model.mobility} "
+            "(a wheel height per side, or heave and roll; and the rack)",
+        )
+    solver = NewtonSolver(model.kin, model.closures, rows, model.branches)
+    solver.evaluate(model.q_design)
+    if np.linalg.cond(solver.jacobian) > 1e10:
+        raise InputError(
+            source, "targets", "the targets do not fix the axle's pose at its design state"
+        )
+    values = target_values(model, sweep.targets)
+    model.kin.update_positions(model.q_design)
+    previous = np.array([row.residual(model.kin)[0] for row in rows]) + np.array(
+        [getattr(row, "value", 0.0) for row in rows]
+    )
+    q, out = model.q_design, []
+    for goal in values:
+        solution = solver.solve(q, previous, goal)
+        if solution.converged:
+            q, previous = solution.q, goal
+        out.append(solution)
+    return out

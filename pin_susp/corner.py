@@ -186,6 +186,18 @@ class Corner(Linkage):
     def _check_targets(self, targets: list[Target], source: str) -> None:
         known = ", ".join(self.point_names)
         for i, t in enumerate(targets):
+            if t.quantity is not None:
+                raise InputError(
+                    source,
+                    f"targets[{i}].quantity",
+                    f"{t.quantity} is an axle's quantity: this geometry is one corner",
+                )
+            if t.side is not None:
+                raise InputError(
+                    source,
+                    f"targets[{i}].side",
+                    "a side is for an axle's targets: this geometry is one corner",
+                )
             key = f"targets[{i}].point"
             if t.point not in self.points:
                 raise InputError(source, key, f"unknown point {t.point!r} (points: {known})")

@@ -21,6 +21,7 @@ from .yamlio import Reader, _short, load_yaml
 BYTES_PER_STEP = 12_500
 
 AXES = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
+QUANTITIES = ("heave", "roll")  # an axle's own targets: heave mm, roll deg
 
 
 @dataclass(frozen=True)
@@ -31,24 +32,32 @@ class Target:
     the direction; ``"absolute"`` takes it as a world coordinate.
     """
 
-    point: str
-    direction: str | Sequence[float]
+    point: str | None
+    direction: str | Sequence[float] | None
     values: float | Sequence[float] = 0.0
     mode: str = "relative"
+    side: str | None = None  # left | right: which corner of an axle
+    quantity: str | None = None  # heave (mm) | roll (deg): an axle quantity, not a point
 
     def __post_init__(self):
         object.__setattr__(self, "values", np.atleast_1d(np.asarray(self.values, dtype=float)))
 
     @property
     def unit_direction(self) -> np.ndarray:
+        if self.direction is None:
+            return np.zeros(3)
         if isinstance(self.direction, str):
             return np.array(AXES[self.direction])
         return direction(self.direction)
 
     @property
-    def key(self) -> tuple[str, tuple[float, ...]]:
-        """(point, unit direction): what the target holds, however it was written."""
-        return self.point, tuple(self.unit_direction.tolist())
+    def key(self) -> tuple:
+        """(point, unit direction[, side]) or the quantity: what the target holds,
+        however it was written."""
+        if self.quantity is not None:
+            return (self.quantity,)
+        key = (self.point, tuple(self.unit_direction.tolist()))
+        return key if self.side is None else (*key, self.side)
 
     def at_design(self) -> Target:
         """The same target holding the point where it is at the design state."""
@@ -92,13 +101,18 @@ def load_sweep(source: str | Path | dict) -> Sweep:
 
 
 def _target(value, key: str, steps: int | None, r: Reader) -> Target:
+    if isinstance(value, dict) and "quantity" in value:  # an axle's heave or roll
+        t = r.mapping(value, key, required=("quantity",), optional=("start", "stop", "values"))
+        quantity = r.choice(t["quantity"], f"{key}.quantity", QUANTITIES)
+        return Target(None, None, _values(t, key, steps, r), "relative", quantity=quantity)
     t = r.mapping(
         value,
         key,
         required=("point", "direction"),
-        optional=("mode", "start", "stop", "values"),
+        optional=("mode", "start", "stop", "values", "side"),
     )
     point = r.text(t["point"], f"{key}.point")
+    side = None if "side" not in t else r.choice(t["side"], f"{key}.side", ("left", "right"))
     d = r.mapping(t["direction"], f"{key}.direction", optional=("axis", "vector"))
     if ("axis" in d) == ("vector" in d):
         r.fail(f"{key}.direction", "give exactly one of axis: x|y|z or vector: [x, y, z]")
@@ -110,7 +124,12 @@ def _target(value, key: str, steps: int | None, r: Reader) -> Target:
             r.fail(f"{key}.direction.vector", "is the zero vector (it needs a direction)")
         along = tuple(along.tolist())
     mode = r.choice(t.get("mode", "relative"), f"{key}.mode", ("relative", "absolute"))
+    return Target(point, along, _values(t, key, steps, r), mode, side)
 
+
+def _values(t: dict, key: str, steps: int | None, r: Reader):
+    """A target's values: a list, or start/stop over the sweep's steps (mm, or deg for
+    roll)."""
     if "values" in t:
         if "start" in t or "stop" in t:
             r.fail(key, "give either values or start/stop, not both")
@@ -129,7 +148,7 @@ def _target(value, key: str, steps: int | None, r: Reader) -> Target:
         start = r.length(t["start"], f"{key}.start")
         stop = r.length(t["stop"], f"{key}.stop")
         values = np.linspace(start, stop, steps)
-    return Target(point, along, values, mode)
+    return values
 
 
 def _check_memory(steps: int, r: Reader) -> None:

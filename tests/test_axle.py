@@ -15,8 +15,9 @@ import yourdfpy
 from conftest import ROOT, example, mirrored
 
 import pin_susp
-from pin_susp.axle import AxleModel, load_axle
+from pin_susp.axle import AxleModel, load_axle, solve_axle_sweep
 from pin_susp.geometry import load_geometry
+from pin_susp.sweep import load_sweep
 
 EXAMPLES = ["double_wishbone.yaml", "macpherson.yaml", "multilink_front.yaml"]
 
@@ -162,3 +163,67 @@ def test_bad_axle_file_names_the_key_as_it_stands_in_the_file(tmp_path, change, 
         load_axle(path)
     assert info.value.source == str(path)
     assert info.value.key.startswith(key), (info.value.key, str(info.value))
+
+
+def roll_sweep(steps=5):
+    return load_sweep(
+        {
+            "steps": steps,
+            "targets": [
+                {"quantity": "roll", "start": -3, "stop": 3},
+                {"quantity": "heave", "values": [10.0] * steps},
+                {
+                    "point": "trackrod_inboard",
+                    "side": "left",
+                    "direction": {"axis": "y"},
+                    "values": [0.0] * steps,
+                },
+            ],
+        }
+    )
+
+
+def test_roll_and_heave_targets_hold_their_definitions(tmp_path):
+    """roll = atan2(ΔWC_z,L − ΔWC_z,R, CP_y,L − CP_y,R), heave = ½(ΔWC_z,L + ΔWC_z,R),
+    computed here from the solved points; a mirrored axle rolls symmetrically."""
+    model = AxleModel(load_axle(axle_file(tmp_path)))
+    solutions = solve_axle_sweep(model, roll_sweep())
+    d = model.design_positions
+    for roll, s in zip(np.linspace(-3, 3, 5), solutions, strict=True):
+        assert s.converged and s.max_residual <= 1e-12
+        p = model.positions(s.q)
+        dl = p["left_wheel_center"][2] - d["left_wheel_center"][2]
+        dr = p["right_wheel_center"][2] - d["right_wheel_center"][2]
+        track = p["left_contact_patch_center"][1] - p["right_contact_patch_center"][1]
+        assert np.degrees(np.arctan2(dl - dr, track)) == pytest.approx(roll, abs=1e-12)
+        assert 0.5 * (dl + dr) * 1e3 == pytest.approx(10.0, abs=1e-9)
+        assert dl * 1e3 == pytest.approx(20.0 - dr * 1e3, abs=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("targets", "key"),
+    [
+        ([{"point": "wheel_center", "direction": {"axis": "z"}, "values": [1]}], "targets[0].side"),
+        ([{"quantity": "roll", "values": [1]}], "targets"),
+    ],
+)
+def test_axle_targets_must_name_a_side_and_fix_the_pose(tmp_path, targets, key):
+    model = AxleModel(load_axle(axle_file(tmp_path)))
+    with pytest.raises(pin_susp.InputError) as info:
+        solve_axle_sweep(model, load_sweep({"targets": targets}))
+    assert info.value.key == key
+
+
+def test_a_corner_refuses_a_side_or_an_axle_quantity():
+    corner = pin_susp.Corner(example("double_wishbone.yaml"))
+    for target, key in (
+        ({"point": "wheel_center", "side": "left", "direction": {"axis": "z"}}, "targets[0].side"),
+        ({"quantity": "heave"}, "targets[0].quantity"),
+    ):
+        sweep = load_sweep({"targets": [target | {"values": [1.0]}, RACK]})
+        with pytest.raises(pin_susp.InputError) as info:
+            corner.run_sweep(sweep)
+        assert info.value.key == key
+
+
+RACK = {"point": "trackrod_inboard", "direction": {"axis": "y"}, "values": [0.0]}
