@@ -19,13 +19,18 @@ from . import __version__
 from .closures import ContactPatchPoint, JointTarget, PointTarget
 from .errors import InputError
 from .geometry import DERIVED_POINTS, MM, Geometry
-from .linkage import Built
+from .linkage import Built, Linkage
 from .solver import NewtonSolver
 from .urdf import Body, Closure, Tree, Visual
 from .yamlio import Reader, load_yaml
 
 SIDES = ("left", "right")
 SHARED = ("chassis", "rack")  # bodies both corners hang from
+
+
+def _corner_point(name: str, point_names: dict) -> bool:
+    side, _, rest = name.partition("_")
+    return side in point_names and rest in point_names[side]
 
 
 def _xml(name: str) -> str:
@@ -183,17 +188,28 @@ class AxleModel:
             )
             self.point_names[side] = tuple(g.hardpoints) + DERIVED_POINTS
         self.mobility = self.model.nv - sum(c.size for c in self.closures)
+        # the points written: each corner's, then the bar's and heave link's
+        extras = [n for n in self.tree.points if not _corner_point(n, self.point_names)]
+        self.output_points = [
+            f"{side}_{n}" for side, names in self.point_names.items() for n in names
+        ] + extras
+        self.frame_names = [n for n in self.output_points if "contact_patch_center" not in n]
         self.kin.update(self.q_design)
         self.design_positions = self.positions(self.q_design)
+        self.design_steer = {}
+        for side, g in self.geometries.items():
+            d = self.design_positions
+            a = d[f"{side}_axle_outboard"] - d[f"{side}_axle_inboard"]
+            self.design_steer[side] = -g.sign * np.degrees(np.arctan2(a[0], g.sign * a[1]))
+        self.spring_sense = {
+            side: (Linkage(g).spring_sense if g.spring == "torsion_bar" else 1.0)
+            for side, g in self.geometries.items()
+        }
 
     def positions(self, q: np.ndarray) -> dict[str, np.ndarray]:
         """World position (m) of every named point (prefixed) at configuration q."""
         pin.framesForwardKinematics(self.model, self.kin.data, q)
-        return {
-            f"{side}_{n}": self.points[f"{side}_{n}"].position(self.kin).copy()
-            for side, names in self.point_names.items()
-            for n in names
-        }
+        return {n: self.points[n].position(self.kin).copy() for n in self.output_points}
 
     def side_positions(self, q: np.ndarray, side: str) -> dict[str, np.ndarray]:
         """One corner's points at q, by their corner names."""
@@ -560,9 +576,10 @@ def target_values(model: AxleModel, targets) -> np.ndarray:
     return np.column_stack(cols)
 
 
-def solve_axle_sweep(model: AxleModel, sweep, source: str | None = None) -> list:
+def solve_axle_sweep(model: AxleModel, sweep, source: str | None = None, progress=None) -> list:
     """Solve every step in order, each from the last solution (halving on failure);
-    the targets must fix the pose (as many as the axle's freedoms, independent)."""
+    the targets must fix the pose (as many as the axle's freedoms, independent).
+    ``progress(done, total)`` is called after each step."""
     source = source or sweep.source
     rows = axle_rows(model, sweep.targets, source)
     if len(rows) != model.mobility:
@@ -584,9 +601,213 @@ def solve_axle_sweep(model: AxleModel, sweep, source: str | None = None) -> list
         [getattr(row, "value", 0.0) for row in rows]
     )
     q, out = model.q_design, []
-    for goal in values:
+    for i, goal in enumerate(values):
         solution = solver.solve(q, previous, goal)
         if solution.converged:
             q, previous = solution.q, goal
         out.append(solution)
+        if progress is not None:
+            progress(i + 1, len(values))
     return out
+
+
+# ---------------------------------------------------------------- columns
+
+
+class AxleResults:
+    """Columns of a solved axle sweep (spec/axle.md), in output units; CSV like a
+    corner's (export.csv_text)."""
+
+    def __init__(self, columns: dict, units: dict, meta: dict):
+        self.columns, self.units, self.meta = columns, units, meta
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        return self.columns[name]
+
+    def __len__(self) -> int:
+        return len(self.columns["step_index"])
+
+    @property
+    def failed_steps(self) -> np.ndarray:
+        return np.flatnonzero(~self.columns["solver_converged"])
+
+
+def axle_results(model: AxleModel, sweep, solutions: list) -> AxleResults:
+    """Every corner column per side (suffix ``_left``/``_right``, derivatives along
+    that side's wheel-centre z and the rack, the other wheel held), the axle's
+    columns, then the points (``left_…``, ``right_…``, the bar's)."""
+    from .metrics import metric_columns
+
+    n = len(solutions)
+    ok = np.array([s.converged for s in solutions])
+    columns = {
+        "step_index": np.arange(n),
+        "solver_converged": ok,
+        "solver_max_residual": np.array([s.max_residual for s in solutions]) * 1e3,
+        "solver_iterations": np.array([s.iterations for s in solutions]),
+    }
+    units = dict.fromkeys(columns, "") | {"solver_max_residual": "mm"}
+    qs = [s.q if s.converged else None for s in solutions]
+    points = _motion(model, qs)
+    sides = {}
+    for side, g in model.geometries.items():
+        design = {k: model.design_positions[f"{side}_{k}"][None] for k in model.point_names[side]}
+        own = {k: points[f"{side}_{k}"][side] for k in model.point_names[side]}
+        sides[side] = metric_columns(g, own, design, model.spring_sense[side])
+    for side, cols in sides.items():
+        for name, (values, unit) in cols.items():
+            columns[f"{name}_{side}"], units[f"{name}_{side}"] = values, unit
+    plain = {k: v["left"].val for k, v in points.items()}
+    for name, (values, unit) in _axle_metrics(model, plain, sides).items():
+        columns[name], units[name] = values, unit
+    for name in model.output_points:
+        for i, axis in enumerate("xyz"):
+            columns[f"{name}_{axis}"] = plain[name][:, i] * 1e3
+            units[f"{name}_{axis}"] = "mm"
+    source = model.axle.source if model.axle is not None else "<geometries>"
+    sha = model.axle.sha256 if model.axle is not None else None
+    meta = {
+        "geometry": (source, sha),
+        "sweep": (sweep.source, sweep.sha256),
+        "q": np.array([s.q for s in solutions]),
+        "why": [s.why for s in solutions],
+    }
+    return AxleResults(columns, units, meta)
+
+
+def _motion(model: AxleModel, qs: list) -> dict:
+    """Every point (prefixed) at every step, as a Dual per side: that side's rates along
+    its wheel-centre z (the other wheel centre and the rack held) and the rack. A
+    step that did not converge is NaN."""
+    from .geometry import contact_patch
+    from .jet import Dual
+
+    rack = model.model.existJointName("rack_slide")
+    drive = [PointTarget(model.points[f"{s}_wheel_center"], Z) for s in SIDES]
+    if rack:
+        drive.append(JointTarget(model.model, "rack_slide"))
+    solver = NewtonSolver(model.kin, model.closures, drive, model.branches)
+    names = [n for n in model.frame_names]
+    n, k = len(qs), len(drive)
+    pos = np.full((len(names), n, 3), np.nan)
+    rates = np.full((len(names), k, n, 3), np.nan)
+    for i, q in enumerate(qs):
+        if q is None:
+            continue
+        solver.evaluate(q)
+        tangent = solver.tangent()
+        for j, name in enumerate(names):
+            point = model.points[name]
+            pos[j, i] = point.position(model.kin)
+            rates[j, :, i] = (point.jacobian(model.kin) @ tangent).T
+    out = {}
+    for j, name in enumerate(names):
+        out[name] = {
+            side: Dual(pos[j], rates[j][[c, 2] if rack else [c]]) for c, side in enumerate(SIDES)
+        }
+    for side, g in model.geometries.items():
+        p = {k: out[f"{side}_{k}"] for k in ("wheel_center", "axle_inboard", "axle_outboard")}
+        out[f"{side}_contact_patch_center"] = {
+            s: contact_patch(
+                p["wheel_center"][s],
+                _unit(p["axle_outboard"][s] - p["axle_inboard"][s]),
+                g.wheel.radius,
+            )
+            for s in SIDES
+        }
+    return out
+
+
+def _unit(v):
+    return v / np.linalg.norm(v, axis=-1, keepdims=True)
+
+
+def _axle_metrics(model: AxleModel, p: dict, sides: dict) -> dict:
+    """heave, roll, body_roll, camber to ground, ride height, track, roll centre, rack,
+    steer angles and Ackermann, the U-bar's arm angles and twist, the heave link."""
+    d = {k: v[None] for k, v in model.design_positions.items()}
+    dz = {s: p[f"{s}_wheel_center"][:, 2] - d[f"{s}_wheel_center"][:, 2] for s in SIDES}
+    cp = {s: p[f"{s}_contact_patch_center"] for s in SIDES}
+    track = cp["left"][:, 1] - cp["right"][:, 1]
+    out = {
+        "heave": (0.5 * (dz["left"] + dz["right"]) * 1e3, "mm"),
+        "roll": (np.degrees(np.arctan2(dz["left"] - dz["right"], track)), "deg"),
+    }
+    body_roll = np.degrees(np.arctan2(cp["right"][:, 2] - cp["left"][:, 2], track))
+    out["body_roll"] = (body_roll, "deg")
+    for side, s in (("left", 1.0), ("right", -1.0)):
+        camber = sides[side]["camber"][0]
+        out[f"camber_to_ground_{side}"] = (camber - s * body_roll, "deg")
+    cp0 = {s: d[f"{s}_contact_patch_center"][:, 2] for s in SIDES}
+    change = -0.5 * ((cp["left"][:, 2] - cp0["left"]) + (cp["right"][:, 2] - cp0["right"]))
+    out["ride_height_change"] = (change * 1e3, "mm")
+    out["track"] = (np.abs(track) * 1e3, "mm")
+    rc = _roll_centre(
+        [(cp[s][:, 1:] * 1e3, sides[s]["fvic_y"][0], sides[s]["fvic_z"][0]) for s in SIDES]
+    )
+    out["roll_center_y"], out["roll_center_z"] = (rc[0], "mm"), (rc[1], "mm")
+    if "left_trackrod_inboard" in p:
+        rack = p["left_trackrod_inboard"][:, 1] - d["left_trackrod_inboard"][:, 1]
+        out["rack_displacement"] = (rack * 1e3, "mm")
+    steer = {}
+    for side, s in (("left", 1.0), ("right", -1.0)):
+        steer[side] = -s * sides[side]["roadwheel_angle"][0]
+        out[f"steer_angle_{side}"] = (steer[side], "deg")
+    out["ackermann"] = (_ackermann(model, steer, track), "%")
+    a = model.axle
+    if a is not None and a.anti_roll == "u_bar":
+        axis = (a.center["arb_u_bar_axis_a"], a.center["arb_u_bar_axis_b"])
+        angles = {}
+        for side in SIDES:
+            name = f"{side}_droplink_u_bar"
+            angles[side] = _turn(axis, d[name], p[name])
+            out[f"arb_arm_angle_{side}"] = (angles[side], "deg")
+        out["arb_twist"] = (angles["left"] - angles["right"], "deg")
+    if a is not None and a.heave_link != "none":
+        length = np.linalg.norm(p["left_heave_link_rocker"] - p["right_heave_link_rocker"], axis=-1)
+        out["heave_link_length"] = (length * 1e3, "mm")
+    return out
+
+
+def _turn(axis, p0: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """Signed rotation (deg) of a point about the axis a → b from p0 (right-hand rule)."""
+    a, b = axis
+    u = (b - a) / np.linalg.norm(b - a)
+    w0, w = p0 - a, p - a
+    w0 = w0 - np.outer(w0 @ u, u)
+    w = w - np.outer(w @ u, u)
+    return np.degrees(np.arctan2(np.cross(w0, w) @ u, np.sum(w0 * w, axis=-1)))
+
+
+def _roll_centre(sides) -> tuple[np.ndarray, np.ndarray]:
+    """Where the lines CP→FVIC of the two sides cross (front view, mm); NaN where an
+    FVIC is blank or the lines are parallel."""
+    (cl, yl, zl), (cr, yr, zr) = sides
+    d1 = np.column_stack([yl, zl]) - cl
+    d2 = np.column_stack([yr, zr]) - cr
+    det = d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        det = np.where(np.abs(det) > 1e-12 * np.hypot(*d1.T) * np.hypot(*d2.T), det, np.nan)
+        w = cr - cl
+        t = (w[:, 0] * d2[:, 1] - w[:, 1] * d2[:, 0]) / det
+    point = cl + t[:, None] * d1
+    return point[:, 0], point[:, 1]
+
+
+def _ackermann(model: AxleModel, steer: dict, track: np.ndarray) -> np.ndarray:
+    """100·(δ_i − δ_o)/(δ_i* − δ_o) from the steer angles' change from design; blank for
+    |δ_o| < 0.5° or without a wheelbase."""
+    wheelbase = model.geometries["left"].wheelbase
+    n = len(track)
+    if wheelbase is None:
+        return np.full(n, np.nan)
+    design = model.design_steer
+    delta = {s: np.abs(steer[s] - design[s]) for s in SIDES}
+    left_inner = (steer["left"] + steer["right"]) > 0.0
+    inner = np.where(left_inner, delta["left"], delta["right"])
+    outer = np.where(left_inner, delta["right"], delta["left"])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        o = np.radians(outer)
+        ideal = np.degrees(np.arctan2(wheelbase, wheelbase / np.tan(o) - np.abs(track)))
+        out = 100.0 * (inner - outer) / (ideal - outer)
+    return np.where(outer >= 0.5, out, np.nan)

@@ -215,6 +215,8 @@ def _sweep(args) -> int:
     _check_outputs(args, args.output, args.plot)
     if args.plot is not None:
         _check_image(args.plot)
+    if _is_axle(args.geometry):
+        return _sweep_axle(args)
     corner = Corner(load_geometry(args.geometry))
     sweep = load_sweep(args.sweep)
     corner.solver_for(sweep.targets, sweep.source)  # target errors before any work
@@ -236,6 +238,63 @@ def _sweep(args) -> int:
         if plot:
             print(f"wrote {args.plot}")
     return _report_failures(results)
+
+
+def _is_axle(path) -> bool:
+    """Whether a geometry file is an axle's (scope: axle)."""
+    from .yamlio import load_yaml
+
+    data, _, _ = load_yaml(path)
+    return data.get("scope") == "axle"
+
+
+def _sweep_axle(args) -> int:
+    """An axle's sweep: both corners' columns (suffixed by side) and the axle's."""
+    from .axle import AxleModel, axle_results, load_axle, solve_axle_sweep
+
+    if args.plot is not None:
+        raise PinSuspError("--plot: the axle report is not drawn yet (the CSV is written)")
+    model = AxleModel(load_axle(args.geometry))
+    sweep = load_sweep(args.sweep)
+    solutions = solve_axle_sweep(model, sweep, progress=_progress_bar(sweep.steps, args.quiet))
+    results = axle_results(model, sweep, solutions)
+    write_text(csv_text(results), args.output)
+    if not args.quiet:
+        ok = results["solver_converged"]
+        print(
+            f"wrote {args.output}: {len(results)} steps, {int(ok.sum())} converged, "
+            f"max residual {np.nanmax(results['solver_max_residual']):.1e} mm"
+        )
+        print(f"  {'column':<28}{'unit':>7}{'first':>13}{'last':>13}{'min':>13}{'max':>13}")
+        for name in AXLE_SUMMARY:
+            if name in results.columns and not np.all(np.isnan(results[name])):
+                v = results[name]
+                print(
+                    f"  {name:<28}{results.units[name]:>7}{v[0]:>13.6g}{v[-1]:>13.6g}"
+                    f"{np.nanmin(v):>13.6g}{np.nanmax(v):>13.6g}"
+                )
+        print("  (every column of both corners, suffixed _left/_right, is in the CSV)")
+    return _report_failures(results)
+
+
+AXLE_SUMMARY = (
+    "heave",
+    "roll",
+    "body_roll",
+    "camber_left",
+    "camber_right",
+    "camber_to_ground_left",
+    "camber_to_ground_right",
+    "roadwheel_angle_left",
+    "roadwheel_angle_right",
+    "roll_center_y",
+    "roll_center_z",
+    "track",
+    "ride_height_change",
+    "arb_twist",
+    "heave_link_length",
+    "ackermann",
+)
 
 
 def _urdf_command(sub) -> None:

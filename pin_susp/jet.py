@@ -199,6 +199,13 @@ _FUNCTIONS = {
 }
 
 
+def plain_der(x):
+    """The driver-level derivative array of a (possibly nested) Dual."""
+    while isinstance(x.val, Dual):
+        x = x.val
+    return x.der
+
+
 def rate(x, i: int):
     """The rate of x along driver ``i``, kept as the same kind of object.
 
@@ -210,8 +217,8 @@ def rate(x, i: int):
     i; the rate's own change along the drivers (a second derivative) is not
     known and is NaN. A plain array has no rates: NaN.
     """
-    if not isinstance(x, Dual):
-        return np.full(np.shape(x), np.nan)
+    if not isinstance(x, Dual) or i >= np.shape(plain_der(x))[0]:  # no such driver
+        return np.full(np.shape(value(x)), np.nan)
     if isinstance(x.val, Dual):
         outer = x.der
         return Dual(
