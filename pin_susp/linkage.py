@@ -152,7 +152,7 @@ class Linkage:
         n = len(rows) - len(self._drive.targets)
         if n:
             s = np.linalg.svd(rows[:n], compute_uv=False)
-            if s[-1] < 1e-9 * s[0]:
+            if s[-1] <= 1e-9 * s[0]:
                 raise InputError(
                     self.geometry.source,
                     "hardpoints",
@@ -161,7 +161,7 @@ class Linkage:
                     f"freedoms than {self.mobility} and no pose can be solved",
                 )
         s = np.linalg.svd(rows, compute_uv=False)
-        if s[-1] < 1e-9 * s[0]:
+        if s[-1] <= 1e-9 * s[0]:  # (a lone zero row too: a wheel that cannot rise)
             held = " with the rack held" if self.geometry.steering == "rack" else ""
             raise InputError(
                 self.geometry.source,

@@ -226,9 +226,10 @@ class CornerScene:
                 self.viewer[f"{ROOT}/links/{name}"].set_object(
                     mg.Cylinder(1.0, radius), mg.MeshLambertMaterial(color=colour)
                 )
-        self.viewer[f"{ROOT}/links/steering_axis"].set_object(
-            mg.Cylinder(1.0, 0.003), mg.MeshLambertMaterial(color=AXIS_COLOUR)
-        )
+        if "steering_axis" in present:  # none on a trailing arm
+            self.viewer[f"{ROOT}/links/steering_axis"].set_object(
+                mg.Cylinder(1.0, 0.003), mg.MeshLambertMaterial(color=AXIS_COLOUR)
+            )
         self.viewer[f"{ROOT}/contact_patch"].set_object(
             mg.Sphere(0.018), mg.MeshLambertMaterial(color=PATCH_COLOUR)
         )

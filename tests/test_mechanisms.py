@@ -851,6 +851,24 @@ def clamp_off_line(g):
 
 
 BAD_INPUT = {
+    "macpherson trackrod end on the steering axis": (
+        "macpherson.yaml",
+        lambda g: g["hardpoints"].update(trackrod_outboard={"x": 5, "y": 735, "z": 120}),
+        "hardpoints.trackrod_outboard: lies on the steering axis",
+    ),
+    "double wishbone toe link end on the steering axis": (
+        "fixed_toe_link.yaml",
+        lambda g: g["hardpoints"].update(toe_link_outboard={"x": -5, "y": 585, "z": 215}),
+        "hardpoints.toe_link_outboard: lies on the steering axis",
+    ),
+    "trailing arm whose pivot axis is vertical (no bump)": (
+        "semi_trailing_arm.yaml",
+        lambda g: g["hardpoints"].update(
+            arm_pivot_inboard={"x": 300, "y": 600, "z": 100},
+            arm_pivot_outboard={"x": 300, "y": 600, "z": 500},
+        ),
+        "hardpoints: the linkage locks the wheel for bump",
+    ),
     "macpherson clamp 2 mm off the strut line": (
         "macpherson.yaml",
         clamp_off_line,

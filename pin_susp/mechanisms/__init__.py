@@ -52,6 +52,9 @@ MATERIALS = {
 ROD = 0.008  # m, visual radius of links
 BALL = 0.014  # m, visual radius of joints
 Y = np.array([0.0, 1.0, 0.0])
+# sin² of the angle between two link lines below this: parallel, no virtual joint
+# (1e-12: within 1e-6 rad, where the solver's own rounding moves the midpoint by metres)
+PARALLEL_LINKS = 1e-12
 
 
 @dataclass(frozen=True)
@@ -129,7 +132,7 @@ def xml_name(name: str) -> str:
 def common_perpendicular_midpoint(a1, b1, a2, b2):
     """The midpoint of the common perpendicular of lines a1→b1 and a2→b2: where
     they meet, when they do (a virtual ball joint). Works on (n, 3) arrays and on
-    jet.Duals; NaN for parallel lines."""
+    jet.Duals; NaN for lines within 1e-6 rad of parallel."""
     d1, d2 = b1 - a1, b2 - a2
     w = a1 - a2
     a = np.sum(d1 * d1, axis=-1)
@@ -138,7 +141,7 @@ def common_perpendicular_midpoint(a1, b1, a2, b2):
     d = np.sum(d1 * w, axis=-1)
     e = np.sum(d2 * w, axis=-1)
     den = a * c - b * b
-    den = np.where(np.abs(den) > 1e-18 * a * c, den, np.nan)
+    den = np.where(np.abs(den) > PARALLEL_LINKS * a * c, den, np.nan)
     s = (b * e - c * d) / den
     t = (a * e - b * d) / den
     return 0.5 * ((a1 + d1 * s[..., None]) + (a2 + d2 * t[..., None]))

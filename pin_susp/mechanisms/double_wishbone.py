@@ -92,6 +92,7 @@ def prepare(p: dict[str, np.ndarray], o, r) -> None:
     distinct(p, pairs, r)
     for arm in ("lower_wishbone", "upper_wishbone"):
         arm_off_axis(p, arm, r)
+    steering_arm(p, outer, LBJ, UBJ, r)
     if o.actuation == "pushrod_rocker":
         off_axis(
             p,
@@ -100,6 +101,22 @@ def prepare(p: dict[str, np.ndarray], o, r) -> None:
             "rocker_axis_b",
             r,
             "lies on the rocker axis (rocker_axis_a→rocker_axis_b): the pushrod cannot turn it",
+        )
+
+
+STEERING_ARM = 1e-3  # m: the least distance of the trackrod's outer end from the kingpin
+
+
+def steering_arm(p, outer: str, lower: str, upper: str, r) -> None:
+    """The trackrod (or toe link) must reach the upright away from the steering axis:
+    on it, the link cannot turn the upright, and 'bump' would steer it instead."""
+    axis = unit(p[upper] - p[lower])
+    arm = p[outer] - p[lower]
+    if np.linalg.norm(arm - axis * (arm @ axis)) < STEERING_ARM:
+        r.fail(
+            f"hardpoints.{outer}",
+            f"lies on the steering axis {lower}→{upper} (within 1 mm): the link has no "
+            "steering arm to hold the upright's turn about it",
         )
 
 

@@ -23,7 +23,7 @@ import numpy as np
 from ..geometry import AXLE_POINTS, STEERING_POINTS, unit
 from ..urdf import Body, Closure, Joint, Tree
 from . import MATERIALS, Pointwise, pivot, rack_joint, rack_rod, visuals, wheel_mounts, xml_name
-from .double_wishbone import arm_off_axis, arm_plane, distinct, steering_link
+from .double_wishbone import arm_off_axis, arm_plane, distinct, steering_arm, steering_link
 
 NAME = "macpherson"
 TITLE = "MacPherson strut"
@@ -78,6 +78,7 @@ def prepare(p: dict[str, np.ndarray], o, r) -> None:
         r,
     )
     arm_off_axis(p, "lower_wishbone", r)
+    steering_arm(p, outer, LBJ, TOP, r)
     axis = p[TOP] - p[LBJ]
     length = np.linalg.norm(axis)
     u = axis / length
