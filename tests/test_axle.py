@@ -309,3 +309,22 @@ def test_each_side_in_heave_is_the_corner_with_its_derivatives(tmp_path):
             np.testing.assert_allclose(axle[ours], corner[name], atol=1e-9, err_msg=ours)
             compared += 1
     assert compared > 150  # metrics, derivatives, motion ratio, points; both sides
+
+
+def test_axle_urdf_and_mjcf_through_the_cli(tmp_path):
+    """The composed URDF parses back to the same model; MuJoCo reads the MJCF with one
+    connect per ball closure and droplink/link (each corner's and the bar's)."""
+    import mujoco
+    import pinocchio as pin
+
+    from pin_susp.cli import main
+
+    geometry = str(ROOT / "examples/axle_front.yaml")
+    assert main(["urdf", geometry, "-o", str(tmp_path / "a.urdf")]) == 0
+    assert main(["mjcf", geometry, "-o", str(tmp_path / "a.xml")]) == 0
+    model = AxleModel(load_axle(geometry))
+    assert (tmp_path / "a.urdf").read_text() == model.urdf
+    parsed = pin.buildModelFromUrdf(str(tmp_path / "a.urdf"))
+    assert parsed.nv == model.model.nv == 15
+    m = mujoco.MjModel.from_xml_path(str(tmp_path / "a.xml"))
+    assert m.neq == len(model.closures) == 8
