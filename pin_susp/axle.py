@@ -17,6 +17,7 @@ import pinocchio as pin
 
 from . import __version__
 from .closures import ContactPatchPoint, JointTarget, PointTarget
+from .corner import Results
 from .errors import InputError
 from .geometry import DERIVED_POINTS, MM, Geometry
 from .linkage import Built, Linkage
@@ -614,22 +615,9 @@ def solve_axle_sweep(model: AxleModel, sweep, source: str | None = None, progres
 # ---------------------------------------------------------------- columns
 
 
-class AxleResults:
-    """Columns of a solved axle sweep (spec/axle.md), in output units; CSV like a
-    corner's (export.csv_text)."""
-
-    def __init__(self, columns: dict, units: dict, meta: dict):
-        self.columns, self.units, self.meta = columns, units, meta
-
-    def __getitem__(self, name: str) -> np.ndarray:
-        return self.columns[name]
-
-    def __len__(self) -> int:
-        return len(self.columns["step_index"])
-
-    @property
-    def failed_steps(self) -> np.ndarray:
-        return np.flatnonzero(~self.columns["solver_converged"])
+class AxleResults(Results):
+    """Columns of a solved axle sweep (spec/axle.md), in output units; written as a
+    corner's are (export.csv_text)."""
 
 
 def axle_results(model: AxleModel, sweep, solutions: list) -> AxleResults:
