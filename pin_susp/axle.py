@@ -648,6 +648,8 @@ def axle_results(model: AxleModel, sweep, solutions: list) -> AxleResults:
     plain = {k: v["left"].val for k, v in points.items()}
     for name, (values, unit) in _axle_metrics(model, plain, sides).items():
         columns[name], units[name] = values, unit
+    for name, (values, unit) in _roll_rates(model, points, sides).items():
+        columns[name], units[name] = values, unit
     for name in model.output_points:
         for i, axis in enumerate("xyz"):
             columns[f"{name}_{axis}"] = plain[name][:, i] * 1e3
@@ -706,6 +708,74 @@ def _motion(model: AxleModel, qs: list) -> dict:
     return out
 
 
+def _roll_rates(model: AxleModel, points: dict, sides: dict) -> dict:
+    """Exact derivatives along roll: the left wheel centre up and the right one down
+    equally, the rack held (spec/axle.md): camber and toe per side (deg/deg), the
+    U-bar's twist per side's hub z, and the roll centre's migration (mm/deg).
+
+    With h the antisymmetric wheel-centre move, roll = atan2(a, b), a = Δz_L − Δz_R,
+    b = CP_y,L − CP_y,R, so dθ/dh = (2b − a·(ḃ_L + ḃ_R)) / (a² + b²), where ḃ_side
+    is that side's contact patch y rate along its own hub z (the sides meet only at
+    the rack). A side's metric then moves at ±(d metric/d hub z) / (dθ/dh).
+    """
+    from .jet import Dual
+    from .metrics import PointSet, fvic_y, fvic_z
+
+    cp = {s: points[f"{s}_contact_patch_center"][s] for s in SIDES}
+    wc = {s: points[f"{s}_wheel_center"][s].val[:, 2] for s in SIDES}
+    d = model.design_positions
+    a = (wc["left"] - d["left_wheel_center"][2]) - (wc["right"] - d["right_wheel_center"][2])
+    b = cp["left"].val[:, 1] - cp["right"].val[:, 1]
+    rate = {s: cp[s].der[0][:, 1] for s in SIDES}  # d CP_y / d own hub z
+    dtheta = (2.0 * b - a * (rate["left"] - rate["right"] * -1.0)) / (a * a + b * b)
+    # per side: m of its own hub z per radian of roll (+ left, − right)
+    per_rad = {"left": 1.0 / dtheta, "right": -1.0 / dtheta}
+    deg = np.pi / 180.0
+    out = {}
+    for side in SIDES:
+        for name in ("camber", "roadwheel_angle"):
+            gain = sides[side][f"deriv_{name}_wrt_hub_z"][0] * 1e3  # deg per m
+            out[f"deriv_{name}_wrt_roll_{side}"] = (gain * per_rad[side] * deg, "deg/deg")
+    # the roll centre as a function of both sides' CP and FVIC, pushed along roll
+    parts = []
+    for s in SIDES:
+        g = model.geometries[s]
+        own = {k: points[f"{s}_{k}"][s] for k in model.point_names[s]}
+        design = {k: d[f"{s}_{k}"][None] for k in model.point_names[s]}
+        ps = PointSet(own, design, g)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            values = (cp[s][..., 1], cp[s][..., 2], fvic_y(ps), fvic_z(ps))
+        # Dual over one direction, roll (rad): d/dθ = d/d(own hub z) · per_rad
+        parts.append(tuple(Dual(v.val * 1e3, v.der[0] * per_rad[s] * 1e3) for v in values))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        rc = _roll_centre(parts)
+    out["deriv_roll_center_y_wrt_roll"] = (rc[0].der * deg, "mm/deg")
+    out["deriv_roll_center_z_wrt_roll"] = (rc[1].der * deg, "mm/deg")
+    if model.axle is not None and model.axle.anti_roll == "u_bar":
+        a_ = model.axle.center
+        axis = (a_["arb_u_bar_axis_a"], a_["arb_u_bar_axis_b"])
+        for side in SIDES:
+            out[f"deriv_arb_twist_wrt_hub_z_{side}"] = (
+                _turn_rate(
+                    axis, points[f"{side}_droplink_u_bar"][side], +1 if side == "left" else -1
+                ),
+                "deg/mm",
+            )
+    return out
+
+
+def _turn_rate(axis, p, sign: float) -> np.ndarray:
+    """d(arm angle)/d(own hub z) (deg/mm) of a point turning about the axis; the
+    twist is left − right, so the right arm's rate counts negative."""
+    a, b = axis
+    u = (b - a) / np.linalg.norm(b - a)
+    arm = p.val - a
+    arm = arm - np.outer(arm @ u, u)
+    velocity = p.der[0]
+    rate = np.sum(np.cross(arm, velocity) * u, axis=-1) / np.sum(arm * arm, axis=-1)
+    return sign * np.degrees(rate) * 1e-3
+
+
 def _unit(v):
     return v / np.linalg.norm(v, axis=-1, keepdims=True)
 
@@ -731,7 +801,10 @@ def _axle_metrics(model: AxleModel, p: dict, sides: dict) -> dict:
     out["ride_height_change"] = (change * 1e3, "mm")
     out["track"] = (np.abs(track) * 1e3, "mm")
     rc = _roll_centre(
-        [(cp[s][:, 1:] * 1e3, sides[s]["fvic_y"][0], sides[s]["fvic_z"][0]) for s in SIDES]
+        [
+            (cp[s][:, 1] * 1e3, cp[s][:, 2] * 1e3, sides[s]["fvic_y"][0], sides[s]["fvic_z"][0])
+            for s in SIDES
+        ]
     )
     out["roll_center_y"], out["roll_center_z"] = (rc[0], "mm"), (rc[1], "mm")
     if "left_trackrod_inboard" in p:
@@ -767,19 +840,18 @@ def _turn(axis, p0: np.ndarray, p: np.ndarray) -> np.ndarray:
     return np.degrees(np.arctan2(np.cross(w0, w) @ u, np.sum(w0 * w, axis=-1)))
 
 
-def _roll_centre(sides) -> tuple[np.ndarray, np.ndarray]:
-    """Where the lines CP→FVIC of the two sides cross (front view, mm); NaN where an
-    FVIC is blank or the lines are parallel."""
-    (cl, yl, zl), (cr, yr, zr) = sides
-    d1 = np.column_stack([yl, zl]) - cl
-    d2 = np.column_stack([yr, zr]) - cr
-    det = d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]
+def _roll_centre(sides):
+    """Where the lines CP→FVIC of the two sides cross (front view): each side given as
+    (CP_y, CP_z, FVIC_y, FVIC_z); NaN where an FVIC is blank or the lines are
+    parallel. Plain arithmetic, so it runs on jet.Duals (its derivative in roll)."""
+    (ly, lz, fly, flz), (ry, rz, fry, frz) = sides
+    d1y, d1z, d2y, d2z = fly - ly, flz - lz, fry - ry, frz - rz
+    det = d1y * d2z - d1z * d2y
+    scale = np.sqrt((d1y * d1y + d1z * d1z) * (d2y * d2y + d2z * d2z))
     with np.errstate(invalid="ignore", divide="ignore"):
-        det = np.where(np.abs(det) > 1e-12 * np.hypot(*d1.T) * np.hypot(*d2.T), det, np.nan)
-        w = cr - cl
-        t = (w[:, 0] * d2[:, 1] - w[:, 1] * d2[:, 0]) / det
-    point = cl + t[:, None] * d1
-    return point[:, 0], point[:, 1]
+        det = np.where(np.abs(det) > 1e-12 * scale, det, np.nan)
+        t = ((ry - ly) * d2z - (rz - lz) * d2y) / det
+    return ly + t * d1y, lz + t * d1z
 
 
 def _ackermann(model: AxleModel, steer: dict, track: np.ndarray) -> np.ndarray:

@@ -328,3 +328,45 @@ def test_axle_urdf_and_mjcf_through_the_cli(tmp_path):
     assert parsed.nv == model.model.nv == 15
     m = mujoco.MjModel.from_xml_path(str(tmp_path / "a.xml"))
     assert m.neq == len(model.closures) == 8
+
+
+def test_roll_derivatives_match_central_differences_of_full_solves(tmp_path):
+    """deriv_*_wrt_roll (roll camber, roll steer, roll-centre migration) and the bar's
+    twist rate per hub z against differences of re-solved poses, ±1e-4 deg of roll."""
+    model = AxleModel(load_axle(axle_file(tmp_path)))
+
+    def at(rolls):
+        n = len(rolls)
+        sweep = load_sweep(
+            {
+                "targets": [
+                    {"quantity": "roll", "values": rolls},
+                    {"quantity": "heave", "values": [10.0] * n},
+                    {
+                        "point": "trackrod_inboard",
+                        "side": "left",
+                        "direction": {"axis": "y"},
+                        "values": [3.0] * n,
+                    },
+                ]
+            }
+        )
+        return axle_results(model, sweep, solve_axle_sweep(model, sweep))
+
+    h = 1e-4
+    for roll in (-2.0, 1.5):
+        r, plus, minus = at([roll]), at([roll + h]), at([roll - h])
+        pairs = [(f"{m}_{s}", f"deriv_{m}_wrt_roll_{s}") for m in ("camber", "roadwheel_angle")
+                 for s in ("left", "right")]  # fmt: skip
+        pairs += [(f"roll_center_{a}", f"deriv_roll_center_{a}_wrt_roll") for a in "yz"]
+        for column, derivative in pairs:
+            fd = (plus[column][0] - minus[column][0]) / (2 * h)
+            assert r[derivative][0] == pytest.approx(fd, rel=1e-6, abs=1e-7), derivative
+        # the twist's rate along roll from its per-side hub-z rates (zL = +, zR = −)
+        fd = (plus["arb_twist"][0] - minus["arb_twist"][0]) / (2 * h)
+        gain = {
+            s: r[f"deriv_camber_wrt_roll_{s}"][0] / r[f"deriv_camber_wrt_hub_z_{s}"][0]
+            for s in ("left", "right")
+        }  # fmt: skip  mm of own hub z per deg of roll
+        exact = sum(r[f"deriv_arb_twist_wrt_hub_z_{s}"][0] * gain[s] for s in ("left", "right"))
+        assert exact == pytest.approx(fd, rel=1e-6)
