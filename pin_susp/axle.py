@@ -21,7 +21,7 @@ from .corner import Results
 from .errors import InputError
 from .geometry import DERIVED_POINTS, MM, Geometry
 from .linkage import Built, Linkage
-from .solver import NewtonSolver
+from .solver import NewtonSolver, Predictor
 from .urdf import Body, Closure, Tree, Visual
 from .yamlio import Reader, load_yaml
 
@@ -602,10 +602,18 @@ def solve_axle_sweep(model: AxleModel, sweep, source: str | None = None, progres
         [getattr(row, "value", 0.0) for row in rows]
     )
     q, out = model.q_design, []
+    predictor = Predictor(model.model)
     for i, goal in enumerate(values):
-        solution = solver.solve(q, previous, goal)
+        solution = None
+        guess = predictor.guess(goal)
+        if guess is not None:  # one Newton iteration from a good guess, usually
+            solver.set_targets(goal)
+            solution = solver.newton(guess)
+        if solution is None or not solution.converged:
+            solution = solver.solve(q, previous, goal)
         if solution.converged:
             q, previous = solution.q, goal
+            predictor.add(q, goal, solver.tangent())
         out.append(solution)
         if progress is not None:
             progress(i + 1, len(values))

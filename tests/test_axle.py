@@ -370,3 +370,51 @@ def test_roll_derivatives_match_central_differences_of_full_solves(tmp_path):
         }  # fmt: skip  mm of own hub z per deg of roll
         exact = sum(r[f"deriv_arb_twist_wrt_hub_z_{s}"][0] * gain[s] for s in ("left", "right"))
         assert exact == pytest.approx(fd, rel=1e-6)
+
+
+def test_ackermann_from_the_two_solved_wheel_planes(tmp_path):
+    """Steer angles from each solved spin axis (ISO yaw: −s·atan2(a_x, s·a_y)), their
+    change from design, the inner wheel the one inside the turn, and the ideal inner
+    angle atan2(L, L/tan δ_o − track): the formula written here from the CSV's points."""
+    model = AxleModel(load_axle(axle_file(tmp_path)))
+    racks = [-30.0, -12.0, 0.0, 12.0, 30.0]
+    n = len(racks)
+    sweep = load_sweep(
+        {
+            "targets": [
+                {"quantity": "roll", "values": [0.0] * n},
+                {"quantity": "heave", "values": [0.0] * n},
+                {"point": "trackrod_inboard", "side": "left", "direction": {"axis": "y"},
+                 "values": racks},
+            ]
+        }
+    )  # fmt: skip
+    r = axle_results(model, sweep, solve_axle_sweep(model, sweep))
+    wheelbase = 2500.0
+
+    def steer(side, step=None):
+        s = 1.0 if side == "left" else -1.0
+        a = np.array(
+            [r[f"{side}_axle_outboard_{x}"] - r[f"{side}_axle_inboard_{x}"] for x in "xyz"]
+        )
+        if step is not None:
+            a = a[:, step]
+        return -s * np.degrees(np.arctan2(a[0], s * a[1]))
+
+    design = {side: steer(side, step=2) for side in ("left", "right")}  # rack 0, no roll
+    for i in range(n):
+        angles = {side: steer(side)[i] for side in ("left", "right")}
+        for side in ("left", "right"):
+            assert r[f"steer_angle_{side}"][i] == pytest.approx(angles[side], abs=1e-9)
+        delta = {side: abs(angles[side] - design[side]) for side in angles}
+        inner, outer = (
+            ("left", "right") if angles["left"] + angles["right"] > 0 else ("right", "left")
+        )
+        d_o = np.radians(delta[outer])
+        if delta[outer] < 0.5:
+            assert np.isnan(r["ackermann"][i])
+            continue
+        ideal = np.degrees(np.arctan2(wheelbase, wheelbase / np.tan(d_o) - r["track"][i]))
+        expected = 100.0 * (delta[inner] - delta[outer]) / (ideal - delta[outer])
+        assert r["ackermann"][i] == pytest.approx(expected, rel=1e-9)
+    assert np.isfinite(r["ackermann"][[0, 1, 3, 4]]).all()
