@@ -323,6 +323,9 @@ def load_axle(source) -> AxleGeometry:
     )
     if r.choice(data.get("scope", "corner"), "scope", ("corner", "axle")) != "axle":
         r.fail("scope", "this is a corner file (scope: corner): load it with load_geometry")
+    if "version" in data:
+        r.text(data["version"], "version")
+    r.choice(data.get("units", "millimeters"), "units", ("millimeters",))
     vehicle = r.mapping(data.get("vehicle_config", {}), "vehicle_config", optional=VEHICLE_KEYS)
     config = r.mapping(
         data["axle_config"], "axle_config", required=("axle_position", "wheel"), optional=AXLE_KEYS
@@ -362,6 +365,8 @@ def load_axle(source) -> AxleGeometry:
     mount = None
     if anti_roll != "none" and not has_rocker:
         mount = r.text(anti.get("mount", "upright"), "axle_config.anti_roll.mount")
+    elif "mount" in anti:
+        r.fail("axle_config.anti_roll.mount", "the droplinks hang from the rockers here")
 
     corners, side_points = {}, {}
     for side in SIDES:
@@ -436,6 +441,25 @@ def load_axle(source) -> AxleGeometry:
                 "hardpoints.center.arb_u_bar_axis_b",
                 "coincides with arb_u_bar_axis_a: the bar's axis needs two points",
             )
+    if mount is not None:
+        g = corners["left"]
+        bodies = [b.name for b in g.mechanism.tree(g).bodies if b.name not in SHARED]
+        if {"arm": g.mechanism.WHEEL_BODY}.get(mount, mount) not in bodies:
+            r.fail(
+                "axle_config.anti_roll.mount",
+                f"expected the body that carries the droplink: one of {', '.join(bodies)}",
+            )
+    if anti_roll == "u_bar":
+        a, b = center["arb_u_bar_axis_a"], center["arb_u_bar_axis_b"]
+        axis = (b - a) / np.linalg.norm(b - a)
+        for side in SIDES:
+            arm = side_points[side]["droplink_u_bar"] - a
+            if np.linalg.norm(arm - axis * (arm @ axis)) < 1e-3:
+                key = "hardpoints.left" if side == "left" or mirrored else "hardpoints.right"
+                r.fail(
+                    f"{key}.droplink_u_bar",
+                    "lies on the bar's axis (within 1 mm): the droplink cannot turn the arm",
+                )
     for g in corners.values():
         warn_implausible(g)
     return AxleGeometry(

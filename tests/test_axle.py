@@ -128,6 +128,23 @@ def test_explicit_right_points_equal_the_mirror(tmp_path):
         np.testing.assert_allclose(a[name], b[name], atol=1e-15, err_msg=name)
 
 
+def direct_bar(mount):
+    """Direct-acting corners (no rocker): the droplink hangs from the named body."""
+
+    def change(data):
+        config = data["axle_config"]
+        config.update(actuation={"type": "direct"}, spring={"type": "none"})
+        config["anti_roll"] = {"type": "u_bar", "mount": mount}
+        left = data["hardpoints"]["left"]
+        for k in ("pushrod_outboard", "pushrod_inboard", "rocker_axis_a", "rocker_axis_b"):
+            left.pop(k)
+        for k in ("strut_top", "strut_bottom", "droplink_rocker"):
+            left.pop(k)
+        left["droplink_lower"] = {"x": 0, "y": 700, "z": 250}
+
+    return change
+
+
 def t_bar_off_centre(data):
     """A T-bar whose pivot is not on the car's centreline."""
     data["axle_config"]["anti_roll"] = {"type": "t_bar"}
@@ -149,6 +166,16 @@ def t_bar_off_centre(data):
             "hardpoints.center.arb_u_bar_axis_b",
         ),
         (t_bar_off_centre, "hardpoints.center.arb_t_bar_pivot"),
+        (direct_bar("foo"), "axle_config.anti_roll.mount"),
+        (
+            lambda d: d["hardpoints"]["left"].update(droplink_u_bar={"x": 0, "y": 200, "z": 300}),
+            "hardpoints.left.droplink_u_bar",
+        ),
+        (lambda d: d.update(version=[1]), "version"),
+        (
+            lambda d: d["axle_config"]["anti_roll"].update(mount="upright"),
+            "axle_config.anti_roll.mount",
+        ),
         (
             lambda d: d["axle_config"].update(
                 left_setup={"camber_shim": {"shim_face_point_a": [0, 0, 0]}}
@@ -418,3 +445,25 @@ def test_ackermann_from_the_two_solved_wheel_planes(tmp_path):
         expected = 100.0 * (delta[inner] - delta[outer]) / (ideal - delta[outer])
         assert r["ackermann"][i] == pytest.approx(expected, rel=1e-9)
     assert np.isfinite(r["ackermann"][[0, 1, 3, 4]]).all()
+
+
+def test_a_direct_acting_axle_hangs_the_droplink_from_the_named_body(tmp_path):
+    model = AxleModel(load_axle(axle_file(tmp_path, direct_bar("lower_wishbone"))))
+    for side in ("left", "right"):
+        assert model.tree.points[f"{side}_droplink_lower"][0] == f"{side}_lower_wishbone"
+    sweep = load_sweep(
+        {
+            "targets": [
+                {"quantity": "roll", "values": [-1.0, 1.0]},
+                {"quantity": "heave", "values": [0.0, 0.0]},
+                {"point": "trackrod_inboard", "side": "left", "direction": {"axis": "y"},
+                 "values": [0.0, 0.0]},
+            ]
+        }
+    )  # fmt: skip
+    results = axle_results(model, sweep, solve_axle_sweep(model, sweep))
+    assert results["solver_converged"].all()
+    # mirrored axle: the left arm at −1° of roll turns as the right one at +1°
+    left, right = results["arb_arm_angle_left"], results["arb_arm_angle_right"]
+    np.testing.assert_allclose(left, right[::-1], atol=1e-9)
+    assert abs(results["arb_twist"][0]) > 0.1
