@@ -467,3 +467,57 @@ def test_a_direct_acting_axle_hangs_the_droplink_from_the_named_body(tmp_path):
     left, right = results["arb_arm_angle_left"], results["arb_arm_angle_right"]
     np.testing.assert_allclose(left, right[::-1], atol=1e-9)
     assert abs(results["arb_twist"][0]) > 0.1
+
+
+def test_each_side_takes_its_setup_before_the_sweep(tmp_path):
+    """left_setup (a camber shim 10 mm thinner, a longer pushrod) is applied as the
+    corner applies it: the left side then equals the set-up corner, and the mirrored
+    right side takes the same setup (spec: a mirrored right side takes the left's)."""
+    shim = yaml.safe_load((ROOT / "examples/camber_shim.yaml").read_text())["config"]["camber_shim"]
+    setup = {"camber_shim": shim, "pushrod_length_delta": 1.5}
+
+    def with_setup(data):
+        data["axle_config"]["left_setup"] = setup
+
+    model = AxleModel(load_axle(axle_file(tmp_path, with_setup)))
+    heights = [-10.0, 20.0]
+    axle_sweep = load_sweep(
+        {
+            "targets": [
+                {"point": "wheel_center", "side": s, "direction": {"axis": "z"}, "values": heights}
+                for s in ("left", "right")
+            ]
+            + [{"point": "trackrod_inboard", "side": "left", "direction": {"axis": "y"},
+                "values": [0.0, 0.0]}]
+        }
+    )  # fmt: skip
+    axle = axle_results(model, axle_sweep, solve_axle_sweep(model, axle_sweep))
+    corner_data = example("pushrod_rocker.yaml")
+    corner_data["config"]["camber_shim"] = shim
+    corner_data["config"]["setup"] = {"pushrod_length_delta": 1.5}
+    corner = pin_susp.Corner(corner_data)
+    result = corner.run_sweep(
+        {
+            "targets": [
+                {"point": "wheel_center", "direction": {"axis": "z"}, "values": heights},
+                {"point": "trackrod_inboard", "direction": {"axis": "y"}, "values": [0.0, 0.0]},
+            ]
+        }
+    )
+    for name in ("camber", "roadwheel_angle", "damper_length", "half_track"):
+        np.testing.assert_allclose(axle[f"{name}_left"], result[name], atol=1e-9, err_msg=name)
+        np.testing.assert_allclose(axle[f"{name}_right"], result[name], atol=1e-9, err_msg=name)
+    assert (
+        abs(
+            result["camber"][0]
+            - pin_susp.Corner(example("pushrod_rocker.yaml")).run_sweep(
+                {
+                    "targets": [
+                        {"point": "wheel_center", "direction": {"axis": "z"}, "values": [-10.0]},
+                        {"point": "trackrod_inboard", "direction": {"axis": "y"}, "values": [0.0]},
+                    ]
+                }
+            )["camber"][0]
+        )
+        > 1.0
+    )  # fmt: skip  the shim changed the corner
