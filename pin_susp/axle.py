@@ -662,15 +662,7 @@ def axle_results(model: AxleModel, sweep, solutions: list) -> AxleResults:
     columns, then the points (``left_…``, ``right_…``, the bar's)."""
     from .metrics import metric_columns
 
-    n = len(solutions)
-    ok = np.array([s.converged for s in solutions])
-    columns = {
-        "step_index": np.arange(n),
-        "solver_converged": ok,
-        "solver_max_residual": np.array([s.max_residual for s in solutions]) * 1e3,
-        "solver_iterations": np.array([s.iterations for s in solutions]),
-    }
-    units = dict.fromkeys(columns, "") | {"solver_max_residual": "mm"}
+    columns, units = AxleResults.solver_columns(solutions)
     qs = [s.q if s.converged else None for s in solutions]
     points = _motion(model, qs)
     sides = {}
@@ -692,13 +684,7 @@ def axle_results(model: AxleModel, sweep, solutions: list) -> AxleResults:
             units[f"{name}_{axis}"] = "mm"
     source = model.axle.source if model.axle is not None else "<geometries>"
     sha = model.axle.sha256 if model.axle is not None else None
-    meta = {
-        "geometry": (source, sha),
-        "sweep": (sweep.source, sweep.sha256),
-        "q": np.array([s.q for s in solutions]),
-        "why": [s.why for s in solutions],
-    }
-    return AxleResults(columns, units, meta)
+    return AxleResults(columns, units, AxleResults.solver_meta(solutions, (source, sha), sweep))
 
 
 def _motion(model: AxleModel, qs: list) -> dict:

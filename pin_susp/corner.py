@@ -240,20 +240,7 @@ class Results:
     def from_solutions(
         cls, corner: Corner, solutions: list[Solution], sweep: Sweep, tangents=None
     ) -> Results:
-        n = len(solutions)
-        ok = np.array([s.converged for s in solutions])
-        columns = {
-            "step_index": np.arange(n),
-            "solver_converged": ok,
-            "solver_max_residual": np.array([s.max_residual for s in solutions]) * 1e3,
-            "solver_iterations": np.array([s.iterations for s in solutions]),
-        }
-        units = {
-            "step_index": "",
-            "solver_converged": "",
-            "solver_max_residual": "mm",
-            "solver_iterations": "",
-        }
+        columns, units = cls.solver_columns(solutions)
         # A step that did not converge has no trustworthy pose: its cells stay empty.
         points = corner.motion([s.q if s.converged else None for s in solutions], tangents)
         design = {k: v[None] for k, v in corner.design_positions.items()}
@@ -263,13 +250,29 @@ class Results:
         positions = {name: p.val for name, p in points.items()}
         for name, (values, column_unit) in point_columns(corner.point_names, positions).items():
             columns[name], units[name] = values, column_unit
-        meta = {
-            "geometry": (corner.geometry.source, corner.geometry.sha256),
+        geometry = (corner.geometry.source, corner.geometry.sha256)
+        return cls(columns, units, cls.solver_meta(solutions, geometry, sweep))
+
+    @staticmethod
+    def solver_columns(solutions: list[Solution]) -> tuple[dict, dict]:
+        """The first columns of every sweep's results: step index and the solver's flags."""
+        columns = {
+            "step_index": np.arange(len(solutions)),
+            "solver_converged": np.array([s.converged for s in solutions]),
+            "solver_max_residual": np.array([s.max_residual for s in solutions]) * 1e3,
+            "solver_iterations": np.array([s.iterations for s in solutions]),
+        }
+        return columns, dict.fromkeys(columns, "") | {"solver_max_residual": "mm"}
+
+    @staticmethod
+    def solver_meta(solutions: list[Solution], geometry: tuple, sweep: Sweep) -> dict:
+        """What the CSV's comments and the failure report need: sources, q, reasons."""
+        return {
+            "geometry": geometry,
             "sweep": (sweep.source, sweep.sha256),
             "q": np.array([s.q for s in solutions]),
             "why": [s.why for s in solutions],  # '' where converged
         }
-        return cls(columns, units, meta)
 
     def __getitem__(self, name: str) -> np.ndarray:
         return self.columns[name]
