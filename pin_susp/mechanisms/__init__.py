@@ -125,8 +125,14 @@ def wheel_mounts(body: str) -> dict[str, str]:
     return dict.fromkeys(("axle_midpoint", "wheel_center", "wheel_inboard", "wheel_outboard"), body)
 
 
-def xml_name(name: str) -> str:
-    return "".join(c if c.isalnum() or c in "-_." else "_" for c in name) or "corner"
+def axis_foot(a: np.ndarray, b: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """The point of the axis a → b nearest p: where an arm turning about it starts."""
+    axis = unit(b - a)
+    return a + axis * ((p - a) @ axis)
+
+
+def xml_name(name: str, default: str = "corner") -> str:
+    return "".join(c if c.isalnum() or c in "-_." else "_" for c in name) or default
 
 
 def common_perpendicular_midpoint(a1, b1, a2, b2):

@@ -22,7 +22,17 @@ import numpy as np
 
 from ..geometry import COINCIDENT, STEERING_POINTS, unit
 from ..urdf import Body, Closure, Joint, Tree
-from . import MATERIALS, Pointwise, pivot, rack_joint, rack_rod, visuals, wheel_mounts, xml_name
+from . import (
+    MATERIALS,
+    Pointwise,
+    axis_foot,
+    pivot,
+    rack_joint,
+    rack_rod,
+    visuals,
+    wheel_mounts,
+    xml_name,
+)
 
 NAME = "double_wishbone"
 TITLE = "Double wishbone"
@@ -332,14 +342,8 @@ def _visuals(g, p, body_of):
         rods.append(("rocker", "rocker", p["rocker_axis_a"], p["rocker_axis_b"]))
         for arm_end in ("pushrod_inboard", "strut_bottom"):
             if body_of.get(arm_end) == "rocker":
-                rods.append(("rocker", "rocker", _axis_foot(p, arm_end), p[arm_end]))
+                foot = axis_foot(p["rocker_axis_a"], p["rocker_axis_b"], p[arm_end])
+                rods.append(("rocker", "rocker", foot, p[arm_end]))
     return visuals(
         g, p, body_of, rods, {"lower_wishbone": "wishbone", "upper_wishbone": "wishbone"}
     )
-
-
-def _axis_foot(p: dict[str, np.ndarray], name: str) -> np.ndarray:
-    """The point of the rocker axis nearest ``name``: where a rocker arm starts."""
-    a = p["rocker_axis_a"]
-    axis = unit(p["rocker_axis_b"] - a)
-    return a + axis * ((p[name] - a) @ axis)

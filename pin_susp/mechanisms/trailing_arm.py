@@ -16,7 +16,7 @@ import numpy as np
 
 from ..geometry import AXLE_POINTS, COILOVER_POINTS
 from ..urdf import Body, Tree
-from . import MATERIALS, Pointwise, pivot, visuals, wheel_mounts, xml_name
+from . import MATERIALS, Pointwise, axis_foot, pivot, visuals, wheel_mounts, xml_name
 from .double_wishbone import distinct, off_axis
 
 NAME = "trailing_arm"
@@ -71,14 +71,21 @@ def tree(g) -> Tree:
     if g.spring == "coilover":
         body_of |= {"strut_top": "chassis", "strut_bottom": "trailing_arm"}
     points = {name: (body, p[name]) for name, body in body_of.items()}
-    foot = _axis_foot(p, "axle_midpoint")
+    foot = axis_foot(p[PIVOT[0]], p[PIVOT[1]], p["axle_midpoint"])
     rods = [
         ("trailing_arm", "wishbone", p[PIVOT[0]], p[PIVOT[1]]),
         ("trailing_arm", "wishbone", foot, p["axle_midpoint"]),
         ("trailing_arm", "upright", p["axle_inboard"], p["axle_outboard"]),
     ]
     if g.spring == "coilover":
-        rods.append(("trailing_arm", "wishbone", _axis_foot(p, "strut_bottom"), p["strut_bottom"]))
+        rods.append(
+            (
+                "trailing_arm",
+                "wishbone",
+                axis_foot(p[PIVOT[0]], p[PIVOT[1]], p["strut_bottom"]),
+                p["strut_bottom"],
+            )
+        )
     return Tree(
         name=xml_name(g.name),
         bodies=bodies,
@@ -87,12 +94,6 @@ def tree(g) -> Tree:
         visuals=visuals(g, p, body_of, rods, {"trailing_arm": "wishbone"}),
         materials=MATERIALS,
     )
-
-
-def _axis_foot(p, name: str) -> np.ndarray:
-    a = p[PIVOT[0]]
-    axis = (p[PIVOT[1]] - a) / np.linalg.norm(p[PIVOT[1]] - a)
-    return a + axis * ((p[name] - a) @ axis)
 
 
 def kingpin(ps):
