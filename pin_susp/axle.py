@@ -143,9 +143,12 @@ def _add_elements(a: AxleGeometry, bodies, points, closures, visuals, materials)
 
 def _mount(a: AxleGeometry, side: str) -> str:
     """The body that carries a droplink's lower end when there is no rocker."""
-    g = a.corner(side)
-    body = {"arm": g.mechanism.WHEEL_BODY}.get(a.anti_roll_mount, a.anti_roll_mount)
-    return f"{side}_{body}"
+    return f"{side}_{_mount_body(a.corner(side), a.anti_roll_mount)}"
+
+
+def _mount_body(g: Geometry, mount: str) -> str:
+    """``anti_roll.mount`` as a body of the corner's tree ("arm": the wheel's body)."""
+    return {"arm": g.mechanism.WHEEL_BODY}.get(mount, mount)
 
 
 class AxleModel:
@@ -440,7 +443,7 @@ def load_axle(source) -> AxleGeometry:
     if mount is not None:
         g = corners["left"]
         bodies = [b.name for b in g.mechanism.tree(g).bodies if b.name not in SHARED]
-        if {"arm": g.mechanism.WHEEL_BODY}.get(mount, mount) not in bodies:
+        if _mount_body(g, mount) not in bodies:
             r.fail(
                 "axle_config.anti_roll.mount",
                 f"expected the body that carries the droplink: one of {', '.join(bodies)}",
