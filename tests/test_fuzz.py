@@ -111,6 +111,11 @@ def _known_good_sweep() -> Case:
         Plan("wheel_center", (0.0, 0.0, 1.0), "relative", [-10.0, 0.0, 10.0]),
         Plan("trackrod_inboard", (0.0, 1.0, 0.0), "relative", [0.0, 2.5, 5.0]),
     ]
+    return _sweep_case(geometry, sweep, plans)
+
+
+def _sweep_case(geometry: bytes, sweep: bytes, plans: list) -> Case:
+    """``pin-susp sweep g.yaml s.yaml -o out.csv -q`` on these files, as a fuzz Case."""
     return Case(
         "sweep",
         ["sweep", "g.yaml", "s.yaml", "-o", "out.csv", "-q"],
@@ -132,16 +137,7 @@ def _bump_sweep(geometry_file: str, rack: bool) -> Case:
     if rack:
         sweep += b"  - {point: trackrod_inboard, direction: {axis: y}, start: -8, stop: 8}\n"
         plans.append(Plan("trackrod_inboard", (0.0, 1.0, 0.0), "relative", [-8.0, 0.0, 8.0]))
-    return Case(
-        "sweep",
-        ["sweep", "g.yaml", "s.yaml", "-o", "out.csv", "-q"],
-        {"g.yaml": geometry, "s.yaml": sweep},
-        ["out.csv"],
-        Inputs(None, geometry, []),
-        Inputs(None, sweep, []),
-        plans,
-        quiet=True,
-    )
+    return _sweep_case(geometry, sweep, plans)
 
 
 def _shift(csv: bytes, row: int, column: str, delta: float) -> bytes:
