@@ -153,9 +153,7 @@ class Geometry:
     def steering_points(self) -> tuple[str, str] | tuple[()]:
         """(inboard, outboard) of the trackrod, or of the fixed toe link; () for a
         mechanism without one (a trailing arm)."""
-        if "toe_link_inboard" in self.hardpoints or "trackrod_inboard" in self.hardpoints:
-            return STEERING_POINTS[self.steering]
-        return ()
+        return self.mechanism.steering_points(self)
 
     def design_points(self) -> dict[str, np.ndarray]:
         """Every hardpoint and derived point at the design condition."""
