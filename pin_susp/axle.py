@@ -23,7 +23,7 @@ from .geometry import DERIVED_POINTS, MM, Geometry, unit
 from .linkage import Built, Linkage
 from .mechanisms import axis_foot, xml_name
 from .solver import NewtonSolver, Predictor
-from .urdf import Body, Closure, Tree, Visual
+from .urdf import Body, Closure, Joint, Tree, Visual
 from .yamlio import Reader, load_yaml
 
 SIDES = ("left", "right")
@@ -100,8 +100,10 @@ def axle_tree(left: Geometry, right: Geometry, name: str = "axle", elements=None
 
 
 def _add_elements(a: AxleGeometry, bodies, points, closures, visuals, materials) -> None:
-    """The U-bar (an arm per side turning on the bar's axis, a rigid droplink from the
-    rocker or the named body to the arm) and the heave link's ends (measured only)."""
+    """The anti-roll bar (a U-bar: an arm per side turning on the bar's axis, or one
+    rigid bar when ``stiffness: rigid``; a T-bar: the crossbar on its pivot), a rigid
+    droplink per side from the rocker (or the named body) to the bar, and the heave
+    link's ends (measured only)."""
     from .mechanisms import BALL, ROD, pivot
 
     materials.setdefault("bar", (0.85, 0.75, 0.15, 1.0))
@@ -109,36 +111,67 @@ def _add_elements(a: AxleGeometry, bodies, points, closures, visuals, materials)
         points[name] = ("chassis", p)
     if a.anti_roll == "u_bar":
         axis = ("arb_u_bar_axis_a", "arb_u_bar_axis_b")
+        for side in SIDES if not a.anti_roll_rigid else ("left",):
+            arm = "arb_bar" if a.anti_roll_rigid else f"{side}_arb_arm"
+            bodies.append(Body(arm, "chassis", pivot(f"{arm}_pivot", *axis, a.center)))
         for side in SIDES:
-            arm = f"{side}_arb_arm"
-            bodies.append(Body(arm, "chassis", pivot(f"{side}_arb_arm_pivot", *axis, a.center)))
-            sp = a.side_points[side]
-            upper = "droplink_rocker" if "droplink_rocker" in sp else "droplink_lower"
-            carrier = f"{side}_rocker" if upper == "droplink_rocker" else _mount(a, side)
-            points[f"{side}_droplink_u_bar"] = (arm, sp["droplink_u_bar"])
-            points[f"{side}_{upper}"] = (carrier, sp[upper])
-            ends = (f"{side}_{upper}", f"{side}_droplink_u_bar")
-            closures.append(
-                Closure(
-                    f"{side}_droplink",
-                    "distance",
-                    tuple((n, points[n][1]) for n in ends),
-                    ends,
-                    branch=(*axis, *ends),
-                )
-            )
-            foot = axis_foot(a.center[axis[0]], a.center[axis[1]], sp["droplink_u_bar"])
-            visuals.append(Visual(arm, "rod", "bar", foot, sp["droplink_u_bar"], ROD))
-            visuals.append(Visual(arm, "ball", "bar", sp["droplink_u_bar"], radius=BALL))
+            arm = "arb_bar" if a.anti_roll_rigid else f"{side}_arb_arm"
+            end = a.side_points[side]["droplink_u_bar"]
+            _droplink(a, side, "droplink_u_bar", arm, axis, points, closures)
+            foot = axis_foot(a.center[axis[0]], a.center[axis[1]], end)
+            visuals.append(Visual(arm, "rod", "bar", foot, end, ROD))
+            visuals.append(Visual(arm, "ball", "bar", end, radius=BALL))
         visuals.append(
             Visual("chassis", "rod", "bar", a.center[axis[0]], a.center[axis[1]], 1.5 * ROD)
         )
+    if a.anti_roll == "t_bar":
+        hub = a.center["arb_t_bar_pivot"]
+        ends = {side: a.side_points[side]["droplink_t_bar"] for side in SIDES}
+        middle = 0.5 * (ends["left"] + ends["right"])
+        # the crossbar's midpoint stays in y = 0: the stem pitches about chassis y and
+        # the crossbar twists about the stem (a universal joint: exactly the ball with
+        # the midpoint held in the plane); a rigid bar only pitches
+        y, stem = np.array([0.0, 1.0, 0.0]), unit(middle - hub)
+        joint = (
+            Joint("t_bar_pivot", "revolute", hub, y)
+            if a.anti_roll_rigid
+            else Joint("t_bar_pivot", "universal", hub, y, ("arb_t_bar_pivot",), stem)
+        )
+        bodies.append(Body("t_bar", "chassis", joint))
+        for side in SIDES:
+            other = f"{'right' if side == 'left' else 'left'}_droplink_t_bar"
+            guard = ("arb_t_bar_pivot", other)
+            _droplink(a, side, "droplink_t_bar", "t_bar", guard, points, closures)
+            visuals.append(Visual("t_bar", "ball", "bar", ends[side], radius=BALL))
+        visuals.append(Visual("t_bar", "rod", "bar", ends["left"], ends["right"], 1.5 * ROD))
+        visuals.append(Visual("t_bar", "rod", "bar", hub, middle, 1.5 * ROD))
     if a.heave_link != "none":
         for side in SIDES:
             points[f"{side}_heave_link_rocker"] = (
                 f"{side}_rocker",
                 a.side_points[side]["heave_link_rocker"],
             )
+
+
+def _droplink(a: AxleGeometry, side: str, lower: str, bar: str, guard, points, closures):
+    """One side's rigid droplink: from the rocker (or the body ``anti_roll.mount``
+    names) to the point ``lower`` on the bar's body; its assembly is kept by the sign
+    of the volume of the two ``guard`` points and its ends."""
+    sp = a.side_points[side]
+    upper = "droplink_rocker" if "droplink_rocker" in sp else "droplink_lower"
+    carrier = f"{side}_rocker" if upper == "droplink_rocker" else _mount(a, side)
+    points[f"{side}_{lower}"] = (bar, sp[lower])
+    points[f"{side}_{upper}"] = (carrier, sp[upper])
+    ends = (f"{side}_{upper}", f"{side}_{lower}")
+    closures.append(
+        Closure(
+            f"{side}_droplink",
+            "distance",
+            tuple((n, points[n][1]) for n in ends),
+            ends,
+            branch=(*guard, *ends),
+        )
+    )
 
 
 def _mount(a: AxleGeometry, side: str) -> str:
@@ -269,6 +302,7 @@ class AxleGeometry:
     right: Geometry
     anti_roll: str
     anti_roll_mount: str | None  # the body a droplink's lower end rides on (no rocker)
+    anti_roll_stiffness: float | None  # N·m/deg (for loads); inf: a rigid (locked) bar
     heave_link: str
     side_points: dict  # side → {point: (3,) m}: droplinks, heave link ends
     center: dict  # point → (3,) m: the bar's axis or pivot
@@ -279,6 +313,11 @@ class AxleGeometry:
 
     def corner(self, side: str) -> Geometry:
         return self.left if side == "left" else self.right
+
+    @property
+    def anti_roll_rigid(self) -> bool:
+        """A bar that does not twist: the axle cannot roll."""
+        return self.anti_roll_stiffness is not None and np.isinf(self.anti_roll_stiffness)
 
 
 class _AxleReader(Reader):
@@ -335,6 +374,7 @@ def load_axle(source) -> AxleGeometry:
         optional=("type", "mount", "stiffness"),
     )
     anti_roll = r.choice(anti.get("type", "none"), "axle_config.anti_roll.type", ANTI_ROLL)
+    stiffness = _stiffness(anti, anti_roll, r)
     heave_map = r.mapping(
         config.get("heave_link", {}), "axle_config.heave_link", optional=("type",)
     )
@@ -429,10 +469,8 @@ def load_axle(source) -> AxleGeometry:
                 f"hardpoints.center.{k}", f"missing point (a {anti_roll} anti-roll bar needs it)"
             )
         center[k] = r.point(center_map[k], f"hardpoints.center.{k}") * MM
-    if anti_roll == "t_bar" and abs(center["arb_t_bar_pivot"][1]) > 1e-6:
-        r.fail("hardpoints.center.arb_t_bar_pivot", "must lie on the centreline (y = 0)")
     if anti_roll == "t_bar":
-        r.fail("axle_config.anti_roll.type", "t_bar is not modelled yet (u_bar and none are)")
+        _check_t_bar(center["arb_t_bar_pivot"], side_points, mirrored, r)
     if anti_roll == "u_bar":
         a, b = center["arb_u_bar_axis_a"], center["arb_u_bar_axis_b"]
         if np.linalg.norm(b - a) < 1e-6:
@@ -467,6 +505,7 @@ def load_axle(source) -> AxleGeometry:
         right=corners["right"],
         anti_roll=anti_roll,
         anti_roll_mount=mount,
+        anti_roll_stiffness=stiffness,
         heave_link=heave,
         side_points=side_points,
         center=center,
@@ -475,6 +514,40 @@ def load_axle(source) -> AxleGeometry:
         sha256=sha,
         data=data,
     )
+
+
+def _stiffness(anti: dict, anti_roll: str, r: Reader) -> float | None:
+    """``anti_roll.stiffness``: N·m/deg (> 0), or ``rigid`` (or .inf) for a locked bar."""
+    if "stiffness" not in anti:
+        return None
+    key = "axle_config.anti_roll.stiffness"
+    if anti_roll == "none":
+        r.fail(key, "there is no anti-roll bar (anti_roll.type: none)")
+    value = anti["stiffness"]
+    if value == "rigid" or (isinstance(value, float) and value == np.inf):
+        return np.inf
+    if isinstance(value, str):
+        r.fail(key, f"expected N·m/deg (a number > 0) or rigid, got {value!r}")
+    return r.positive(value, key)
+
+
+def _check_t_bar(hub: np.ndarray, side_points: dict, mirrored: bool, r: Reader) -> None:
+    """The T-bar's pivot on the centreline, its crossbar's midpoint in y = 0 and its
+    stem (pivot → midpoint) of some length: the universal joint it turns on."""
+    if abs(hub[1]) > 1e-6:
+        r.fail("hardpoints.center.arb_t_bar_pivot", "must lie on the centreline (y = 0)")
+    ends = [side_points[s]["droplink_t_bar"] for s in SIDES]
+    key = "hardpoints.left" if mirrored else "hardpoints.right"
+    if abs(ends[0][1] + ends[1][1]) > 2e-5:
+        r.fail(
+            f"{key}.droplink_t_bar",
+            "the crossbar's ends must be mirror images in y (its midpoint on y = 0)",
+        )
+    if np.linalg.norm(0.5 * (ends[0] + ends[1]) - hub) < 1e-3:
+        r.fail(
+            "hardpoints.center.arb_t_bar_pivot",
+            "lies on the crossbar's midpoint (within 1 mm): the T-bar needs a stem",
+        )
 
 
 def _mirror(corner: dict) -> dict:
@@ -606,12 +679,26 @@ def solve_axle_sweep(model: AxleModel, sweep, source: str | None = None, progres
     ``progress(done, total)`` is called after each step."""
     source = source or sweep.source
     rows = axle_rows(model, sweep.targets, source)
+    rigid = model.axle is not None and model.axle.anti_roll_rigid
+    for i, t in enumerate(sweep.targets):
+        if rigid and t.quantity == "roll":
+            raise InputError(
+                source,
+                f"targets[{i}]",
+                "roll is unreachable: the anti-roll bar is rigid "
+                "(axle_config.anti_roll.stiffness), so the axle cannot roll",
+            )
     if len(rows) != model.mobility:
+        need = (
+            "its anti-roll bar is rigid, so it only heaves: heave or one wheel height"
+            if rigid
+            else "a wheel height per side, or heave and roll"
+        )
         raise InputError(
             source,
             "targets",
             f"{len(rows)} target(s) given, this axle needs exactly {model.mobility} "
-            "(a wheel height per side, or heave and roll; and the rack)",
+            f"({need}; and the rack)",
         )
     solver = NewtonSolver(model.kin, model.closures, rows, model.branches)
     solver.evaluate(model.q_design)
@@ -768,16 +855,17 @@ def _roll_rates(model: AxleModel, points: dict, sides: dict) -> dict:
         rc = _roll_centre(parts)
     out["deriv_roll_center_y_wrt_roll"] = (rc[0].der * deg, "mm/deg")
     out["deriv_roll_center_z_wrt_roll"] = (rc[1].der * deg, "mm/deg")
-    if model.axle is not None and model.axle.anti_roll == "u_bar":
-        a_ = model.axle.center
-        axis = (a_["arb_u_bar_axis_a"], a_["arb_u_bar_axis_b"])
-        for side in SIDES:
-            out[f"deriv_arb_twist_wrt_hub_z_{side}"] = (
-                _turn_rate(
-                    axis, points[f"{side}_droplink_u_bar"][side], +1 if side == "left" else -1
-                ),
-                "deg/mm",
-            )
+    bar = model.axle.anti_roll if model.axle is not None else "none"
+    for side in SIDES if bar != "none" else ():
+        sign = 1.0 if side == "left" else -1.0
+        if bar == "u_bar":
+            c = model.axle.center
+            axis = (c["arb_u_bar_axis_a"], c["arb_u_bar_axis_b"])
+            rate = _turn_rate(axis, points[f"{side}_droplink_u_bar"][side], sign)
+        else:
+            ends = [points[f"{s}_droplink_t_bar"][side] for s in SIDES]
+            rate = np.degrees(_t_bar_twist(model, *ends).der[0]) * 1e-3
+        out[f"deriv_arb_twist_wrt_hub_z_{side}"] = (rate, "deg/mm")
     return out
 
 
@@ -837,6 +925,9 @@ def _axle_metrics(model: AxleModel, p: dict, sides: dict) -> dict:
             angles[side] = _turn(axis, d[name], p[name])
             out[f"arb_arm_angle_{side}"] = (angles[side], "deg")
         out["arb_twist"] = (angles["left"] - angles["right"], "deg")
+    if a is not None and a.anti_roll == "t_bar":
+        ends = (p["left_droplink_t_bar"], p["right_droplink_t_bar"])
+        out["arb_twist"] = (np.degrees(_t_bar_twist(model, *ends)), "deg")
     if a is not None and a.heave_link != "none":
         length = np.linalg.norm(p["left_heave_link_rocker"] - p["right_heave_link_rocker"], axis=-1)
         out["heave_link_length"] = (length * 1e3, "mm")
@@ -851,6 +942,35 @@ def _turn(axis, p0: np.ndarray, p: np.ndarray) -> np.ndarray:
     w0 = w0 - np.outer(w0 @ u, u)
     w = w - np.outer(w @ u, u)
     return np.degrees(np.arctan2(np.cross(w0, w) @ u, np.sum(w0 * w, axis=-1)))
+
+
+def _t_bar_twist(model: AxleModel, left, right):
+    """The T-bar crossbar's twist (rad) about its stem from design, from its two ends
+    (arrays (n, 3) or jet.Duals; right-hand rule about the design stem pivot →
+    crossbar midpoint). The bar turns on a universal joint — a pitch θ of the stem
+    about chassis y, then the twist about the stem — so undoing θ (read from the
+    stem, which only pitches) leaves the crossbar turned by the twist alone."""
+    d = model.design_positions
+    hub = model.axle.center["arb_t_bar_pivot"]
+    s0 = 0.5 * (d["left_droplink_t_bar"] + d["right_droplink_t_bar"]) - hub
+    c0 = d["left_droplink_t_bar"] - d["right_droplink_t_bar"]
+    sx, sz = (
+        0.5 * (left[..., 0] + right[..., 0]) - hub[0],
+        0.5 * (left[..., 2] + right[..., 2]) - hub[2],
+    )
+    rho = np.sqrt((s0[0] * sx + s0[2] * sz) ** 2 + (s0[2] * sx - s0[0] * sz) ** 2)
+    cos, sin = (s0[0] * sx + s0[2] * sz) / rho, (s0[2] * sx - s0[0] * sz) / rho
+    cx, cy, cz = (left[..., i] - right[..., i] for i in range(3))
+    c = (cx * cos - cz * sin, cy, cx * sin + cz * cos)  # the crossbar with θ undone
+    u = s0 / np.linalg.norm(s0)
+    w0 = c0 - (c0 @ u) * u
+    along = c[0] * u[0] + c[1] * u[1] + c[2] * u[2]
+    w = [c[i] - along * u[i] for i in range(3)]
+    k = np.cross(u, w0)  # (w0 × w)·u = w·(u × w0)
+    return np.arctan2(
+        w[0] * k[0] + w[1] * k[1] + w[2] * k[2],
+        w[0] * w0[0] + w[1] * w0[1] + w[2] * w0[2],
+    )
 
 
 def _roll_centre(sides):

@@ -284,6 +284,14 @@ def _parse(data: dict, r: Reader, sha: str | None) -> Geometry:
             "config",
         ),
     )
+    legacy = data.get("type")
+    if isinstance(legacy, str) and legacy.endswith("_axle"):
+        r.fail(
+            "type",
+            f"{legacy!r} is an older open-kinematics axle layout; 0.4's (read here) is "
+            f"type: {legacy.removesuffix('_axle').removesuffix('_pushrod_rocker')} with "
+            "scope: axle, vehicle_config, axle_config and hardpoints.left/right/center",
+        )
     kind = r.choice(data.get("type", "double_wishbone"), "type", mechanisms.NAMES)
     mech = mechanisms.get(kind)
     scope = r.choice(data.get("scope", "corner"), "scope", ("corner", "axle"))

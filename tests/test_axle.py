@@ -521,3 +521,150 @@ def test_each_side_takes_its_setup_before_the_sweep(tmp_path):
         )
         > 1.0
     )  # fmt: skip  the shim changed the corner
+
+
+DATA = ROOT / "tests" / "data"
+
+
+def test_open_kinematics_axle_files_load_unchanged_and_roll_alike(tmp_path):
+    """open-kinematics 0.4's two axle test geometries sweep through the CLI as they
+    stand; the rocker, torsion bars and U-bar of the second constrain no wheel motion,
+    so both give the same corner columns, and each is mirror-symmetric in roll."""
+    from pin_susp.cli import main
+
+    sweep = DATA / "open_kinematics_axle_rocker_sweep.yaml"
+    csv = {}
+    for name in ("open_kinematics_axle_geometry", "open_kinematics_axle_geometry_rocker"):
+        out = tmp_path / f"{name}.csv"
+        assert main(["sweep", str(DATA / f"{name}.yaml"), str(sweep), "-o", str(out), "-q"]) == 0
+        csv[name] = c = read_csv(out)
+        assert all(v == "True" for v in c["solver_converged"])
+        assert max(c["solver_max_residual"]) <= 1e-9
+        n = len(c["roll"])
+        for i in range(n):
+            assert c["camber_left"][i] == pytest.approx(c["camber_right"][n - 1 - i], abs=1e-9)
+    plain, rocker = csv.values()
+    for name in ("camber_left", "roadwheel_angle_right", "roll", "roll_center_z", "track"):
+        np.testing.assert_allclose(
+            plain[name].astype(float), rocker[name].astype(float), atol=1e-9, err_msg=name
+        )
+    assert np.ptp(rocker["arb_twist"].astype(float)) > 10.0  # the bar twists in roll
+
+
+def t_bar_model(rigid=False) -> AxleModel:
+    data = yaml.safe_load((DATA / "axle_t_bar.yaml").read_text())
+    if rigid:
+        data["axle_config"]["anti_roll"]["stiffness"] = "rigid"
+    return AxleModel(load_axle(data))
+
+
+def test_t_bar_is_a_rigid_crossbar_on_its_pivot_and_its_twist_is_the_turn_about_the_stem():
+    """Read from the solved points alone: pivot → crossbar ends stay rigid, the
+    crossbar's midpoint stays in y = 0, the droplinks keep their lengths; the
+    crossbar's rotation (fitted by scipy) is a pitch about y and then a turn about the
+    design stem, and that turn is the arb_twist column."""
+    from scipy.spatial.transform import Rotation
+
+    model = t_bar_model()
+    solutions = solve_axle_sweep(model, roll_sweep(7))
+    results = axle_results(model, roll_sweep(7), solutions)
+    d = model.design_positions
+    hub = model.axle.center["arb_t_bar_pivot"]
+    ends0 = np.array([d["left_droplink_t_bar"], d["right_droplink_t_bar"]]) - hub
+    stem0 = ends0.mean(axis=0)
+    u0 = stem0 / np.linalg.norm(stem0)
+    for i, s in enumerate(solutions):
+        assert s.converged
+        p = model.positions(s.q)
+        ends = np.array([p["left_droplink_t_bar"], p["right_droplink_t_bar"]]) - hub
+        np.testing.assert_allclose(np.linalg.norm(ends, axis=1), np.linalg.norm(ends0, axis=1))
+        assert abs(ends.mean(axis=0)[1]) < 1e-12
+        for side in ("left", "right"):
+            a, b = f"{side}_droplink_rocker", f"{side}_droplink_t_bar"
+            assert np.linalg.norm(p[a] - p[b]) == pytest.approx(np.linalg.norm(d[a] - d[b]))
+        turn, _ = Rotation.align_vectors(ends, ends0)
+        stem = turn.apply(stem0)
+        pitch = Rotation.from_rotvec([0.0, np.arctan2(np.cross(stem0, stem)[1], stem0 @ stem), 0])
+        twist = (pitch.inv() * turn).as_rotvec()
+        assert np.linalg.norm(np.cross(twist, u0)) < 1e-9  # a turn about the stem only
+        assert results.columns["arb_twist"][i] == pytest.approx(np.degrees(twist @ u0), abs=1e-9)
+    assert abs(results.columns["arb_twist"][0]) > 3.0
+
+
+def test_t_bar_twist_rate_matches_central_differences_of_wheel_heights():
+    model = t_bar_model()
+    d = model.design_positions
+    z = {s: d[f"{s}_wheel_center"][2] for s in ("left", "right")}
+    z["left"] += 0.01
+    base = model.solve(z)
+    results = axle_results(model, one_step(), [base])
+    h = 1e-5
+    for side in ("left", "right"):
+        twist = []
+        for dz in (h, -h):
+            moved = dict(z, **{side: z[side] + dz})
+            s = model.solve(moved, q0=base.q)
+            twist.append(axle_results(model, one_step(), [s]).columns["arb_twist"][0])
+        fd = (twist[0] - twist[1]) / (2 * h * 1e3)
+        exact = results.columns[f"deriv_arb_twist_wrt_hub_z_{side}"][0]
+        assert exact == pytest.approx(fd, rel=1e-6, abs=1e-9)
+        assert abs(exact) > 1e-2
+
+
+def one_step():
+    return load_sweep({"targets": [{"quantity": "heave", "values": [0.0]}]})
+
+
+@pytest.mark.parametrize("bar", ["u_bar", "t_bar"])
+def test_a_rigid_bar_cannot_roll(tmp_path, bar):
+    """A locked bar (stiffness: rigid) leaves heave and the rack: a roll target is
+    refused as unreachable (exit 2, nothing written), and driving the left wheel
+    alone carries the right one to the same height."""
+    from pin_susp.cli import main
+
+    data = yaml.safe_load(
+        (
+            ROOT / "examples/axle_front.yaml" if bar == "u_bar" else DATA / "axle_t_bar.yaml"
+        ).read_text()
+    )
+    data["axle_config"]["anti_roll"]["stiffness"] = "rigid"
+    path = tmp_path / "rigid.yaml"
+    path.write_text(yaml.safe_dump(data))
+    model = AxleModel(load_axle(path))
+    assert model.mobility == 2
+    out = tmp_path / "out.csv"
+    assert main(["sweep", str(path), str(ROOT / "examples/roll.yaml"), "-o", str(out), "-q"]) == 2
+    assert not out.exists()
+    with pytest.raises(pin_susp.InputError, match="unreachable.*rigid"):
+        solve_axle_sweep(model, load_sweep(ROOT / "examples/roll.yaml"))
+    sweep = load_sweep(
+        {
+            "steps": 5,
+            "targets": [
+                {"point": "wheel_center", "side": "left", "direction": {"axis": "z"},
+                 "start": -30, "stop": 30},
+                {"point": "trackrod_inboard", "side": "left", "direction": {"axis": "y"},
+                 "start": 0, "stop": 0},
+            ],
+        }
+    )  # fmt: skip
+    solutions = solve_axle_sweep(model, sweep)
+    for s in solutions:
+        assert s.converged
+        p = model.positions(s.q)
+        assert p["right_wheel_center"][2] == pytest.approx(p["left_wheel_center"][2], abs=1e-12)
+    assert model.positions(solutions[0].q)["left_wheel_center"][2] == pytest.approx(
+        model.design_positions["left_wheel_center"][2] - 0.03
+    )
+
+
+def test_an_older_open_kinematics_axle_layout_is_named(tmp_path):
+    from pin_susp.cli import main
+
+    path = tmp_path / "old.yaml"
+    path.write_text("type: double_wishbone_axle\nhardpoints: {side: left, points: {}}\n")
+    with pytest.raises(pin_susp.InputError, match="older open-kinematics axle layout"):
+        load_geometry(path)
+    out = tmp_path / "out.csv"
+    assert main(["sweep", str(path), str(ROOT / "examples/roll.yaml"), "-o", str(out)]) == 2
+    assert not out.exists()
