@@ -16,7 +16,11 @@ where there is no rack, against the fixed-toe-link double wishbone) it prints:
 - per-step time for sweeps of 11, 101, 1 001 and 10 001 steps;
 - a 51 × 41 bump × steer grid solved by continuation along rows;
 - each mechanism's per-step time as a ratio to the double wishbone's on the
-  same kind of sweep (target: MacPherson and multilink <= 1.5x).
+  same kind of sweep (target: MacPherson and multilink <= 1.5x);
+- the example axle (examples/axle_front.yaml: two pushrod-rocker corners, one
+  rack, a U-bar) against its corner (examples/pushrod_rocker.yaml), per step,
+  measured in alternation: bump + steer on both wheels and a roll sweep (roll
+  and heave targets), solve alone and solve with every column (target <= 2.5x).
 
 Timing lives here, never in the tests (a test runs ``--quick`` and checks
 only iterations and residuals).
@@ -34,8 +38,9 @@ import numpy as np
 import pinocchio as pin
 
 import pin_susp
+from pin_susp.axle import AxleModel, axle_results, load_axle, solve_axle_sweep
 from pin_susp.pointwise import PointwiseCorner
-from pin_susp.sweep import Sweep, Target
+from pin_susp.sweep import Sweep, Target, load_sweep
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 CORNERS = ("double_wishbone.yaml", "camber_shim.yaml", "pushrod_rocker.yaml")
@@ -198,7 +203,70 @@ def run(repeat: int, quick: bool) -> dict:
     pairs = {name: ref for name, ref in MECHANISMS.items() if ref is not None}
     for name, ratio in interleaved(pairs, max(3, repeat // 2)).items():
         report["corners"][name]["vs"] = {"corner": pairs[name], "ratio": ratio}
+    report["axle"] = axle_vs_corner(max(3, repeat // 2))
     return report
+
+
+def axle_sweeps(steps: int) -> dict[str, Sweep]:
+    """The axle's sweeps: both wheels' bump with the rack (the corner's bump + steer on
+    each side), and roll −3…3° at 10 mm of heave with the rack held."""
+    side = lambda s, point, axis, a, b: {  # noqa: E731
+        "point": point, "side": s, "direction": {"axis": axis}, "start": a, "stop": b,
+    }  # fmt: skip
+    rack = side("left", "trackrod_inboard", "y", -10, 10)
+    return {
+        "bump+steer": load_sweep(
+            {
+                "steps": steps,
+                "targets": [
+                    side("left", "wheel_center", "z", -40, 60),
+                    side("right", "wheel_center", "z", -40, 60),
+                    rack,
+                ],
+            }
+        ),
+        "roll": load_sweep(
+            {
+                "steps": steps,
+                "targets": [
+                    {"quantity": "roll", "start": -3, "stop": 3},
+                    {"quantity": "heave", "start": 10, "stop": 10},
+                    rack | {"start": 0, "stop": 0},
+                ],
+            }
+        ),
+    }
+
+
+def axle_vs_corner(rounds: int, steps: int = 101) -> dict:
+    """Per-step time of the example axle over its corner's, in alternation (so that the
+    machine's drift cancels): solve alone, and solve with every column."""
+    corner = pin_susp.Corner(EXAMPLES / "pushrod_rocker.yaml")
+    model = AxleModel(load_axle(EXAMPLES / "axle_front.yaml"))
+    reference = bump_steer(steps)
+    jobs = {
+        "corner solve": lambda: corner.solve_steps(reference),
+        "corner whole": lambda: corner.run_sweep(reference),
+    }
+    for kind, sweep in axle_sweeps(steps).items():
+        jobs[f"axle {kind} solve"] = lambda sweep=sweep: solve_axle_sweep(model, sweep)
+        jobs[f"axle {kind} whole"] = lambda sweep=sweep: axle_results(
+            model, sweep, solve_axle_sweep(model, sweep)
+        )
+    times = {name: [] for name in jobs}
+    for job in jobs.values():
+        job()  # warm-up
+    for _ in range(rounds):
+        for name, job in jobs.items():
+            started = time.perf_counter()
+            job()
+            times[name].append((time.perf_counter() - started) / steps * 1e6)
+    us = {name: float(np.median(t)) for name, t in times.items()}
+    out = {"us_per_step": us, "ratio": {}}
+    for name, t in us.items():
+        if name.startswith("axle"):
+            out["ratio"][name] = t / us[f"corner {name.rsplit(' ', 1)[1]}"]
+    return out
 
 
 def interleaved(pairs: dict[str, str], rounds: int) -> dict[str, float]:
@@ -277,6 +345,16 @@ def show(report: dict) -> None:
             )
 
 
+def show_axle(axle: dict) -> None:
+    print("\naxle_front.yaml against its corner pushrod_rocker.yaml (bump + steer), per step,")
+    print("measured in alternation (target <= 2.5x):")
+    us = axle["us_per_step"]
+    for name in ("corner solve", "corner whole"):
+        print(f"  {name:26s} {us[name]:8.1f} us")
+    for name, ratio in axle["ratio"].items():
+        print(f"  {name:26s} {us[name]:8.1f} us = {ratio:.2f}x")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=40, help="repetitions per measurement")
@@ -285,6 +363,7 @@ def main() -> None:
     args = parser.parse_args()
     report = run(3 if args.quick else args.repeat, args.quick)
     show(report)
+    show_axle(report["axle"])
     if args.json:
         Path(args.json).write_text(json.dumps(report, indent=2, default=float))
         print(f"\nwrote {args.json}")

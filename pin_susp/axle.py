@@ -10,6 +10,7 @@ is parsed from the composed URDF like a corner's (:class:`linkage.Built`).
 from __future__ import annotations
 
 import copy
+import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -20,9 +21,9 @@ from .closures import ContactPatchPoint, JointTarget, PointTarget
 from .corner import Results
 from .errors import InputError
 from .geometry import DERIVED_POINTS, MM, Geometry, unit
-from .linkage import Built, Linkage
+from .linkage import Built, FrameMotion, Linkage
 from .mechanisms import axis_foot, xml_name
-from .solver import NewtonSolver, Predictor
+from .solver import NewtonSolver, march
 from .urdf import Body, Closure, Joint, Tree, Visual
 from .yamlio import Reader, load_yaml
 
@@ -579,50 +580,57 @@ def _mirror(corner: dict) -> dict:
 Z = np.array([0.0, 0.0, 1.0])
 
 
-class HeaveTarget:
-    """½(ΔWC_z,L + ΔWC_z,R) held at a value (m): 1 row."""
+class _FrameRow:
+    """A target row computed from frames' positions and Jacobians (``from_frames``),
+    so that the solver's batch reads each frame once for every row."""
 
     size = 1
+
+    def residual(self, kin) -> np.ndarray:
+        return self.from_frames([p.position(kin) for p in self.frame_points])[0]
+
+    def jacobian(self, kin) -> np.ndarray:
+        P = [p.position(kin) for p in self.frame_points]
+        return self.from_frames(P, [p.jacobian(kin) for p in self.frame_points])[1]
+
+
+class HeaveTarget(_FrameRow):
+    """½(ΔWC_z,L + ΔWC_z,R) held at a value (m): 1 row."""
+
     name = "target heave"
 
     def __init__(self, left, right, design: float, value: float = 0.0):
-        self.left, self.right, self.design, self.value = left, right, design, value
+        self.frame_points = (left, right)
+        self.design, self.value = design, value
 
-    def residual(self, kin) -> np.ndarray:
-        z = self.left.position(kin)[2] + self.right.position(kin)[2]
-        return np.array([0.5 * z - self.design - self.value])
-
-    def jacobian(self, kin) -> np.ndarray:
-        return (0.5 * (self.left.jacobian(kin)[2] + self.right.jacobian(kin)[2]))[None]
+    def from_frames(self, P, J=None) -> tuple:
+        r = np.array([0.5 * (P[0][2] + P[1][2]) - self.design - self.value])
+        return r, None if J is None else (0.5 * (J[0][2] + J[1][2]))[None]
 
 
-class RollTarget:
+class RollTarget(_FrameRow):
     """atan2(ΔWC_z,L − ΔWC_z,R, CP_y,L − CP_y,R) held at a value (rad): 1 row
     (open-kinematics' roll: + = the left wheel higher relative to the chassis)."""
 
-    size = 1
     name = "target roll"
 
     def __init__(self, wheels, patches, design: float, value: float = 0.0):
-        self.wheels, self.patches = wheels, patches  # (left, right) each
+        self.patches = patches  # (left, right) ContactPatchPoints
+        self.frame_points = (*wheels, *patches[0].frame_points, *patches[1].frame_points)
         self.design, self.value = design, value  # design: ΔWC_z,L − ΔWC_z,R offset (m)
 
-    def _parts(self, kin):
-        (wl, wr), (cl, cr) = self.wheels, self.patches
-        a = wl.position(kin)[2] - wr.position(kin)[2] - self.design
-        b = cl.position(kin)[1] - cr.position(kin)[1]
-        return a, b
-
-    def residual(self, kin) -> np.ndarray:
-        a, b = self._parts(kin)
-        return np.array([np.arctan2(a, b) - self.value])
-
-    def jacobian(self, kin) -> np.ndarray:
-        a, b = self._parts(kin)
-        (wl, wr), (cl, cr) = self.wheels, self.patches
-        da = wl.jacobian(kin)[2] - wr.jacobian(kin)[2]
-        db = cl.jacobian(kin)[1] - cr.jacobian(kin)[1]
-        return ((b * da - a * db) / (a * a + b * b))[None]
+    def from_frames(self, P, J=None) -> tuple:
+        (cl, jl), (cr, jr) = (
+            patch.from_frames(P[k : k + 3], None if J is None else J[k : k + 3])
+            for patch, k in zip(self.patches, (2, 5), strict=True)
+        )
+        a = P[0][2] - P[1][2] - self.design
+        b = cl[1] - cr[1]
+        r = np.array([math.atan2(a, b) - self.value])
+        if J is None:
+            return r, None
+        da, db = J[0][2] - J[1][2], jl[1] - jr[1]
+        return r, ((b * da - a * db) / (a * a + b * b))[None]
 
 
 def axle_rows(model: AxleModel, targets, source: str = "<targets>") -> list:
@@ -711,23 +719,26 @@ def solve_axle_sweep(model: AxleModel, sweep, source: str | None = None, progres
     previous = np.array([row.residual(model.kin)[0] for row in rows]) + np.array(
         [getattr(row, "value", 0.0) for row in rows]
     )
-    q, out = model.q_design, []
-    predictor = Predictor(model.model)
-    for i, goal in enumerate(values):
-        solution = None
-        guess = predictor.guess(goal)
-        if guess is not None:  # one Newton iteration from a good guess, usually
-            solver.set_targets(goal)
-            solution = solver.newton(guess)
-        if solution is None or not solution.converged:
-            solution = solver.solve(q, previous, goal)
-        if solution.converged:
-            q, previous = solution.q, goal
-            predictor.add(q, goal, solver.tangent())
-        out.append(solution)
-        if progress is not None:
-            progress(i + 1, len(values))
-    return out
+    solver.keep_jacobian = True  # exact tangents: a better prediction, and the columns' rates
+    found = []
+    solutions = march(solver, values, model.q_design, previous, progress, tangents=found)
+    drive = _drive_rows(model)
+    for solution, tangent in zip(solutions, found, strict=True):
+        # dq per driver from dq per target: T·(J_drive·T)⁻¹ (a rigid bar has fewer
+        # freedoms than drivers: its per-side rates stay blank)
+        if tangent is not None and tangent.shape[1] == len(drive):
+            model.kin.update(solution.q)
+            across = np.vstack([row.jacobian(model.kin) for row in drive]) @ tangent
+            solution.drive_tangent = tangent @ np.linalg.inv(across)
+    return solutions
+
+
+def _drive_rows(model: AxleModel) -> list:
+    """The drivers of the columns' rates: each wheel centre's z, and the rack."""
+    drive = [PointTarget(model.points[f"{s}_wheel_center"], Z) for s in SIDES]
+    if model.model.existJointName("rack_slide"):
+        drive.append(JointTarget(model.model, "rack_slide"))
+    return drive
 
 
 # ---------------------------------------------------------------- columns
@@ -746,7 +757,7 @@ def axle_results(model: AxleModel, sweep, solutions: list) -> AxleResults:
 
     columns, units = AxleResults.solver_columns(solutions)
     qs = [s.q if s.converged else None for s in solutions]
-    points = _motion(model, qs)
+    points = _motion(model, qs, solutions)
     sides = {}
     for side, g in model.geometries.items():
         design = {k: model.design_positions[f"{side}_{k}"][None] for k in model.point_names[side]}
@@ -769,35 +780,32 @@ def axle_results(model: AxleModel, sweep, solutions: list) -> AxleResults:
     return AxleResults(columns, units, AxleResults.solver_meta(solutions, (source, sha), sweep))
 
 
-def _motion(model: AxleModel, qs: list) -> dict:
+def _motion(model: AxleModel, qs: list, solutions: list) -> dict:
     """Every point (prefixed) at every step, as a Dual per side: that side's rates along
     its wheel-centre z (the other wheel centre and the rack held) and the rack. A
     step that did not converge is NaN."""
     from .geometry import contact_patch
     from .jet import Dual
 
-    rack = model.model.existJointName("rack_slide")
-    drive = [PointTarget(model.points[f"{s}_wheel_center"], Z) for s in SIDES]
-    if rack:
-        drive.append(JointTarget(model.model, "rack_slide"))
+    drive = _drive_rows(model)
+    rack = len(drive) == 3
     solver = NewtonSolver(model.kin, model.closures, drive, model.branches)
-    names = [n for n in model.frame_names]
-    n, k = len(qs), len(drive)
-    pos = np.full((len(names), n, 3), np.nan)
-    rates = np.full((len(names), k, n, 3), np.nan)
-    for i, q in enumerate(qs):
-        if q is None:
-            continue
+
+    def tangent_at(i: int, q: np.ndarray) -> np.ndarray:
+        known = solutions[i].drive_tangent
+        if known is not None:
+            model.kin.update(q)
+            return known
         solver.evaluate(q)
-        tangent = solver.tangent()
-        for j, name in enumerate(names):
-            point = model.points[name]
-            pos[j, i] = point.position(model.kin)
-            rates[j, :, i] = (point.jacobian(model.kin) @ tangent).T
+        return solver.tangent()
+
+    motion = FrameMotion(model.kin, model.frame_names, model.points, model.design_positions)
+    pos, rates = motion(qs, tangent_at, len(drive))
     out = {}
-    for j, name in enumerate(names):
+    for j, name in enumerate(model.frame_names):
         out[name] = {
-            side: Dual(pos[j], rates[j][[c, 2] if rack else [c]]) for c, side in enumerate(SIDES)
+            side: Dual(pos[:, j], rates[[c, 2] if rack else [c], :, j])
+            for c, side in enumerate(SIDES)
         }
     for side, g in model.geometries.items():
         p = {k: out[f"{side}_{k}"] for k in ("wheel_center", "axle_inboard", "axle_outboard")}

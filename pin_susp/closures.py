@@ -76,24 +76,31 @@ class ContactPatchPoint:
         self.center, self.axle_in, self.axle_out = center, axle_in, axle_out
         self.radius = radius
 
+    @property
+    def frame_points(self) -> tuple:
+        return (self.center, self.axle_in, self.axle_out)
+
     def position(self, kin: Kinematics) -> np.ndarray:
-        a = self.axle_out.position(kin) - self.axle_in.position(kin)
-        down, _ = wheel_down(a / np.linalg.norm(a))
-        return self.center.position(kin) + self.radius * down
+        return self.from_frames([p.position(kin) for p in self.frame_points])[0]
 
     def jacobian(self, kin: Kinematics) -> np.ndarray:
-        v = self.axle_out.position(kin) - self.axle_in.position(kin)
-        n = np.linalg.norm(v)
+        P = [p.position(kin) for p in self.frame_points]
+        return self.from_frames(P, [p.jacobian(kin) for p in self.frame_points])[1]
+
+    def from_frames(self, P, J=None) -> tuple:
+        """(position, Jacobian or None) from its frames' positions P and Jacobians J
+        (wheel centre, axle inboard, axle outboard): for the solver's batch."""
+        v = P[2] - P[1]
+        n = math.sqrt(v @ v)
         a = v / n
         down, norm = wheel_down(a)
-        da = (
-            (np.eye(3) - np.outer(a, a))
-            @ (self.axle_out.jacobian(kin) - self.axle_in.jacobian(kin))
-            / n
-        )
+        position = P[0] + self.radius * down
+        if J is None:
+            return position, None
+        da = (J[2] - J[1] - np.outer(a, a @ (J[2] - J[1]))) / n
         du = np.outer(a, da[2]) + a[2] * da
-        dd = (np.eye(3) - np.outer(down, down)) @ du / norm
-        return self.center.jacobian(kin) + self.radius * dd
+        dd = (du - np.outer(down, down @ du)) / norm
+        return position, J[0] + self.radius * dd
 
 
 class BallClosure:

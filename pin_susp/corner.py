@@ -8,8 +8,6 @@ The model itself — URDF, Pinocchio model, points, closures — is the
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
 
 from . import setup
@@ -18,7 +16,7 @@ from .errors import InputError
 from .geometry import Geometry, load_geometry, warn_outside
 from .linkage import Linkage
 from .metrics import METRICS, TOE_LINK, Pose, metric_columns, point_columns
-from .solver import NewtonSolver, Predictor, Solution
+from .solver import NewtonSolver, Solution, march
 from .sweep import Sweep, Target, load_sweep
 
 
@@ -129,40 +127,20 @@ class Corner(Linkage):
         order = self.drive_order(sweep.targets) if tangents is not None else None
         solver.keep_jacobian = order is not None
         values = self.target_values(sweep.targets)
-        n = values.shape[0]
         q = self.q_design if q_start is None else q_start
         previous = self.target_values([t.at_design() for t in sweep.targets])[0]
         if q_start is not None:
             previous = self._values_at(solver, q_start)
-        predictor = Predictor(self.model)
-        # which steps repeat the one before (a uniform sweep): worked out once for all
-        steps = np.diff(np.vstack([previous, values]), axis=0)
-        repeats = np.r_[False, np.abs(np.diff(steps, axis=0)).max(axis=1) <= 1e-15]
-        solutions = []
-        clock = time.perf_counter
-        for i in range(n):
-            started = clock()
-            solution = None
-            guess = predictor.guess(values[i], bool(repeats[i]) and predictor.before is not None)
-            if guess is not None:  # one Newton iteration from a good guess, usually
-                solver.set_targets(values[i])
-                solution = solver.newton(guess)
-            if solution is None or not solution.converged:
-                solution = solver.solve(q, previous, values[i])
-            tangent = None
-            if solution.converged:
-                q, previous = solution.q, values[i]
-                # exact when keep_jacobian; else J of the last iterate: good enough to predict
-                tangent = solver.tangent()
-                predictor.add(q, previous, tangent, exact=solver.keep_jacobian)
-            if order is not None:
-                tangents.append(None if tangent is None else tangent[:, order])
-            if step_times is not None:
-                step_times.append(clock() - started)
-            solutions.append(solution)
-            if progress is not None:
-                progress(i + 1, n)
-        return solutions
+        return march(
+            solver,
+            values,
+            q,
+            previous,
+            progress=progress,
+            step_times=step_times,
+            tangents=tangents,
+            order=order,
+        )
 
     def _values_at(self, solver: NewtonSolver, q: np.ndarray) -> np.ndarray:
         """The target values that q satisfies."""

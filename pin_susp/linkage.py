@@ -75,6 +75,67 @@ class Built:
         return FramePoint(name, self.model.addFrame(frame), link)
 
 
+class FrameMotion:
+    """Points fixed to bodies, at many configurations, with their rates along a
+    tangent of the solution manifold: each point grouped by the joint that carries
+    it, every step's joint placements and twists read once, then all points at once
+    (p = o + R·l moves at v + ω × (p − o))."""
+
+    def __init__(self, kin, names: list[str], points: dict, design_positions: dict):
+        self.kin, self.names = kin, list(names)
+        groups = {}
+        for i, name in enumerate(self.names):
+            frame = kin.model.frames[points[name].frame_id]
+            if frame.parentJoint == 0:
+                offset = design_positions[name]
+            else:
+                offset = frame.placement.translation
+            groups.setdefault(frame.parentJoint, []).append((i, offset))
+        self.groups = [
+            (j, np.array([i for i, _ in g]), np.array([o for _, o in g])) for j, g in groups.items()
+        ]
+
+    def __call__(self, qs: list, tangent_at, k: int) -> tuple[np.ndarray, np.ndarray]:
+        """Positions (n, m, 3) and rates (k, n, m, 3) of the m points at the n
+        configurations; ``tangent_at(i, q)`` updates the kinematics (Jacobians too) at
+        q and returns dq per driver (nv × k). A None configuration gives NaN."""
+        n, m = len(qs), len(self.names)
+        pos = np.full((n, m, 3), np.nan)
+        rates = np.full((k, n, m, 3), np.nan)
+        moving = [(j, index, local) for j, index, local in self.groups if j != 0]
+        rotation = np.full((len(moving), n, 3, 3), np.nan)
+        origin = np.full((len(moving), n, 3), np.nan)
+        twist = np.full((len(moving), n, 6, k), np.nan)
+        model, data = self.kin.model, self.kin.data
+        for i, q in enumerate(qs):
+            if q is None:
+                continue
+            tangent = tangent_at(i, q)
+            oMi = data.oMi
+            for g, (joint, _, _) in enumerate(moving):
+                placement = oMi[joint]
+                rotation[g, i] = placement.rotation
+                origin[g, i] = placement.translation
+                twist[g, i] = (
+                    pin.getJointJacobian(model, data, joint, pin.LOCAL_WORLD_ALIGNED).reshape(6, -1)
+                    @ tangent
+                )
+        for j, index, local in self.groups:
+            if j == 0:  # the chassis: fixed points
+                pos[:, index] = local
+                rates[:, :, index] = 0.0
+        for g, (_, index, local) in enumerate(moving):
+            arms = np.einsum("nij,mj->nmi", rotation[g], local)
+            pos[:, index] = arms + origin[g][:, None]
+            v = np.moveaxis(twist[g, :, :3], -1, 0)  # (k, n, 3)
+            w = np.moveaxis(twist[g, :, 3:], -1, 0)
+            rates[:, :, index] = v[:, :, None] + np.cross(w[:, :, None], arms[None])
+        unsolved = np.array([q is None for q in qs])
+        pos[unsolved] = np.nan
+        rates[:, unsolved] = np.nan
+        return pos, rates
+
+
 class Linkage:
     """The kinematic model of one corner at its geometry's design state."""
 
@@ -124,19 +185,8 @@ class Linkage:
             toe = np.zeros((self._drive.nrows, 1))
             toe[row] = 1.0
             self.drive_rhs = np.hstack([self._drive._unit_rhs, toe])
-        # Points grouped by the joint that carries them: (joint id, columns, offsets).
         frames = [name for name in self.point_names if name != "contact_patch_center"]
-        groups = {}
-        for i, name in enumerate(frames):
-            frame = self.model.frames[self.points[name].frame_id]
-            if frame.parentJoint == 0:
-                offset = self.design_positions[name]
-            else:
-                offset = frame.placement.translation
-            groups.setdefault(frame.parentJoint, []).append((i, offset))
-        self._point_groups = [
-            (j, np.array([i for i, _ in g]), np.array([o for _, o in g])) for j, g in groups.items()
-        ]
+        self._frame_motion = FrameMotion(self.kin, frames, self.points, self.design_positions)
         # The sense in which bump winds a torsion bar at design (motion_ratio's sign).
         self.spring_sense = 1.0
         if geometry.spring == "torsion_bar":
@@ -188,48 +238,16 @@ class Linkage:
         The contact patch follows by the chain rule (jet.Dual). A None
         configuration (a step that did not converge) gives NaN.
         """
-        n, k = len(qs), len(self.drivers)
-        frames = [name for name in self.point_names if name != "contact_patch_center"]
-        pos = np.full((n, len(frames), 3), np.nan)
-        rates = np.full((k, n, len(frames), 3), np.nan)
-        moving = [(j, index, local) for j, index, local in self._point_groups if j != 0]
-        # per moving joint and step: rotation, origin, and its twist (v; ω) per driver
-        rotation = np.full((len(moving), n, 3, 3), np.nan)
-        origin = np.full((len(moving), n, 3), np.nan)
-        twist = np.full((len(moving), n, 6, k), np.nan)
-        model, data = self.model, self.kin.data
-        for i, q in enumerate(qs):
-            if q is None:
-                continue
+
+        def tangent_at(i: int, q: np.ndarray) -> np.ndarray:
             if tangents is not None and tangents[i] is not None:
-                tangent = tangents[i]
                 self.kin.update(q)
-            else:
-                self._drive.evaluate(q)
-                tangent = self._drive.tangent(self.drive_rhs)
-            oMi = data.oMi
-            for g, (joint, _, _) in enumerate(moving):
-                placement = oMi[joint]
-                rotation[g, i] = placement.rotation
-                origin[g, i] = placement.translation
-                twist[g, i] = (
-                    pin.getJointJacobian(model, data, joint, pin.LOCAL_WORLD_ALIGNED).reshape(6, -1)
-                    @ tangent
-                )
-        # every step at once: p = o + R·l, and p moves at v + ω × (p − o)
-        for j, index, local in self._point_groups:
-            if j == 0:  # the chassis: fixed points
-                pos[:, index] = local
-                rates[:, :, index] = 0.0
-        for g, (_, index, local) in enumerate(moving):
-            arms = np.einsum("nij,mj->nmi", rotation[g], local)
-            pos[:, index] = arms + origin[g][:, None]
-            v = np.moveaxis(twist[g, :, :3], -1, 0)  # (k, n, 3)
-            w = np.moveaxis(twist[g, :, 3:], -1, 0)
-            rates[:, :, index] = v[:, :, None] + np.cross(w[:, :, None], arms[None])
-        unsolved = np.array([q is None for q in qs])
-        pos[unsolved] = np.nan
-        rates[:, unsolved] = np.nan
+                return tangents[i]
+            self._drive.evaluate(q)
+            return self._drive.tangent(self.drive_rhs)
+
+        pos, rates = self._frame_motion(qs, tangent_at, len(self.drivers))
+        frames = self._frame_motion.names
         points = {f: Dual(pos[:, i], rates[:, :, i]) for i, f in enumerate(frames)}
         axis = unit(points["axle_outboard"] - points["axle_inboard"])
         points["contact_patch_center"] = contact_patch(

@@ -14,7 +14,8 @@ Speed: rows of the common kinds (ball and distance closures, targets on
 frame points, held joints) are evaluated together — one Pinocchio call per
 frame they need, numpy on stacked arrays — and the small square system goes
 to LAPACK's dgesv directly. Other rows (the shim's, a contact-patch target)
-take their own ``residual``/``jacobian``. A sweep also predicts each step
+take their own ``residual``/``jacobian``, or are computed from their frames
+(``from_frames``: an axle's heave and roll). A sweep (``march``) also predicts each step
 from the last two solutions and the tangent (see ``predict``), so that one
 Newton iteration usually suffices.
 """
@@ -22,6 +23,7 @@ Newton iteration usually suffices.
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -55,6 +57,9 @@ class Solution:
     max_residual: float  # m
     # The loop whose design assembly branch the pose left (its residual may be tiny).
     branch: str | None = None
+    # dq per unit of each driver (an axle's wheel-centre z per side, the rack) at q,
+    # exact, when the sweep's solve had it: the columns' rates need no new solve
+    drive_tangent: np.ndarray | None = None
 
     @property
     def why(self) -> str:
@@ -186,6 +191,57 @@ class NewtonSolver:
         return full
 
 
+def march(
+    solver: NewtonSolver,
+    values: np.ndarray,
+    q: np.ndarray,
+    previous: np.ndarray,
+    progress=None,
+    step_times=None,
+    tangents: list | None = None,
+    order=None,
+) -> list[Solution]:
+    """Solve a sweep's steps (``values``: a row of target values each) in order, each
+    from a prediction off the last solutions (halving toward it on failure).
+
+    ``q``, ``previous``: a solved configuration and its target values to start from;
+    ``progress(done, total)`` after each step; ``step_times``: a list that receives
+    each step's solve time (s); ``tangents``: a list that receives each step's exact
+    tangent (solver.keep_jacobian must be set), its columns in ``order`` if given.
+    """
+    predictor = Predictor(solver.kin.model)
+    # which steps repeat the one before (a uniform sweep): worked out once for all
+    steps = np.diff(np.vstack([previous, values]), axis=0)
+    repeats = np.r_[False, np.abs(np.diff(steps, axis=0)).max(axis=1) <= 1e-15]
+    n = values.shape[0]
+    solutions = []
+    clock = time.perf_counter
+    for i in range(n):
+        started = clock()
+        solution = None
+        guess = predictor.guess(values[i], bool(repeats[i]) and predictor.before is not None)
+        if guess is not None:  # one Newton iteration from a good guess, usually
+            solver.set_targets(values[i])
+            solution = solver.newton(guess)
+        if solution is None or not solution.converged:
+            solution = solver.solve(q, previous, values[i])
+        tangent = None
+        if solution.converged:
+            q, previous = solution.q, values[i]
+            # exact when keep_jacobian; else J of the last iterate: good enough to predict
+            tangent = solver.tangent()
+            predictor.add(q, previous, tangent, exact=solver.keep_jacobian)
+        if tangents is not None:
+            keep = tangent if order is None or tangent is None else tangent[:, order]
+            tangents.append(keep)
+        if step_times is not None:
+            step_times.append(clock() - started)
+        solutions.append(solution)
+        if progress is not None:
+            progress(i + 1, n)
+    return solutions
+
+
 class Predictor:
     """The next step's starting configuration from the last solutions and the tangent.
 
@@ -252,7 +308,8 @@ class _Batch:
                 self.frames.append(point.frame_id)
             return index[point.frame_id]
 
-        self.balls, self.distances, self.targets, self.joints, self.others = [], [], [], [], []
+        self.balls, self.distances, self.targets, self.joints = [], [], [], []
+        self.composite, self.others = [], []  # rows of frames' positions and Jacobians
         i = 0
         for row in rows:
             if isinstance(row, BallClosure) and _framed(row.a, row.b):
@@ -265,6 +322,8 @@ class _Batch:
                 self.targets.append((i, frame(row.point), d, axis, row))
             elif isinstance(row, JointTarget):
                 self.joints.append((i, row.index_q, row))
+            elif hasattr(row, "from_frames") and _framed(*row.frame_points):
+                self.composite.append((i, row, [frame(p) for p in row.frame_points]))
             else:
                 self.others.append((i, row))
             i += row.size
@@ -305,6 +364,13 @@ class _Batch:
             r[i] = q[k] - row.value
             if J is not None:
                 J[i] = row.row[0]
+        for i, row, frames in self.composite:
+            value, jacobian = row.from_frames(
+                [P[k] for k in frames], None if J is None else [Jf[k] for k in frames]
+            )
+            r[i : i + row.size] = value
+            if J is not None:
+                J[i : i + row.size] = jacobian
 
 
 def _framed(*points) -> bool:
