@@ -668,3 +668,59 @@ def test_an_older_open_kinematics_axle_layout_is_named(tmp_path):
     out = tmp_path / "out.csv"
     assert main(["sweep", str(path), str(ROOT / "examples/roll.yaml"), "-o", str(out)]) == 2
     assert not out.exists()
+
+
+def no_side(sweep):
+    del sweep["targets"][2]["side"]
+
+
+def right_setup_mirrored(axle):
+    axle["axle_config"]["right_setup"] = {"trackrod_length_delta": 1.0}
+
+
+def bar_pivot_off_centre(axle):
+    t_bar_off_centre(axle)
+
+
+@pytest.mark.parametrize(
+    ("geometry_change", "sweep_change", "corner", "where", "words"),
+    [
+        (right_setup_mirrored, None, False, "axle_config.right_setup", "hardpoints.right"),
+        (bar_pivot_off_centre, None, False, "hardpoints.center.arb_t_bar_pivot", "centreline"),
+        (None, no_side, False, "targets[2].side", "missing"),
+        (None, None, True, "targets[0].side", "axle"),
+    ],
+    ids=["right_setup", "bar_pivot", "no_side", "side_on_corner"],
+)
+def test_bad_axle_input_gets_one_line_and_exit_2(
+    tmp_path, capsys, geometry_change, sweep_change, corner, where, words
+):
+    """Through the CLI: one line naming the file and key, exit 2, nothing written."""
+    from pin_susp.cli import main
+
+    if corner:
+        geometry = tmp_path / "corner.yaml"
+        geometry.write_text((ROOT / "examples/double_wishbone.yaml").read_text())
+    else:
+        geometry = axle_file(tmp_path, geometry_change)
+    sweep_data = yaml.safe_load((ROOT / "examples/roll.yaml").read_text())
+    if corner:
+        sweep_data = {"targets": [
+            {"point": "wheel_center", "side": "left", "direction": {"axis": "z"}, "values": [1]},
+            RACK,
+        ]}  # fmt: skip
+    if sweep_change:
+        sweep_change(sweep_data)
+    sweep = tmp_path / "sweep.yaml"
+    sweep.write_text(yaml.safe_dump(sweep_data))
+    out = tmp_path / "out.csv"
+    assert main(["sweep", str(geometry), str(sweep), "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in err, err
+    blamed = sweep if sweep_change or corner else geometry
+    assert lines[0].startswith(f"pin-susp: error: {blamed}: {where}"), lines[0]
+    assert words in lines[0]
+    assert not out.exists() and sorted(p.name for p in tmp_path.iterdir()) == sorted(
+        [geometry.name, sweep.name]
+    )
