@@ -245,6 +245,12 @@ class AxleModel:
         pin.framesForwardKinematics(self.model, self.kin.data, q)
         return {n: self.points[n].position(self.kin).copy() for n in self.output_points}
 
+    def motion(self, qs: list, solutions: list | None = None) -> dict:
+        """Every point (prefixed) at each configuration (None: NaN), as a jet.Dual per
+        side: its rates along that side's hub z and the rack (or its toe link);
+        ``solutions``: the sweep's, whose exact tangents spare a solve per step."""
+        return _motion(self, qs, solutions)
+
     def side_positions(self, q: np.ndarray, side: str) -> dict[str, np.ndarray]:
         """One corner's points at q, by their corner names."""
         all_points = self.positions(q)
@@ -321,7 +327,7 @@ class AxleGeometry:
         return self.anti_roll_stiffness is not None and np.isinf(self.anti_roll_stiffness)
 
 
-class _AxleReader(Reader):
+class AxleReader(Reader):
     """A Reader of a corner assembled from the axle file: each key it blames is named
     as it stands in the axle file (``config.wheel`` → ``axle_config.wheel``)."""
 
@@ -452,7 +458,7 @@ def load_axle(source) -> AxleGeometry:
             corner["side"] = "right"
             if mirrored:
                 corner = _mirror(corner)
-        reader = _AxleReader(name, "left" if side == "left" or mirrored else "right")
+        reader = AxleReader(name, "left" if side == "left" or mirrored else "right")
         corners[side] = _parse(corner, reader, sha)
         sign = 1.0 if side == "left" else -1.0
         side_points[side] = {
@@ -757,7 +763,7 @@ def axle_results(model: AxleModel, sweep, solutions: list) -> AxleResults:
 
     columns, units = AxleResults.solver_columns(solutions)
     qs = [s.q if s.converged else None for s in solutions]
-    points = _motion(model, qs, solutions)
+    points = model.motion(qs, solutions)
     sides = {}
     for side, g in model.geometries.items():
         design = {k: model.design_positions[f"{side}_{k}"][None] for k in model.point_names[side]}
@@ -780,7 +786,7 @@ def axle_results(model: AxleModel, sweep, solutions: list) -> AxleResults:
     return AxleResults(columns, units, AxleResults.solver_meta(solutions, (source, sha), sweep))
 
 
-def _motion(model: AxleModel, qs: list, solutions: list) -> dict:
+def _motion(model: AxleModel, qs: list, solutions: list | None = None) -> dict:
     """Every point (prefixed) at every step, as a Dual per side: that side's rates along
     its wheel-centre z (the other wheel centre and the rack held) and the rack. A
     step that did not converge is NaN."""
@@ -790,23 +796,31 @@ def _motion(model: AxleModel, qs: list, solutions: list) -> dict:
     drive = _drive_rows(model)
     rack = len(drive) == 3
     solver = NewtonSolver(model.kin, model.closures, drive, model.branches)
+    # each side's columns: its hub z, then the rack, or its fixed toe link's length (the
+    # steer of a toe-link corner: a column of 1 on that closure's row, as Linkage's)
+    rhs, columns = solver._unit_rhs, {}
+    for c, (side, g) in enumerate(model.geometries.items()):
+        columns[side] = [c, 2] if rack else [c]
+        if g.steering == "none" and g.steering_points:
+            row = _closure_row(model.closures, f"{side}_toe_link")
+            toe = np.zeros((solver.nrows, 1))
+            toe[row] = 1.0
+            columns[side].append(rhs.shape[1])
+            rhs = np.hstack([rhs, toe])
 
     def tangent_at(i: int, q: np.ndarray) -> np.ndarray:
-        known = solutions[i].drive_tangent
-        if known is not None:
+        known = None if solutions is None else solutions[i].drive_tangent
+        if known is not None and known.shape[1] == rhs.shape[1]:
             model.kin.update(q)
             return known
         solver.evaluate(q)
-        return solver.tangent()
+        return solver.tangent(rhs)
 
     motion = FrameMotion(model.kin, model.frame_names, model.points, model.design_positions)
-    pos, rates = motion(qs, tangent_at, len(drive))
+    pos, rates = motion(qs, tangent_at, rhs.shape[1])
     out = {}
     for j, name in enumerate(model.frame_names):
-        out[name] = {
-            side: Dual(pos[:, j], rates[[c, 2] if rack else [c], :, j])
-            for c, side in enumerate(SIDES)
-        }
+        out[name] = {side: Dual(pos[:, j], rates[columns[side], :, j]) for side in SIDES}
     for side, g in model.geometries.items():
         p = {k: out[f"{side}_{k}"] for k in ("wheel_center", "axle_inboard", "axle_outboard")}
         out[f"{side}_contact_patch_center"] = {
@@ -818,6 +832,16 @@ def _motion(model: AxleModel, qs: list, solutions: list) -> dict:
             for s in SIDES
         }
     return out
+
+
+def _closure_row(closures: list, name: str) -> int:
+    """The first row of the named closure in a solver's stacked rows."""
+    row = 0
+    for c in closures:
+        if c.name == name:
+            return row
+        row += c.size
+    raise KeyError(name)
 
 
 def _roll_rates(model: AxleModel, points: dict, sides: dict) -> dict:
@@ -860,7 +884,7 @@ def _roll_rates(model: AxleModel, points: dict, sides: dict) -> dict:
         # Dual over one direction, roll (rad): d/dθ = d/d(own hub z) · per_rad
         parts.append(tuple(Dual(v.val * 1e3, v.der[0] * per_rad[s] * 1e3) for v in values))
     with np.errstate(invalid="ignore", divide="ignore"):
-        rc = _roll_centre(parts)
+        rc = roll_centre(parts)
     out["deriv_roll_center_y_wrt_roll"] = (rc[0].der * deg, "mm/deg")
     out["deriv_roll_center_z_wrt_roll"] = (rc[1].der * deg, "mm/deg")
     bar = model.axle.anti_roll if model.axle is not None else "none"
@@ -909,7 +933,7 @@ def _axle_metrics(model: AxleModel, p: dict, sides: dict) -> dict:
     change = -0.5 * ((cp["left"][:, 2] - cp0["left"]) + (cp["right"][:, 2] - cp0["right"]))
     out["ride_height_change"] = (change * 1e3, "mm")
     out["track"] = (np.abs(track) * 1e3, "mm")
-    rc = _roll_centre(
+    rc = roll_centre(
         [
             (cp[s][:, 1] * 1e3, cp[s][:, 2] * 1e3, sides[s]["fvic_y"][0], sides[s]["fvic_z"][0])
             for s in SIDES
@@ -981,7 +1005,7 @@ def _t_bar_twist(model: AxleModel, left, right):
     )
 
 
-def _roll_centre(sides):
+def roll_centre(sides):
     """Where the lines CP→FVIC of the two sides cross (front view): each side given as
     (CP_y, CP_z, FVIC_y, FVIC_z); NaN where an FVIC is blank or the lines are
     parallel. Plain arithmetic, so it runs on jet.Duals (its derivative in roll)."""

@@ -138,7 +138,7 @@ class Corner(Linkage):
             previous,
             progress=progress,
             step_times=step_times,
-            tangents=tangents,
+            tangents=tangents if order is not None else None,
             order=order,
         )
 

@@ -724,3 +724,31 @@ def test_bad_axle_input_gets_one_line_and_exit_2(
     assert not out.exists() and sorted(p.name for p in tmp_path.iterdir()) == sorted(
         [geometry.name, sweep.name]
     )
+
+
+@pytest.mark.parametrize("name", ["fixed_toe_link.yaml", "multilink_rear.yaml"])
+def test_a_toe_link_axle_has_each_corners_columns_with_the_toe_link_rates(name):
+    """Without a rack each side's second driver is its fixed toe link's length, as the
+    corner's: every column (the steer-axis ones included) equals the corner's sweep."""
+    data, model = axle(name)
+    heights = [-20.0, 0.0, 15.0]
+    sweep = load_sweep(
+        {
+            "targets": [
+                {"point": "wheel_center", "side": s, "direction": {"axis": "z"}, "values": heights}
+                for s in ("left", "right")
+            ]
+        }
+    )
+    columns = axle_results(model, sweep, solve_axle_sweep(model, sweep)).columns
+    compared = 0
+    for side, drawn in (("left", data), ("right", mirrored(data))):
+        corner = pin_susp.Corner(drawn).run_sweep(
+            {"targets": [{"point": "wheel_center", "direction": {"axis": "z"}, "values": heights}]}
+        )
+        for column in corner.columns:
+            ours = f"{column}_{side}"
+            if ours in columns and not column.startswith("anti_"):
+                np.testing.assert_allclose(columns[ours], corner[column], atol=1e-9, err_msg=ours)
+                compared += 1
+    assert compared > 50 and any(c.startswith("isa_") for c in corner.columns)
