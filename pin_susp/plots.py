@@ -20,11 +20,20 @@ centre at infinity (parallel arm planes) or further than 20 m is not drawn
 but noted; the view stays on the corner and lines run off its edges. The
 tyre is its silhouette: the two rim-edge circles, projected, cut at the road.
 ``labels=True`` names every hardpoint and adds a legend of the colours.
+
+An axle's results (per-side columns, ``roll``, ``heave``) give the axle report
+(``axle_panels``): a line per side (the right dashed) against roll, else
+heave, else rack travel — the first the sweep varied — and Ackermann against
+the mean steer angle when the rack moved. ``axle_drawing_figure`` draws the
+axle in front view at design or at a pose (``axle_pose``: a step of its
+results), with each side's FVIC construction and the roll centre where the
+two contact-patch lines cross.
 """
 
 from __future__ import annotations
 
 import json
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import matplotlib
@@ -122,16 +131,19 @@ class ResultsFile:
                 self.columns[name] = np.array([_cell(row[j]) for _, row in body])
             except ValueError:
                 raise InputError(source, name, "has a cell that is not a number") from None
-        for needed in ("wheel_travel", "camber"):
+        # an axle's results: every corner column per side, and the axle's own
+        self.axle = "camber_left" in self.columns
+        travel, shape = ("heave", "roll") if self.axle else ("wheel_travel", "camber")
+        for needed in (travel, shape):
             if needed not in self.columns:
                 raise InputError(source, needed, "missing column: not a sweep results CSV")
         if not any(np.any(np.isfinite(c)) for c in self.columns.values()):
             raise InputError(source, "", "no numbers in it: every data cell is empty")
-        if not np.any(np.isfinite(self.columns["wheel_travel"])):
+        if not np.any(np.isfinite(self.columns[travel])):
             converged = self.columns.get("solver_converged")
             if converged is not None and not np.any(converged == 1.0):
                 raise InputError(source, "", "no step of this sweep converged: nothing to plot")
-            raise InputError(source, "wheel_travel", "no values: every cell is empty")
+            raise InputError(source, travel, "no values: every cell is empty")
 
     def __getitem__(self, name):
         return self.columns[name]
@@ -177,10 +189,20 @@ WHEEL_X = ("wheel_travel", "Wheel travel (+ bump) [mm]")
 RACK_X = ("rack_displacement", "Rack position from centre (+ left) [mm]")
 # results written before the rack_displacement column: the design position is unknown
 RACK_ABSOLUTE_X = ("trackrod_inboard_y", "Rack position: trackrod inboard y (absolute) [mm]")
+# an axle's sweep, by what it moved, in this order: a roll at a rack position is a roll
+AXLE_X = {
+    "roll": ("roll", "Roll (+ left wheel up relative to the chassis) [deg]"),
+    "heave": ("heave", "Heave (+ bump) [mm]"),
+    "rack travel": RACK_X,
+}
 
 
 def sweeps(results: ResultsFile) -> str | None:
-    """What the sweep moved: 'wheel travel', 'rack travel', or None (nothing: one step)."""
+    """What the sweep moved: 'wheel travel', 'rack travel', or None (nothing: one step);
+    an axle's: 'roll', else 'heave', else 'rack travel'."""
+    if results.axle:
+        moved = (k for k, (x, _) in AXLE_X.items() if x in results.columns and _varies(results[x]))
+        return next(moved, None)
     if _varies(results["wheel_travel"]):
         return "wheel travel"
     for name in ("rack_displacement", "trackrod_inboard_y"):
@@ -205,6 +227,8 @@ def x_axis(results: ResultsFile | list[ResultsFile]) -> tuple[str, str]:
                 "",
                 f"x is {kind} but {first.source}'s is {first_kind}: plot them separately",
             )
+    if files[0].axle:
+        return AXLE_X[first_kind or "roll"]
     if first_kind in (None, "wheel travel"):
         return WHEEL_X
     if all("rack_displacement" in r.columns for r in files):
@@ -225,9 +249,18 @@ def panels(results: list[ResultsFile], xname: str) -> list[str]:
 
 
 def report_figure(results: list[ResultsFile]):
-    """One panel per metric against wheel travel (or rack), one line per results file."""
+    """One panel per metric against wheel travel (or rack), one line per results file;
+    an axle's results: the axle report (``axle_panels``)."""
     if not results:
         raise PinSuspError("no results file to plot")
+    axle = next((r for r in results if r.axle), None)
+    corner = next((r for r in results if not r.axle), None)
+    if axle is not None and corner is not None:
+        raise InputError(
+            corner.source,
+            "",
+            f"a corner's results, but {axle.source} is an axle's: plot them separately",
+        )
     xname, xlabel = x_axis(results)
     for r in results[1:]:
         if xname not in r.columns or not np.any(np.isfinite(r[xname])):
@@ -237,31 +270,123 @@ def report_figure(results: list[ResultsFile]):
                 f"no values, but {results[0].label} is plotted against it: "
                 "plot results of the same kind of sweep together",
             )
-    names = panels(results, xname)
-    if not names:
+    if axle is not None:
+        drawn = axle_panels(results, xname, xlabel)
+        title = "pin_susp axle kinematics: "
+    else:
+        drawn = [_corner_panel(results, name, xname, xlabel) for name in panels(results, xname)]
+        title = "pin_susp kinematics: "
+    if not drawn:
         files = ", ".join(r.source for r in results)
         raise InputError(files, "", "no metric column has a value to plot")
-    ncols = 4
-    nrows = -(-len(names) // ncols)
-    fig, axes = plt.subplots(nrows, ncols, figsize=(4.4 * ncols, 3.1 * nrows), squeeze=False)
-    for ax, name in zip(axes.flat, names, strict=False):
-        unit = next((r.units.get(name, "") for r in results if name in r.columns), "")
-        for r in results:
-            if name in r.columns:
-                # a lone point (one row, or one step between failed ones) shows as a dot
-                ax.plot(r[xname], r[name], label=r.label, linewidth=1.6, marker=_marker(r, name))
-        ax.set_title(label(name), fontsize=10)
-        ax.set_ylabel(f"{name} [{unit}]" if unit else name, fontsize=8)
-        ax.set_xlabel(xlabel, fontsize=8)
-        ax.grid(True, alpha=0.3)
-        ax.tick_params(labelsize=8)
-    for ax in list(axes.flat)[len(names) :]:
-        ax.set_visible(False)
-    if len(results) > 1:
-        axes.flat[0].legend(fontsize=8)
-    fig.suptitle("pin_susp kinematics: " + ", ".join(r.label for r in results), fontsize=12)
+    fig = _grid(drawn)
+    if axle is None and len(results) > 1:
+        fig.axes[0].legend(fontsize=8)
+    fig.suptitle(title + ", ".join(r.label for r in results), fontsize=12)
     fig.tight_layout()
     return fig
+
+
+@dataclass
+class Panel:
+    """One panel of a report: its lines (x, y, legend label, line style, colour, marker)."""
+
+    title: str
+    ylabel: str
+    xlabel: str
+    lines: list = field(default_factory=list)
+    legend: bool = False
+
+
+def _corner_panel(results: list[ResultsFile], name: str, xname: str, xlabel: str) -> Panel:
+    unit = next((r.units.get(name, "") for r in results if name in r.columns), "")
+    panel = Panel(label(name), f"{name} [{unit}]" if unit else name, xlabel)
+    for r in results:
+        if name in r.columns:
+            panel.lines.append((r[xname], r[name], r.label, "-", None, _marker(r, name)))
+    return panel
+
+
+def _grid(drawn: list[Panel]):
+    """The panels, four to a row (a legend in those that ask for one)."""
+    ncols = 4
+    nrows = -(-len(drawn) // ncols)
+    fig, axes = plt.subplots(nrows, ncols, figsize=(4.4 * ncols, 3.1 * nrows), squeeze=False)
+    for ax, panel in zip(axes.flat, drawn, strict=False):
+        for x, y, name, style, colour, marker in panel.lines:
+            # a lone point (one row, or one step between failed ones) shows as a dot
+            ax.plot(x, y, style, label=name, linewidth=1.6, color=colour, marker=marker)
+        ax.set_title(panel.title, fontsize=10)
+        ax.set_ylabel(panel.ylabel, fontsize=8)
+        ax.set_xlabel(panel.xlabel, fontsize=8)
+        ax.grid(True, alpha=0.3)
+        ax.tick_params(labelsize=8)
+        if panel.legend:
+            ax.legend(fontsize=7)
+    for ax in list(axes.flat)[len(drawn) :]:
+        ax.set_visible(False)
+    return fig
+
+
+# The axle report: title, columns (a line each: the left side solid, the right dashed)
+AXLE_PANELS = (
+    ("Camber (to the chassis)", ("camber_left", "camber_right")),
+    ("Camber to ground", ("camber_to_ground_left", "camber_to_ground_right")),
+    ("Toe: roadwheel angle (+ in)", ("roadwheel_angle_left", "roadwheel_angle_right")),
+    ("Steer angle (ISO yaw, + left)", ("steer_angle_left", "steer_angle_right")),
+    ("Roll centre height", ("roll_center_z",)),
+    ("Roll centre lateral position (+ left)", ("roll_center_y",)),
+    ("Anti-roll bar twist (left − right arm)", ("arb_twist",)),
+    ("Camber change per roll", ("deriv_camber_wrt_roll_left", "deriv_camber_wrt_roll_right")),
+    ("Track", ("track",)),
+    ("Ride height change (+ body up)", ("ride_height_change",)),
+    ("Heave link length", ("heave_link_length",)),
+)
+# Ackermann is read against the steer, whatever else the sweep moved
+ACKERMANN = ("ackermann", "Ackermann", "Mean steer angle ½(left + right) (ISO yaw, + left) [deg]")
+
+
+def axle_panels(results: list[ResultsFile], xname: str, xlabel: str) -> list[Panel]:
+    """The axle report's panels: each of AXLE_PANELS whose columns have a value in some
+    file, against the sweep's x; Ackermann against the mean steer angle when the rack
+    moved. Colour by file, line style by side."""
+    out = []
+    for title, names in AXLE_PANELS:
+        if any(_has(r, n) for r in results for n in names):
+            out.append(_axle_panel(results, title, names, xlabel, lambda r: r[xname]))
+    name, title, steer_label = ACKERMANN
+    steers = any(_has(r, "rack_displacement") and _varies(r["rack_displacement"]) for r in results)
+    if steers and any(_has(r, name) for r in results):
+        out.append(_axle_panel(results, title, (name,), steer_label, mean_steer_angle))
+    return out
+
+
+def mean_steer_angle(r: ResultsFile) -> np.ndarray:
+    """½(steer_angle_left + steer_angle_right), deg: the axle's steer (+ left)."""
+    return 0.5 * (r["steer_angle_left"] + r["steer_angle_right"])
+
+
+def _has(r: ResultsFile, name: str) -> bool:
+    return name in r.columns and bool(np.any(np.isfinite(r[name])))
+
+
+def _axle_panel(results, title: str, names: tuple, xlabel: str, x) -> Panel:
+    first = next(r for r in results if any(n in r.columns for n in names))
+    unit = next(first.units.get(n, "") for n in names if n in first.columns)
+    shown = names[0].removesuffix("_left") + ("_<side>" if len(names) > 1 else "")
+    panel = Panel(title, f"{shown} [{unit}]" if unit else shown, xlabel)
+    for k, r in enumerate(results):
+        for name in names:
+            if name not in r.columns:
+                continue
+            side = name.rpartition("_")[2] if len(names) > 1 else ""
+            who = " ".join(w for w in (r.label if len(results) > 1 else "", side) if w)
+            style = "--" if side == "right" else "-"
+            panel.lines.append(
+                (x(r), r[name], who or "_nolegend_", style, f"C{k}", _marker(r, name))
+            )
+    panel.legend = len(panel.lines) > 1
+    return panel
 
 
 def _marker(r: ResultsFile, name: str) -> str | None:
@@ -288,22 +413,19 @@ def drawing_figure(corner, labels: bool = False):
         from .linkage import Linkage
 
         corners.insert(0, (Linkage(corner.geometry.drawn), 0.3, "--"))
+    views = ((front, FRONT), (side, SIDE))
     for c, alpha, style in corners:
-        _draw_corner(front, side, c, alpha, style)
+        _rods(views, c.tree.visuals, c.tree.materials, alpha, style)
+        _draw_corner(views, c, alpha, style)
     ground = _mm(corner)["contact_patch_center"][2]
     for ax, title, xl in (
         (front, "Front view", "y [mm] (+ left)"),
         (side, "Side view", "x [mm] (+ forward)"),
     ):
         ax.axhline(ground, color="0.5", lw=0.8)
-        ax.set_aspect("equal")
-        ax.grid(True, alpha=0.3)
-        ax.set_title(title)
-        ax.set_xlabel(xl)
-        ax.set_ylabel("z [mm]")
-    front.axvline(0.0, color="0.5", lw=0.8, ls="-.")  # the car's centreline
+        _view_axes(ax, title, xl, centreline=ax is front)
     drawn, keep = _instant_centres(front, side, corner)
-    _fit_view(front, side, [c for c, _, _ in corners], keep)
+    _fit_view(views, [c for c, _, _ in corners], keep)
     if corner.geometry.sign < 0:
         front.invert_xaxis()  # a right corner seen from the front: outboard to the left
     note = " (dashed: as drawn)" if len(corners) > 1 else ""
@@ -312,46 +434,62 @@ def drawing_figure(corner, labels: bool = False):
         _legend(fig, corner, ghost=len(corners) > 1, construction=bool(drawn))
     fig.tight_layout(rect=(0, 0.06 if labels else 0, 1, 1))
     if labels:
-        _label_points(fig, front, side, corner)
+        _label_points(fig, views, {n: _mm(corner)[n] for n in corner.geometry.hardpoints})
     return fig
+
+
+def _view_axes(ax, title: str, xlabel: str, centreline: bool) -> None:
+    ax.set_aspect("equal")
+    ax.grid(True, alpha=0.3)
+    ax.set_title(title)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel("z [mm]")
+    if centreline:  # the car's, in front view
+        ax.axvline(0.0, color="0.5", lw=0.8, ls="-.")
 
 
 def _mm(c) -> dict[str, np.ndarray]:
     return {k: v * 1e3 for k, v in c.design_positions.items()}
 
 
-def _draw_corner(front, side, c, alpha, style) -> None:
-    """Bodies (the URDF's rods), links and steering axis, tyre, hardpoints."""
-    from .viz import links, segments
-
-    colours = dict(c.tree.materials)
-    for v in c.tree.visuals:
+def _rods(views, visuals, materials, alpha, style) -> None:
+    """The bodies: the URDF's rods (world positions, m), each in its material's colour."""
+    colours = dict(materials)
+    for v in visuals:
         if v.shape == "rod" and v.material != "tyre":
             colour = colours[v.material][:3]
-            _both(front, side, v.start, v.end, style, color=colour, alpha=alpha, lw=2)
+            _segment(views, v.start, v.end, style, color=colour, alpha=alpha, lw=2)
+
+
+def _draw_corner(views, c, alpha, style) -> None:
+    """What a corner shows between its points (``c.design_positions``): links and
+    steering axis, tyre, hardpoints, and in front view the wheel's centre plane."""
+    from .viz import links, segments
+
     for name, (a, b) in segments(c, c.design_positions).items():
         axis = name == "steering_axis"
         colour = "goldenrod" if axis else f"#{links(c)[name][1]:06x}"
-        _both(front, side, a, b, ":" if axis else style, alpha=alpha, lw=1.5, color=colour)
+        _segment(views, a, b, ":" if axis else style, alpha=alpha, lw=1.5, color=colour)
     p = _mm(c)
-    for ax, view in ((front, FRONT), (side, SIDE)):
+    for ax, view in views:
         outline = tyre_outline(c, view)
         ax.plot(*outline.T, style, color="0.15", alpha=alpha, lw=1.2, gid="tyre")
         pts = np.array([p[n][list(view)] for n in c.geometry.hardpoints])
         ax.plot(*pts.T, "o", color="0.2", ms=3, alpha=alpha)
         ax.plot(*p["wheel_center"][list(view)], "+", color="0.2", ms=8, alpha=alpha)
-    # the wheel's centre plane, top of the rim to the contact patch: camber at a glance
-    down = unit(p["contact_patch_center"] - p["wheel_center"])
-    top = p["wheel_center"] - down * c.geometry.wheel.radius * 1e3
-    line = np.array([top, p["contact_patch_center"]])[:, list(FRONT)]
-    front.plot(*line.T, "-.", color="0.4", alpha=alpha, lw=0.6)
+        if view == FRONT:
+            # the wheel's centre plane, top of the rim to the contact patch: camber at a glance
+            down = unit(p["contact_patch_center"] - p["wheel_center"])
+            top = p["wheel_center"] - down * c.geometry.wheel.radius * 1e3
+            line = np.array([top, p["contact_patch_center"]])[:, list(FRONT)]
+            ax.plot(*line.T, "-.", color="0.4", alpha=alpha, lw=0.6)
 
 
-def _both(front, side, a, b, style, **kwargs) -> None:
-    """A segment (m) in front view (y, z) and side view (x, z), in mm."""
-    a, b = a * 1e3, b * 1e3
-    front.plot([a[1], b[1]], [a[2], b[2]], style, **kwargs)
-    side.plot([a[0], b[0]], [a[2], b[2]], style, **kwargs)
+def _segment(views, a, b, style, **kwargs) -> None:
+    """A segment between two points (m) in each (axes, view), in mm."""
+    for ax, view in views:
+        ends = np.array([a, b])[:, list(view)] * 1e3
+        ax.plot(*ends.T, style, **kwargs)
 
 
 def tyre_outline(c, view: tuple[int, int]) -> np.ndarray:
@@ -391,31 +529,66 @@ def _above(polygon: np.ndarray, ground: float) -> np.ndarray:
 def _instant_centres(front, side, corner) -> tuple[list[str], list[np.ndarray]]:
     """Draw the FVIC and SVIC constructions; which were drawn, and the points (mm) the
     view should keep."""
-    from .jet import value
-
     design = {k: v[None] for k, v in corner.design_positions.items()}
     # with the rates at design: a mechanism's instant centres may come from its twist
     ps = PointSet(corner.motion([corner.q_design]), design, corner.geometry)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        ends = ps.kingpin()
-    if ends is None:  # no kingpin (a trailing arm): the chassis points of the wheel's body
-        names = corner.mechanism.upright_points(corner.geometry)
-        ends = [design[n] for n in names if corner.body_of(n) == "chassis"][:2]
-    rays = [value(e)[0] * 1e3 for e in reversed(ends)]  # upper first
+    rays = _kingpin_rays(ps, corner.geometry, lambda n: corner.body_of(n) == "chassis")
     p = _mm(corner)
     drawn, keep = [], []
     for ax, axis, view, name in ((front, X, FRONT, "FVIC"), (side, Y, SIDE, "SVIC")):
-        with np.errstate(invalid="ignore", divide="ignore"):
-            ic = np.array([value(x)[0] for x in ps.instant_axis_point(axis)], dtype=float) * 1e3
-        far = float(np.linalg.norm(ic - p["wheel_center"][list(view)]))
-        if not np.all(np.isfinite(ic)):
-            _note(ax, PARALLEL)
-        elif far > IC_FAR:
-            _note(ax, f"arms nearly parallel: {name} {far / 1e3:.0f} m away, not drawn")
+        ic = _instant_centre(ps, axis)
+        problem = _too_far(ic, p["wheel_center"][list(view)], name)
+        if problem is not None:
+            _note(ax, problem)
         else:
             keep += _construction(ax, p, rays, view, ic, name)
             drawn.append(name)
     return drawn, keep
+
+
+def _kingpin_rays(ps: PointSet, geometry, on_chassis) -> list[np.ndarray]:
+    """Where the instant-centre construction starts (mm, upper first): the kingpin's
+    ends (ball joints, virtual or the top mount); without a kingpin (a trailing arm),
+    the chassis points of the wheel's body (``on_chassis(point)``)."""
+    from .jet import value
+
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ends = ps.kingpin()
+    if ends is None:
+        names = geometry.mechanism.upright_points(geometry)
+        ends = [ps[n] for n in names if on_chassis(n)][:2]
+    return [value(e)[0] * 1e3 for e in reversed(ends)]
+
+
+def _instant_centre(ps: PointSet, axis: int) -> np.ndarray:
+    """The instant axis ∩ the view plane through WC normal to ``axis`` (mm, the view's
+    two coordinates); NaN when there is none."""
+    from .jet import value
+
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.array([value(x)[0] for x in ps.instant_axis_point(axis)], dtype=float) * 1e3
+
+
+def _too_far(ic: np.ndarray, wheel_centre: np.ndarray, name: str) -> str | None:
+    """Why an instant centre is not drawn (at infinity, or beyond IC_FAR), or None."""
+    if not np.all(np.isfinite(ic)):
+        return PARALLEL
+    far = float(np.linalg.norm(ic - wheel_centre))
+    if far > IC_FAR:
+        return f"arms nearly parallel: {name} {far / 1e3:.0f} m away, not drawn"
+    return None
+
+
+def _arms_to(ax, rays, view, ic, name, tag: str = "") -> None:
+    """The kingpin's ends to the IC (dashed) and the IC, named."""
+    v = list(view)
+    for end in rays:
+        line = np.array([end[v], ic])
+        ax.plot(*line.T, "--", color=CONSTRUCTION, lw=0.9, gid=f"{name.lower()}_arm{tag}")
+    ax.plot(*ic, "o", color=CONSTRUCTION, ms=4, gid=f"{name.lower()}{tag}")
+    ax.annotate(
+        name, ic, xytext=(4, -9), textcoords="offset points", fontsize=7, color=CONSTRUCTION
+    )
 
 
 def _construction(ax, p, rays, view, ic, name) -> list[np.ndarray]:
@@ -423,13 +596,7 @@ def _construction(ax, p, rays, view, ic, name) -> list[np.ndarray]:
     (dashed), the contact patch through it; front view: on to the centreline, the roll
     centre of a symmetric axle. Returns the roll centre, if any."""
     v = list(view)
-    for end in rays:
-        line = np.array([end[v], ic])
-        ax.plot(*line.T, "--", color=CONSTRUCTION, lw=0.9, gid=f"{name.lower()}_arm")
-    ax.plot(*ic, "o", color=CONSTRUCTION, ms=4, gid=name.lower())
-    ax.annotate(
-        name, ic, xytext=(4, -9), textcoords="offset points", fontsize=7, color=CONSTRUCTION
-    )
+    _arms_to(ax, rays, view, ic, name)
     cp = p["contact_patch_center"][v]
     text = f"{name}: {'y' if name == 'FVIC' else 'x'} = {ic[0]:.0f} mm, z = {ic[1]:.0f} mm"
     ends, keep = [0.0, 1.0], []  # along the line from CP (0) through the IC (1)
@@ -478,14 +645,14 @@ def _note(ax, text: str) -> None:
     )
 
 
-def _fit_view(front, side, corners, keep) -> None:
-    """Limits: the corner (and the centreline in front view) plus a margin; construction
+def _fit_view(views, corners, keep) -> None:
+    """Limits: the corners (and the centreline in front view) plus a margin; construction
     lines to a far instant centre run off the edge instead of shrinking the corner."""
     ground = _mm(corners[-1])["contact_patch_center"][2]
-    for ax, view in ((front, FRONT), (side, SIDE)):
+    for ax, view in views:
         pts = [tyre_outline(c, view) for c in corners]
         pts += [np.array([q[list(view)] for q in _mm(c).values()]) for c in corners]
-        if ax is front:
+        if view == FRONT:
             near = [q for q in keep if abs(q[1] - ground) < 1000.0]  # a roll centre near the road
             pts.append(np.array([[0.0, ground], *near]))
         pts = np.vstack(pts)
@@ -509,16 +676,14 @@ LABEL_PLACES = (  # offset (points), alignment: tried in this order, the first f
 )
 
 
-def _label_points(fig, front, side, corner) -> None:
-    """Each hardpoint's name next to it, where it covers the fewest other labels and
-    points; points that coincide in a view share one label. After the layout: it
-    measures the labels on the page."""
+def _label_points(fig, views, points: dict[str, np.ndarray]) -> None:
+    """Each point's name (points: name → position, mm) next to it, where it covers the
+    fewest other labels and points; points that coincide in a view share one label.
+    After the layout: it measures the labels on the page."""
     renderer = fig.canvas.get_renderer()
-    p = _mm(corner)
-    names = list(corner.geometry.hardpoints)
-    for ax, view in ((front, FRONT), (side, SIDE)):
+    for ax, view in views:
         ax.apply_aspect()  # the box the equal aspect gives it, as drawn, not the layout's
-        xy = {n: p[n][list(view)] for n in names}
+        xy = {n: p[list(view)] for n, p in points.items()}
         dots = ax.transData.transform(np.array(list(xy.values())))
         taken = [Bbox.from_bounds(x - 3, y - 3, 6, 6) for x, y in dots]
         for group in _coincident(xy, 0.012 * float(np.ptp(ax.get_xlim()))):
@@ -569,15 +734,17 @@ def _area(box) -> float:
     return 0.0 if box is None else box.width * box.height
 
 
-def _legend(fig, corner, ghost: bool, construction: bool) -> None:
-    """The colours: bodies, links, steering axis, tyre, construction."""
+def _legend(fig, corner, ghost: bool, construction: bool, tree=None, more=()) -> None:
+    """The colours: bodies (of ``tree``, default the corner's), links, steering axis,
+    tyre, construction; ``more``: other lines' handles."""
     from matplotlib.lines import Line2D
 
     from .viz import links, segments
 
-    colours = dict(corner.tree.materials)
+    tree = corner.tree if tree is None else tree
+    colours = dict(tree.materials)
     bodies = dict.fromkeys(
-        v.material for v in corner.tree.visuals if v.shape == "rod" and v.material != "tyre"
+        v.material for v in tree.visuals if v.shape == "rod" and v.material != "tyre"
     )
     handles = [Line2D([], [], color=colours[m][:3], lw=2, label=m) for m in bodies]
     for name in segments(corner, corner.design_positions):
@@ -589,6 +756,7 @@ def _legend(fig, corner, ghost: bool, construction: bool) -> None:
         Line2D([], [], color="0.15", lw=1.2, label="tyre"),
         Line2D([], [], color="0.2", marker="o", ms=3, ls="", label="hardpoint"),
     ]
+    handles += list(more)
     if construction:
         handles.append(
             Line2D([], [], color=CONSTRUCTION, ls="--", lw=0.9, label="instant-centre construction")
@@ -596,6 +764,201 @@ def _legend(fig, corner, ghost: bool, construction: bool) -> None:
     if ghost:
         handles.append(Line2D([], [], color="0.5", ls="--", lw=1.2, label="as drawn"))
     fig.legend(handles=handles, loc="lower center", ncol=min(len(handles), 8), fontsize=8)
+
+
+def axle_drawing_figure(model, q=None, labels: bool = False, caption: str = "design state"):
+    """Front view of an axle (both corners, the bar) at configuration ``q`` (default:
+    its as-set design state), seen from the front (+y, the car's left, to the right).
+
+    The road is the line through both contact patches. Each side: its kingpin's
+    ends to its FVIC (dashed) and its contact patch through the FVIC (dash-dot);
+    where the two contact-patch lines cross, the roll centre (spec/axle.md's
+    ``roll_center_y``, ``roll_center_z``). An FVIC at infinity or further than 20 m
+    is not drawn but noted (its contact-patch line still is, towards it); so is a
+    roll centre further than that. ``labels``: the left corner's hardpoints and the
+    bar's points named (the right corner is its mirror image), and a legend.
+    """
+    from .axle import SIDES
+
+    q = model.q_design if q is None else q
+    positions = model.positions(q)
+    sides = {s: _AxleSide(model, s, positions) for s in SIDES}
+    fig, front = plt.subplots(figsize=(15, 7.5))
+    views = ((front, FRONT),)
+    _rods(views, _posed_visuals(model, q), model.tree.materials, 1.0, "-")
+    for c in sides.values():
+        _draw_corner(views, c, 1.0, "-")
+    _axle_links(views, model, positions, sides)
+    corner_points = {f"{s}_{n}" for s in SIDES for n in model.point_names[s]}
+    extras = {n: positions[n] * 1e3 for n in model.output_points if n not in corner_points}
+    if extras:  # the bar's and the heave link's points
+        front.plot(*np.array([p[list(FRONT)] for p in extras.values()]).T, "o", color="0.2", ms=3)
+    road = [_mm(c)["contact_patch_center"][list(FRONT)] for c in sides.values()]
+    front.axline(*road, color="0.5", lw=0.8, gid="road")
+    _view_axes(front, f"Front view: {caption}", "y [mm] (+ left, seen from the front)", True)
+    drawn, keep = _roll_centre_construction(front, model, q, sides)
+    _fit_view(views, list(sides.values()), keep)
+    fig.suptitle(model.axle.name if model.axle is not None else model.tree.name)
+    if labels:
+        more = [h for h in front.get_lines() if h.get_gid() == "heave_link"][:1]
+        _legend(fig, sides["left"], ghost=False, construction=drawn, tree=model.tree, more=more)
+    fig.tight_layout(rect=(0, 0.06 if labels else 0, 1, 1))
+    if labels:
+        named = {n: _mm(sides["left"])[n] for n in sides["left"].geometry.hardpoints}
+        named |= {n.removeprefix("left_"): p for n, p in extras.items() if n[:6] != "right_"}
+        _label_points(fig, views, named)
+    return fig
+
+
+def _axle_links(views, model, positions, sides) -> None:
+    """The axle's own links: the bar's droplinks (its distance closures that are no
+    corner's), and the heave link between the rockers (thin: it only measures)."""
+    from .viz import LINK
+
+    own = {f"{s}_{c.name}" for s, side in sides.items() for c in side.tree.closures}
+    bar = model.tree.materials.get("bar", (0.85, 0.75, 0.15, 1.0))[:3]
+    for c in model.tree.closures:
+        if c.kind == "distance" and c.name not in own:
+            a, b = (positions[n] for n in c.points)
+            _segment(views, a, b, "-", color=bar, lw=1.5, gid="droplink")
+    ends = [f"{s}_heave_link_rocker" for s in sides]
+    if all(n in positions for n in ends):
+        colour = f"#{LINK[0]:06x}"
+        a, b = (positions[n] for n in ends)
+        _segment(views, a, b, "--", color=colour, lw=1.0, gid="heave_link", label="heave link")
+
+
+class _AxleSide:
+    """One corner of an axle at a pose, read as the drawing reads a corner: its
+    geometry (as set), its own tree (the links drawn between its points) and, as
+    ``design_positions``, the pose's points (m) by the corner's names."""
+
+    def __init__(self, model, side: str, positions: dict[str, np.ndarray]):
+        g = model.geometries[side]
+        self.geometry, self.tree = g, g.mechanism.tree(g)
+        self.design_positions = {n: positions[f"{side}_{n}"] for n in model.point_names[side]}
+
+
+def _posed_visuals(model, q) -> list:
+    """The axle's visuals (placed at design, m) carried by their bodies to ``q``."""
+    import pinocchio as pin
+
+    design, posed = model.model.createData(), model.model.createData()
+    pin.framesForwardKinematics(model.model, design, model.q_design)
+    pin.framesForwardKinematics(model.model, posed, q)
+    out = []
+    for v in model.tree.visuals:
+        frame = model.model.getFrameId(v.body)
+        move = posed.oMf[frame] * design.oMf[frame].inverse()
+        end = None if v.end is None else move.act(v.end)
+        out.append(replace(v, start=move.act(v.start), end=end))
+    return out
+
+
+def _roll_centre_construction(ax, model, q, sides) -> tuple[bool, list[np.ndarray]]:
+    """Each side's FVIC construction and the crossing of the contact-patch lines, the
+    roll centre; whether it was drawn, and the points (mm) the view should keep."""
+    from .axle import roll_centre
+
+    # with the rates (solved here): a mechanism's FVIC may come from its twist
+    motion = model.motion([q])
+    d = model.design_positions
+    lines, notes = {}, []
+    for s, c in sides.items():
+        own = {k: motion[f"{s}_{k}"][s] for k in model.point_names[s]}
+        ps = PointSet(own, {k: d[f"{s}_{k}"][None] for k in model.point_names[s]}, c.geometry)
+        ic = _instant_centre(ps, X)
+        p = _mm(c)
+        problem = _too_far(ic, p["wheel_center"][list(FRONT)], "FVIC")
+        if problem is None:
+            on_chassis = lambda n, s=s: model.points[f"{s}_{n}"].body == "chassis"  # noqa: E731
+            _arms_to(ax, _kingpin_rays(ps, c.geometry, on_chassis), FRONT, ic, "FVIC", f"_{s}")
+            notes.append(f"FVIC {s}: y = {ic[0]:.0f} mm, z = {ic[1]:.0f} mm")
+        else:
+            notes.append(f"{s}: {problem}")
+        if np.all(np.isfinite(ic)):
+            lines[s] = (p["contact_patch_center"][list(FRONT)], ic, problem is None)
+    rc = None
+    if len(lines) == 2:
+        with np.errstate(invalid="ignore", divide="ignore"):
+            rc = np.array(roll_centre([(*cp, *ic) for cp, ic, _ in lines.values()]), dtype=float)
+        middle = 0.5 * (lines["left"][0] + lines["right"][0])
+        if not np.all(np.isfinite(rc)):
+            notes.append("RC: the contact-patch lines are parallel")
+            rc = None
+        elif (far := float(np.linalg.norm(rc - middle))) > IC_FAR:
+            notes.append(f"RC {far / 1e3:.0f} m away, not drawn")
+            rc = None
+        else:
+            ax.plot(*rc, "D", color=CONSTRUCTION, ms=6, gid="roll_centre")
+            ax.annotate(
+                "RC", rc, xytext=(6, 5), textcoords="offset points", fontsize=8, color=CONSTRUCTION
+            )
+            notes.insert(0, f"RC: y = {rc[0]:.0f} mm, z = {rc[1]:.0f} mm")
+    else:
+        missing = [s for s in sides if s not in lines]
+        notes.append("RC: no front-view instant centre on " + " and ".join(missing))
+    for s, (cp, ic, near) in lines.items():
+        ends = [0.0, 1.0] if near else [0.0]  # along CP (0) → FVIC (1)
+        if rc is not None:
+            ends.append(float((rc - cp) @ (ic - cp) / ((ic - cp) @ (ic - cp))))
+        if len(ends) == 1:  # a far FVIC, no roll centre: towards the FVIC, as long as CP_y
+            ends.append(abs(cp[0]) / float(np.linalg.norm(ic - cp)))
+        line = np.array([cp + t * (ic - cp) for t in (min(ends), max(ends))])
+        ax.plot(*line.T, "-.", color=CONSTRUCTION, lw=0.9, gid=f"fvic_contact_patch_{s}")
+    _note(ax, "\n".join(notes))
+    return rc is not None or any(near for *_, near in lines.values()), [] if rc is None else [rc]
+
+
+def axle_pose(model, results: ResultsFile, step: int) -> tuple[np.ndarray, str]:
+    """The axle's configuration at a step of its results, and a caption: solved to that
+    row's wheel-centre heights and rack, then checked against the row's points (they
+    must be this axle's: results of another geometry are refused)."""
+    from .axle import SIDES
+
+    if not results.axle:
+        raise InputError(
+            results.source, "", "a corner's results: an axle is drawn at a step of its own"
+        )
+    rows = np.flatnonzero(results["step_index"] == step)
+    if rows.size == 0:
+        last = int(np.nanmax(results["step_index"]))
+        raise InputError(results.source, f"step {step}", f"no such step (steps 0 to {last})")
+    i = int(rows[0])
+    if results.columns.get("solver_converged", np.ones(i + 1))[i] != 1.0:
+        raise InputError(results.source, f"step {step}", "did not converge: it has no pose to draw")
+    needed = [f"{s}_wheel_center_z" for s in SIDES]
+    if model.model.existJointName("rack_slide"):
+        needed.append("rack_displacement")
+    for name in needed:
+        if name not in results.columns or not np.isfinite(results[name][i]):
+            raise InputError(results.source, name, f"no value at step {step}: the pose is unknown")
+    z = {s: results[f"{s}_wheel_center_z"][i] * 1e-3 for s in SIDES}
+    rack = results["rack_displacement"][i] * 1e-3 if "rack_displacement" in needed else 0.0
+    solution = model.solve(z, rack)
+    if not solution.converged:
+        raise InputError(
+            results.source, f"step {step}", f"this axle does not reach that pose ({solution.why})"
+        )
+    solved = model.positions(solution.q)
+    names = [(n, k) for n in model.output_points for k in range(3)]
+    names = [(n, k) for n, k in names if f"{n}_{'xyz'[k]}" in results.columns]
+    offs = [abs(solved[n][k] * 1e3 - results[f"{n}_{'xyz'[k]}"][i]) for n, k in names]
+    j = int(np.argmax(np.nan_to_num(offs, nan=np.inf)))
+    off, worst = offs[j], f"{names[j][0]}_{'xyz'[names[j][1]]}"
+    if not off <= 1e-3:  # mm; NaN too
+        raise InputError(
+            results.source,
+            worst,
+            f"{off:.3g} mm from this axle's point at step {step}: results of another geometry?",
+        )
+    shown = [("heave", "heave", "mm", 1), ("roll", "roll", "°", 2)]
+    shown += [("rack", "rack_displacement", "mm", 1)] * ("rack_displacement" in results.columns)
+    values = ", ".join(
+        f"{word} {np.round(results[name][i], digits) + 0.0:.{digits}f} {unit}"
+        for word, name, unit, digits in shown
+    )
+    return solution.q, f"step {step} of {results.label} ({values})"
 
 
 def check_image_path(path: str | Path) -> None:
