@@ -42,7 +42,7 @@ from .closures import (
 from .errors import InputError
 from .geometry import contact_patch, unit, wheel_points
 from .jet import Dual
-from .metrics import METRICS, PointSet, derivative_columns
+from .metrics import METRIC_BY_NAME, METRICS, PointSet, derivative_columns
 from .sweep import Target
 from .urdf import Body, Joint, Tree, tree_to_urdf
 
@@ -181,6 +181,13 @@ class HardpointSensitivity:
     def at(self, q: np.ndarray, targets: list[Target] | None = None, step: int = 0) -> Sensitivity:
         """Sensitivities at the solved configuration q (of the corner's model),
         holding ``targets`` (default: wheel-centre height and rack at design)."""
+        return self._collect(*self.jets(q, targets), step)
+
+    def jets(self, q: np.ndarray, targets: list[Target] | None = None) -> tuple[dict, dict]:
+        """Every point at q, and its design position, as nested jet.Duals: outside, the
+        hardpoint coordinates (n_h directions, per m); inside, the drivers (per m).
+        Positions (1, 3) m; d/dh (n_h, 1, 1, 3); rates (k, 1, 3); d rates/dh (n_h, k, 1, 3).
+        """
         c = self.corner
         if targets is None:
             targets = [Target("wheel_center", "z", 0.0)]
@@ -261,7 +268,7 @@ class HardpointSensitivity:
             pts["contact_patch_center"] = contact_patch(
                 pts["wheel_center"], a, c.geometry.wheel.radius
             )
-        return self._collect(points, design, step)
+        return points, design
 
     def _design_rate(self, point: str) -> np.ndarray:
         if point in self.design_rates:
@@ -469,3 +476,216 @@ def select_points(corner, spec: str = "designer") -> list[str]:
             f"or names of this corner's hardpoints, separated by commas: {', '.join(names)})",
         )
     return wanted
+
+
+# ---------------------------------------------------------------- an axle
+
+SYMMETRIC_MOVE = (
+    "a symmetric move: hardpoint P moves the left P by (dx, dy, dz) and the right P by "
+    "(dx, -dy, dz)"
+)
+ONE_SIDED_MOVE = "a one-sided move: left_P and right_P each move alone"
+
+
+def axle_held(model) -> str:
+    """What an axle's sensitivities hold (the note on its table and CSV)."""
+    rack = " and the rack" if model.model.existJointName("rack_slide") else ""
+    return f"each wheel centre's height{rack} held"
+
+
+# the axle's own columns, after each side's (spec/axle.md's names)
+AXLE_COLUMNS = (
+    "body_roll",
+    "camber_to_ground_left",
+    "camber_to_ground_right",
+    "track",
+    "roll_center_y",
+    "roll_center_z",
+    "deriv_camber_wrt_roll_left",
+    "deriv_camber_wrt_roll_right",
+    "deriv_roadwheel_angle_wrt_roll_left",
+    "deriv_roadwheel_angle_wrt_roll_right",
+    "deriv_roll_center_y_wrt_roll",
+    "deriv_roll_center_z_wrt_roll",
+)
+
+
+class AxleSensitivity:
+    """d(column)/d(hardpoint coordinate) of an axle (spec/axle.md), exact.
+
+    Each side is its corner's HardpointSensitivity (the as-set corner): with each
+    wheel centre's height and the rack held, the sides share nothing else, so a
+    side's columns move with its own points only. The axle's columns (track, roll
+    centre, body roll, the roll rates) are plain functions of both sides' contact
+    patches, instant centres, wheel heights and rates, run on the sides' nested
+    Duals lifted onto the axle's directions:
+
+    - symmetric (default): one direction per corner point and axis, the left
+      point moved by (dx, dy, dz) and the right one by (dx, −dy, dz);
+    - one-sided: the left's points (``left_…``), then the right's, each alone.
+
+    Inside, the one driver is roll's tangent — the left hub z up, the right one
+    down, equally, the rack held — so d(column)/d roll and its sensitivities
+    follow as the axle's sweep columns do (axle._roll_rates). The bar's and the
+    heave link's own points are not among the hardpoints: they move no column here.
+    """
+
+    def __init__(self, model, one_sided: bool = False):
+        from .axle import SIDES
+        from .linkage import Linkage
+
+        self.model, self.one_sided = model, one_sided
+        self.sides = {s: HardpointSensitivity(Linkage(model.geometries[s])) for s in SIDES}
+        names = {s: h.hardpoints for s, h in self.sides.items()}
+        if one_sided:
+            self.hardpoints = [f"{s}_{n}" for s in SIDES for n in names[s]]
+        else:
+            self.hardpoints = list(dict.fromkeys(names["left"] + names["right"]))
+        # lift[side] (3 axle points, 3 side points): d/d(axle coordinate) from d/d(side's)
+        self.lift = {}
+        for s in SIDES:
+            flip = np.diag([1.0, -1.0 if s == "right" and not one_sided else 1.0, 1.0])
+            lift = np.zeros((3 * len(self.hardpoints), 3 * len(names[s])))
+            for j, n in enumerate(names[s]):
+                i = self.hardpoints.index(f"{s}_{n}" if one_sided else n)
+                lift[3 * i : 3 * i + 3, 3 * j : 3 * j + 3] = flip
+            self.lift[s] = lift
+        # each side's corner joints in the axle's configuration
+        axle = model.model
+        self.joints = {}
+        for s, h in self.sides.items():
+            c = h.corner.model
+            pairs = [
+                (c.joints[j].idx_q, axle.joints[axle.getJointId(_axle_joint(c.names[j], s))].idx_q)
+                for j in range(1, c.njoints)
+            ]
+            self.joints[s] = tuple(np.array(x) for x in zip(*pairs, strict=True))
+
+    def side_q(self, q: np.ndarray, side: str) -> np.ndarray:
+        """The side's corner configuration within the axle's q."""
+        corner, axle = self.joints[side]
+        out = np.empty(self.sides[side].corner.model.nq)
+        out[corner] = q[axle]
+        return out
+
+    def at(self, q: np.ndarray | None = None, step: int = 0) -> Sensitivity:
+        """At the axle's solved configuration q (default: its design state), each wheel
+        centre's height and the rack held where q has them."""
+        from .axle import SIDES
+
+        jets, per_side = {}, {}
+        for s, h in self.sides.items():
+            qs = h.corner.q_design if q is None else self.side_q(q, s)
+            jets[s] = h.jets(qs)
+            per_side[s] = h._collect(*jets[s], step)
+        n = len(self.hardpoints)
+        values, units, metrics = {}, {}, {}
+        for s in SIDES:
+            side = per_side[s]
+            for name, v in side.values.items():
+                key = f"{name}_{s}"
+                values[key] = (self.lift[s] @ v.ravel()).reshape(n, 3)
+                units[key], metrics[key] = side.units[name], side.metrics[name]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            columns = self._axle_columns(jets)
+        for name in AXLE_COLUMNS:
+            x, unit_ = columns[name]
+            metrics[name] = float(x.val[0])
+            values[name] = x.der[:, 0].reshape(n, 3) * 1e-3  # per mm
+            units[name] = f"{unit_}/mm"
+        return Sensitivity(step, self.hardpoints, values, units, metrics)
+
+    def _lifted(self, side: str, x) -> Dual:
+        """A side's nested scalar on the axle's directions: outside, the axle's hardpoint
+        coordinates; inside, roll's tangent (this side's hub z, + left, − right)."""
+        sign = 1.0 if side == "left" else -1.0
+        lift = self.lift[side]
+        return Dual(
+            Dual(x.val.val, sign * x.val.der[:1]),
+            Dual(
+                np.tensordot(lift, x.der.val, axes=1),
+                sign * np.tensordot(lift, x.der.der[:, :1], axes=1),
+            ),
+        )
+
+    def _axle_columns(self, jets: dict) -> dict:
+        """name → (Dual over the axle's hardpoint coordinates (per m), unit)."""
+        from .axle import roll_centre
+        from .metrics import fvic_y, fvic_z
+
+        sides = {}
+        for s, (points, design) in jets.items():
+            ps = PointSet(points, design, self.sides[s].corner.geometry)
+            cp, wc = points["contact_patch_center"], points["wheel_center"]
+            parts = {
+                "cp_y": cp[..., 1] * 1e3,
+                "cp_z": cp[..., 2] * 1e3,
+                "fvic_y": fvic_y(ps) * 1e3,
+                "fvic_z": fvic_z(ps) * 1e3,
+                "dz": (wc[..., 2] - design["wheel_center"][..., 2]) * 1e3,
+            }
+            for name in ("camber", "roadwheel_angle"):
+                m = METRIC_BY_NAME[name]
+                parts[name] = m.function(ps) * m.scale
+            sides[s] = {k: self._lifted(s, v) for k, v in parts.items()}
+        left, right = sides["left"], sides["right"]
+        deg = 180.0 / np.pi
+        b = left["cp_y"] - right["cp_y"]
+        roll = np.arctan2(left["dz"] - right["dz"], b)  # rad
+        body_roll = np.arctan2(right["cp_z"] - left["cp_z"], b) * deg
+        ends = ("cp_y", "cp_z", "fvic_y", "fvic_z")  # each side's line CP → FVIC
+        rc = roll_centre([tuple(side[k] for k in ends) for side in (left, right)])
+        nested = {
+            "body_roll": (body_roll, "deg"),
+            "camber_to_ground_left": (left["camber"] - body_roll, "deg"),
+            "camber_to_ground_right": (right["camber"] + body_roll, "deg"),
+            "track": (np.abs(b), "mm"),
+            "roll_center_y": (rc[0], "mm"),
+            "roll_center_z": (rc[1], "mm"),
+        }
+        out = {name: (_value(x), unit_) for name, (x, unit_) in nested.items()}
+        per_roll = _rate(roll) * deg  # deg of roll per m along the tangent
+        for name in ("camber", "roadwheel_angle"):
+            for s, side in sides.items():
+                out[f"deriv_{name}_wrt_roll_{s}"] = (_rate(side[name]) / per_roll, "deg/deg")
+        for axis, x in zip("yz", rc, strict=True):
+            out[f"deriv_roll_center_{axis}_wrt_roll"] = (_rate(x) / per_roll, "mm/deg")
+        return out
+
+
+def _axle_joint(name: str, side: str) -> str:
+    """A corner joint's name in the axle's model (the rack is shared)."""
+    return name if name == "rack_slide" else f"{side}_{name}"
+
+
+def _value(x) -> Dual:
+    """A nested scalar's value, with its hardpoint derivatives (outside)."""
+    return Dual(x.val.val, x.der.val[:, 0])
+
+
+def _rate(x) -> Dual:
+    """A nested scalar's rate along the (one) driver, with its hardpoint derivatives."""
+    return Dual(x.val.der[0], x.der.der[:, 0])
+
+
+def axle_sensitivities(sens: AxleSensitivity, sweep=None, progress=None):
+    """An axle's sensitivities (``AxleSensitivity(model)``) at its design state, or at
+    every converged step of ``sweep`` — each wheel centre's height and the rack held as
+    solved there (a roll or heave target too: the roll angle then moves with the track).
+    (A list of Sensitivity, the sweep's solver columns as AxleResults or None.)"""
+    from .axle import AxleResults, solve_axle_sweep
+
+    model = sens.model
+    if sweep is None:
+        return [sens.at()], None
+    solutions = solve_axle_sweep(model, sweep)
+    columns, units = AxleResults.solver_columns(solutions)
+    source = (model.axle.source, model.axle.sha256) if model.axle else ("<geometries>", None)
+    results = AxleResults(columns, units, AxleResults.solver_meta(solutions, source, sweep))
+    out = []
+    for i, solution in enumerate(solutions):
+        if solution.converged:
+            out.append(sens.at(solution.q, step=i))
+        if progress is not None:
+            progress(i + 1, len(solutions))
+    return out, results

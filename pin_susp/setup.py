@@ -459,3 +459,120 @@ def setup_sheet(
             except InputError as exc:  # the listed value is at fault, not the file
                 raise InputError(flag, "", f"{value:g} mm: {exc.problem}") from None
     return rows
+
+
+# ---------------------------------------------------------------- an axle
+#
+# Each side of an axle is its corner (spec/axle.md): AxleModel applies each side's
+# setup as the corner does, the rack held at design, and with the rack held the
+# sides share nothing else. So an axle's setup sheet, sensitivities and inverse
+# solve are each side's corner's; the axle adds its own static columns (track,
+# roll centre) of both sides together. A mirrored axle (no hardpoints.right) has
+# one setup: the right side takes the left's shim stack and length deltas.
+
+AXLE_STATIC = (("track", "track"), ("roll_center_y", "RC y"), ("roll_center_z", "RC z"))
+
+
+def set_sides(axle, side: str | None = None) -> tuple[str, ...]:
+    """The sides a setup option sets: both by default, or ``side`` alone on an axle
+    with its own right points (a mirrored axle has one setup for both sides)."""
+    from .axle import SIDES
+
+    if side is None:
+        return SIDES
+    if side not in SIDES:
+        raise InputError("--side", "", f"unknown side {side!r} (left or right)")
+    if axle.mirrored:
+        raise InputError(
+            "--side",
+            "",
+            f"{axle.source} is a mirrored axle (no hardpoints.right): its right side takes "
+            "the left's setup, so one setup sets both sides; give the right corner's own "
+            "points (hardpoints.right, with axle_config.right_setup) to set one side alone",
+        )
+    return (side,)
+
+
+def _on_axle(axle, side: str, work):
+    """Run a corner's setup ``work()`` for one side; its errors name the axle file's key
+    (``axle_config.left_setup.camber_shim``) and the side."""
+    from .axle import AxleReader
+
+    try:
+        return work()
+    except InputError as exc:
+        problem = f"{side} corner: {exc.problem}"
+        if exc.source != axle.source:  # an option (--shim) or the targets
+            raise InputError(exc.source, exc.key, problem) from None
+        reader = AxleReader(axle.source, "left" if axle.mirrored else side)
+        try:
+            reader.fail(exc.key, problem)
+        except InputError as renamed:
+            raise renamed from None
+
+
+def axle_setup_sheet(axle, shim=(), trackrod=(), pushrod=(), side: str | None = None) -> dict:
+    """Per side (``{"left": rows, "right": rows}``): the as-set state, then one row per
+    listed value (mm) of one adjuster, as :func:`setup_sheet`. The values go to both
+    sides, or to ``side`` alone; a side not set has its as-set row only."""
+    chosen = set_sides(axle, side)
+    out = {}
+    for s in ("left", "right"):
+        lists = (shim, trackrod, pushrod) if s in chosen else ()
+        out[s] = _on_axle(axle, s, lambda s=s, lists=lists: setup_sheet(axle.corner(s), *lists))
+    return out
+
+
+def solve_axle_setup(axle, targets: dict[str, float], side: str | None = None) -> dict:
+    """Per side (``{"left": InverseResult, "right": ...}``), the inverse solve of
+    :func:`solve_setup` on that side's corner: its own shim, trackrod and pushrod for
+    the targets (camber, toe, ride height), on both sides or on ``side`` alone (the
+    other: its setup as it is, 0 iterations). A mirrored axle is solved on the left;
+    its right side takes the left's setup (the mirrored corner at those values, 0
+    iterations: it hits the same targets)."""
+    chosen = set_sides(axle, side)
+    out = {}
+    for s in ("left",) if axle.mirrored else chosen:
+        out[s] = _on_axle(axle, s, lambda s=s: solve_setup(axle.corner(s), targets))
+    for s in ("left", "right"):
+        if s not in out:
+            g = axle.corner(s)
+            p = setup_values(out["left"].geometry if axle.mirrored else g)
+            model = SetupModel(g)
+            before = _on_axle(axle, s, lambda g=g, model=model: model.state(setup_values(g)))
+            after = _on_axle(axle, s, lambda model=model, p=p: model.state(p))
+            out[s] = InverseResult(with_setup(g, p), before, after, 0)
+    return out
+
+
+def axle_static(axle, states: dict) -> dict[str, float]:
+    """The axle's static columns (track, roll centre y and z, mm) with each side set as
+    in its SetupState: the axle model at its design state."""
+    from .axle import AxleModel, axle_results
+    from .solver import Solution
+    from .sweep import Sweep
+
+    sides = {s: with_setup(axle.corner(s), state.setup * MM) for s, state in states.items()}
+    model = AxleModel(replace(axle, **sides))
+    state = Solution(model.q_design, True, 0, 0.0)
+    results = axle_results(model, Sweep([], "<static state>"), [state])
+    return {name: float(results[name][0]) for name, _ in AXLE_STATIC}
+
+
+def axle_data(axle, geometries: dict) -> dict:
+    """The axle file's data with each given side's setup values written in
+    (``axle_config.<side>_setup``, mm). A mirrored axle's right side is the left's:
+    only left_setup is written."""
+    data = copy.deepcopy(axle.data)
+    config = data["axle_config"]
+    for side, g in geometries.items():
+        if axle.mirrored and side == "right":
+            continue
+        corner = geometry_data(g)["config"]
+        written = {"camber_shim": corner["camber_shim"]} if "camber_shim" in corner else {}
+        written |= corner.get("setup", {})
+        if written:
+            config[f"{side}_setup"] = written
+        else:
+            config.pop(f"{side}_setup", None)
+    return data
