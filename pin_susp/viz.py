@@ -1,4 +1,4 @@
-"""The corner in meshcat: live view, animated sweeps, a self-contained HTML replay.
+"""A corner or an axle in meshcat: live view, animated sweeps, a self-contained HTML replay.
 
 The bodies come from the URDF's own visuals through Pinocchio's
 MeshcatVisualizer. What the URDF cannot show as bodies — the links that are
@@ -16,6 +16,15 @@ meshcat orbits about the world origin, so the scene is moved to put that
 point there. The ground (the contact patch's height at design, where scrub
 and trail are measured) is drawn as a translucent square, with meshcat's
 grid on it.
+
+An axle (:class:`pin_susp.axle.AxleModel`) goes through the same scene: its
+URDF holds both corners and the anti-roll bar's arms (their visuals), its
+closures both corners' links and the droplinks; the coilovers, steering axes
+and contact patches are drawn per side, and the heave link from rocker to
+rocker. The roll centre is a marker, placed from an axle's results columns
+(``roll_center_y``, ``roll_center_z``, in the front-view plane midway between
+the contact patches) and hidden where they are blank. It is seen from the
+left side, and the ground is widened to the axle's track.
 """
 
 from __future__ import annotations
@@ -33,55 +42,84 @@ LINKS = {  # name: (ends, colour, radius); other distance closures (links) as LI
     "toe_link": (("toe_link_inboard", "toe_link_outboard"), 0x2E9E4F, 0.006),
     "pushrod": (("pushrod_outboard", "pushrod_inboard"), 0xB0B0B0, 0.007),
     "coilover": (("strut_top", "strut_bottom"), 0xD02828, 0.012),
+    "droplink": ((), 0xD9BF26, 0.006),  # an axle's, from rocker to bar: the bar's gold
+    "heave_link": (("left_heave_link_rocker", "right_heave_link_rocker"), 0xD02828, 0.012),
 }
 LINK = (0x1F6BD9, 0.007)  # a multilink's links: the wishbones' blue
 AXIS_COLOUR, PATCH_COLOUR = 0xE8C020, 0xE83070
 GHOST = [0.55, 0.55, 0.6, 0.35]
 GROUND_COLOUR, GROUND_OPACITY = 0xB4B4A8, 0.3
 GROUND_SIZE, GROUND_THICKNESS = 1.5, 0.002  # m: a square under the corner, its top at the CP
+GROUND_SPAN = 1.2  # ... or this times the width of what is drawn, if wider (an axle)
+MARKERS = {"roll_centre": (0x00D8F0, 0.025)}  # name: colour, radius (m)
 VIEW = np.array([1.6, 0.35, 0.7])  # camera direction: front, outboard (y by side), above
 FOV = 75.0  # degrees, vertical: meshcat's default camera (three.js PerspectiveCamera)
 FILL = 0.8  # the corner's share of the view's height, or of its width ...
 ASPECT = 4 / 3  # ... in a view at least this wide for its height
 
 
-def segments(corner, positions: dict[str, np.ndarray]) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+def sides(model) -> list[tuple[str, object]]:
+    """(prefix of its points' names, Geometry) of each corner: a corner's own (prefix
+    ``""``), an axle's two (``"left_"``, ``"right_"``)."""
+    geometries = getattr(model, "geometries", None)
+    if geometries is None:
+        return [("", model.geometry)]
+    return [(f"{side}_", g) for side, g in geometries.items()]
+
+
+def _bare(model, name: str) -> str:
+    """A name without its side's prefix (an axle's ``left_trackrod``: ``trackrod``)."""
+    for prefix, _ in sides(model):
+        if prefix and name.startswith(prefix):
+            return name[len(prefix) :]
+    return name
+
+
+def segments(model, positions: dict[str, np.ndarray]) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """Lines that are not bodies of the tree: closure links, coilover, steering axis (m).
 
     The steering axis runs from the upper ball joint down to the ground
-    (the contact patch's height), where scrub and trail are measured.
+    (the contact patch's height), where scrub and trail are measured. An
+    axle's are per side, named with the side's prefix (``left_steering_axis``).
     """
     out = {}
-    for name, ((a, b), _, _) in links(corner).items():
+    for name, ((a, b), _, _) in links(model).items():
         if a in positions and b in positions:
             out[name] = (positions[a], positions[b])
     from .metrics import PointSet
 
-    ps = PointSet({k: v[None] for k, v in positions.items()}, {}, corner.geometry)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        ends = ps.kingpin()
-    if ends is not None:
-        lower, upper = ends[0][0], ends[1][0]
-        k = upper - lower
-        ground = positions["contact_patch_center"][2]
-        if abs(k[2]) > 1e-9 and np.all(np.isfinite(k)):
-            out["steering_axis"] = (upper, lower + (ground - lower[2]) / k[2] * k)
+    for prefix, g in sides(model):
+        own = {k[len(prefix) :]: v[None] for k, v in positions.items() if k.startswith(prefix)}
+        ps = PointSet(own, {}, g)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            ends = ps.kingpin()
+        if ends is not None:
+            lower, upper = ends[0][0], ends[1][0]
+            k = upper - lower
+            ground = own["contact_patch_center"][0, 2]
+            if abs(k[2]) > 1e-9 and np.all(np.isfinite(k)):
+                out[f"{prefix}steering_axis"] = (upper, lower + (ground - lower[2]) / k[2] * k)
     return out
 
 
-def links(corner) -> dict[str, tuple[tuple[str, str], int, float]]:
-    """The corner's links drawn between their ends: its distance closures and a coilover."""
+def links(model) -> dict[str, tuple[tuple[str, str], int, float]]:
+    """The links drawn between their ends: the distance closures (an axle's droplinks
+    too), a coilover per corner, an axle's heave link."""
     out = {}
-    for c in corner.tree.closures:
+    for c in model.tree.closures:
         if c.kind == "distance":
-            out[c.name] = (c.points, *LINKS.get(c.name, (None, *LINK))[1:])
-    if "strut_top" in corner.geometry.hardpoints:
-        out["coilover"] = LINKS["coilover"]
+            out[c.name] = (c.points, *LINKS.get(_bare(model, c.name), (None, *LINK))[1:])
+    for prefix, g in sides(model):
+        if "strut_top" in g.hardpoints:
+            (a, b), colour, radius = LINKS["coilover"]
+            out[f"{prefix}coilover"] = ((prefix + a, prefix + b), colour, radius)
+    if all(end in model.design_positions for end in LINKS["heave_link"][0]):
+        out["heave_link"] = LINKS["heave_link"]
     return out
 
 
-def outline(*corners) -> np.ndarray:
-    """Points (m, N×3) around what is drawn of the corners at design.
+def outline(*models) -> np.ndarray:
+    """Points (m, N×3) around what is drawn of the corners (or axles) at design.
 
     Their design points, the rack's end on the car's centre plane, and the
     tyre's two rims: circles of the wheel's radius at its inboard and
@@ -89,25 +127,76 @@ def outline(*corners) -> np.ndarray:
     """
     points = []
     angles = np.linspace(0.0, 2.0 * np.pi, 48, endpoint=False)
-    for corner in corners:
-        g, p = corner.geometry, corner.design_positions
+    for model in models:
+        p = model.design_positions
         points += list(p.values())
-        if g.steering == "rack":  # the rack is drawn to the centre plane (y = 0)
-            points.append(p[g.steering_points[0]] * np.array([1.0, 0.0, 1.0]))
-        a, b = p["wheel_inboard"], p["wheel_outboard"]
-        axis = (b - a) / np.linalg.norm(b - a)
-        e1 = np.cross(axis, [1.0, 0.0, 0.0] if abs(axis[0]) < 0.9 else [0.0, 0.0, 1.0])
-        e1 /= np.linalg.norm(e1)
-        e2 = np.cross(axis, e1)
-        rim = g.wheel.radius * (np.outer(np.cos(angles), e1) + np.outer(np.sin(angles), e2))
-        points += [*(a + rim), *(b + rim)]
+        for prefix, g in sides(model):
+            points += _tyre(g, prefix, p, angles)
     return np.array(points)
 
 
-def bounds(*corners) -> tuple[np.ndarray, np.ndarray]:
+def _tyre(g, prefix: str, p: dict, angles: np.ndarray) -> list[np.ndarray]:
+    """A corner's rack end on the centre plane, and its tyre's two rims (m)."""
+    points = []
+    if g.steering == "rack":  # the rack is drawn to the centre plane (y = 0)
+        points.append(p[prefix + g.steering_points[0]] * np.array([1.0, 0.0, 1.0]))
+    a, b = p[prefix + "wheel_inboard"], p[prefix + "wheel_outboard"]
+    axis = (b - a) / np.linalg.norm(b - a)
+    e1 = np.cross(axis, [1.0, 0.0, 0.0] if abs(axis[0]) < 0.9 else [0.0, 0.0, 1.0])
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(axis, e1)
+    rim = g.wheel.radius * (np.outer(np.cos(angles), e1) + np.outer(np.sin(angles), e2))
+    return [*points, *(a + rim), *(b + rim)]
+
+
+def bounds(*models) -> tuple[np.ndarray, np.ndarray]:
     """The box (lowest, highest corner, m) around what is drawn of the corners at design."""
-    points = outline(*corners)
+    points = outline(*models)
     return points.min(axis=0), points.max(axis=0)
+
+
+def roll_centres(results) -> np.ndarray:
+    """An axle's roll centre at each step (m, N×3; NaN where blank), from its results
+    columns: y and z from ``roll_center_y``/``_z``, x midway between the contact
+    patches (the front view the roll centre is found in)."""
+    x = 0.5 * (results["left_contact_patch_center_x"] + results["right_contact_patch_center_x"])
+    return 1e-3 * np.column_stack([x, results["roll_center_y"], results["roll_center_z"]])
+
+
+def design_results(model):
+    """An axle's results columns at its design state: one row, no sweep."""
+    from .axle import axle_results
+    from .solver import Solution
+    from .sweep import Sweep
+
+    return axle_results(model, Sweep([]), [Solution(model.q_design, True, 0, 0.0)])
+
+
+def as_drawn(model):
+    """The model as drawn, without its shims and adjusters (a ghost under the as-set
+    one); None when it is set as drawn."""
+    from dataclasses import replace
+
+    from .linkage import Linkage
+
+    geometries = [g for _, g in sides(model)]
+    if all(g.drawn is None for g in geometries):
+        return None
+    if not hasattr(model, "geometries"):
+        return Linkage(model.geometry.drawn)
+    from .axle import AxleModel
+
+    def drawn(g):  # its setup at the design values: AxleModel sets up nothing more
+        g = g.drawn or g
+        shim = g.camber_shim
+        if shim is not None:
+            shim = replace(shim, setup_thickness=shim.design_thickness)
+        return replace(g, camber_shim=shim, trackrod_length_delta=0.0, pushrod_length_delta=0.0)
+
+    left, right = (drawn(g) for g in geometries)
+    if model.axle is None:
+        return AxleModel(left, right)
+    return AxleModel(replace(model.axle, left=left, right=right))
 
 
 def framing(points: np.ndarray, sign: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
@@ -198,14 +287,15 @@ def _rod_transform(p0: np.ndarray, p1: np.ndarray) -> np.ndarray:
     return T
 
 
-class CornerScene:
-    """One corner (and, for a shimmed corner, its drawn geometry as a ghost) in meshcat."""
+class Scene:
+    """A corner or an axle (and, when shimmed or adjusted, its drawn geometry as a
+    ghost) in meshcat; an axle with its roll-centre marker."""
 
-    def __init__(self, corner, viewer=None):
+    def __init__(self, model, viewer=None):
         import meshcat
         import meshcat.geometry as mg
 
-        self.corner = corner
+        self.model = model
         self.server = None
         if viewer is None:
             self.server, zmq_url = start_server()
@@ -213,42 +303,50 @@ class CornerScene:
         self.viewer = viewer
         self.viewer[ROOT].delete()
         self.robots = []
-        drawn = corner.geometry.drawn
+        drawn = as_drawn(model)
         if drawn is not None:  # the geometry as drawn, translucent, under the as-set one
-            from .linkage import Linkage
+            self.robots.append(self._robot(drawn, "drawn", GHOST))
+        self.robots.append(self._robot(model, "corner", None))
 
-            self.robots.append(self._robot(Linkage(drawn), "drawn", GHOST))
-        self.robots.append(self._robot(corner, "corner", None))
-
-        present = segments(corner, corner.design_positions)
-        for name, (_, colour, radius) in links(corner).items():
+        present = segments(model, model.design_positions)
+        for name, (_, colour, radius) in links(model).items():
             if name in present:
                 self.viewer[f"{ROOT}/links/{name}"].set_object(
                     mg.Cylinder(1.0, radius), mg.MeshLambertMaterial(color=colour)
                 )
-        if "steering_axis" in present:  # none on a trailing arm
-            self.viewer[f"{ROOT}/links/steering_axis"].set_object(
-                mg.Cylinder(1.0, 0.003), mg.MeshLambertMaterial(color=AXIS_COLOUR)
+        for prefix, _ in sides(model):
+            if f"{prefix}steering_axis" in present:  # none on a trailing arm
+                self.viewer[f"{ROOT}/links/{prefix}steering_axis"].set_object(
+                    mg.Cylinder(1.0, 0.003), mg.MeshLambertMaterial(color=AXIS_COLOUR)
+                )
+            self.viewer[f"{ROOT}/{prefix}contact_patch"].set_object(
+                mg.Sphere(0.018), mg.MeshLambertMaterial(color=PATCH_COLOUR)
             )
-        self.viewer[f"{ROOT}/contact_patch"].set_object(
-            mg.Sphere(0.018), mg.MeshLambertMaterial(color=PATCH_COLOUR)
-        )
-        self._frame([c for c, _ in self.robots])
+        # an axle's roll centre: where its design results put it
+        self.design_markers = {}
+        if hasattr(model, "geometries"):
+            self.design_markers["roll_centre"] = roll_centres(design_results(model))[0]
+        for name in self.design_markers:
+            colour, radius = MARKERS[name]
+            self.viewer[f"{ROOT}/{name}"].set_object(
+                mg.Sphere(radius), mg.MeshLambertMaterial(color=colour)
+            )
+        self._frame([m for m, _ in self.robots])
         self.show()
 
-    def _robot(self, corner, name, colour):
+    def _robot(self, model, name, colour):
         from pinocchio.visualize import MeshcatVisualizer
 
-        visual = pin.buildGeomFromUrdfString(corner.model, corner.urdf, pin.GeometryType.VISUAL)
-        viz = MeshcatVisualizer(corner.model, visual, visual)
+        visual = pin.buildGeomFromUrdfString(model.model, model.urdf, pin.GeometryType.VISUAL)
+        viz = MeshcatVisualizer(model.model, visual, visual)
         viz.initViewer(viewer=self.viewer, loadModel=False)
         kwargs = {} if colour is None else {"visual_color": colour}
         viz.loadViewerModel(f"{ROOT}/{name}", **kwargs)
-        viz.display(corner.q_design)
-        return corner, viz
+        viz.display(model.q_design)
+        return model, viz
 
-    def _frame(self, corners) -> None:
-        """Put the corners' middle on the orbit target, set the camera back, lay the ground.
+    def _frame(self, models) -> None:
+        """Put the models' middle on the orbit target, set the camera back, lay the ground.
 
         meshcat 0.3.2 orbits its camera about the world origin and cannot move
         that target (OrbitControls' target is not in the scene tree and there
@@ -256,12 +354,12 @@ class CornerScene:
         three.js's lookAt still aims it at the world origin), so the scene is
         moved instead: the point the camera looks at goes to the origin. The
         camera's position is written in meshcat's rotated camera frame
-        (three.js: x, z up, −y).
+        (three.js: x, z up, −y). An axle is seen from its left side.
         """
         import meshcat.geometry as mg
 
-        points = outline(*corners)
-        target, eye = framing(points, self.corner.geometry.sign)
+        points = outline(*models)
+        target, eye = framing(points, sides(self.model)[0][1].sign)
         shift = np.eye(4)
         shift[:3, 3] = -target
         self.viewer[ROOT].set_transform(shift)
@@ -270,50 +368,76 @@ class CornerScene:
         )
         self.viewer["/Axes"].set_property("visible", False)
 
-        ground = float(self.corner.design_positions["contact_patch_center"][2])
+        patches = [
+            self.model.design_positions[f"{prefix}contact_patch_center"][2]
+            for prefix, _ in sides(self.model)
+        ]
+        ground = float(np.mean(patches))
+        low, high = points.min(axis=0), points.max(axis=0)
+        size = max(GROUND_SIZE, GROUND_SPAN * float(np.max(high[:2] - low[:2])))
         self.viewer[f"{ROOT}/ground"].set_object(
-            mg.Box([GROUND_SIZE, GROUND_SIZE, GROUND_THICKNESS]),
+            mg.Box([size, size, GROUND_THICKNESS]),
             mg.MeshLambertMaterial(
                 color=GROUND_COLOUR, opacity=GROUND_OPACITY, transparent=True, depthWrite=False
             ),
         )
         plane = np.eye(4)  # its top face at the ground, centred under the corner
-        plane[:2, 3] = 0.5 * (points.min(axis=0) + points.max(axis=0))[:2]
+        plane[:2, 3] = 0.5 * (low + high)[:2]
         plane[2, 3] = ground - 0.5 * GROUND_THICKNESS
         self.viewer[f"{ROOT}/ground"].set_transform(plane)
         grid = shift.copy()  # meshcat's grid on the same ground, in the car's x and y
         grid[2, 3] = ground - target[2] - 0.5 * GROUND_THICKNESS
         self.viewer["/Grid"].set_transform(grid)
 
-    def show(self, q: np.ndarray | None = None, viewer=None) -> None:
-        """Display the corner at q (default: its design state), drawn on ``viewer``."""
-        q = self.corner.q_design if q is None else q
+    def show(self, q: np.ndarray | None = None, viewer=None, markers=None) -> None:
+        """Display the model at q (default: its design state), drawn on ``viewer``.
+
+        ``markers``: {name: position (m)} of the markers (an axle's
+        ``roll_centre``); a marker not given, or NaN, is hidden. By default
+        at the design state, where the design results put them."""
+        if q is None:
+            q = self.model.q_design
+            markers = self.design_markers if markers is None else markers
         target = self.viewer if viewer is None else viewer
-        corner, viz = self.robots[-1]
+        model, viz = self.robots[-1]
         saved = viz.viewer
         viz.viewer = target
         try:
             viz.display(q)
         finally:
             viz.viewer = saved
-        positions = corner.positions(q)
-        for name, (p0, p1) in segments(corner, positions).items():
+        positions = model.positions(q)
+        for name, (p0, p1) in segments(model, positions).items():
             target[f"{ROOT}/links/{name}"].set_transform(_rod_transform(p0, p1))
-        patch = np.eye(4)
-        patch[:3, 3] = positions["contact_patch_center"]
-        target[f"{ROOT}/contact_patch"].set_transform(patch)
+        for prefix, _ in sides(model):
+            patch = np.eye(4)
+            patch[:3, 3] = positions[f"{prefix}contact_patch_center"]
+            target[f"{ROOT}/{prefix}contact_patch"].set_transform(patch)
+        for name in self.design_markers:
+            p = np.asarray((markers or {}).get(name, np.nan), dtype=float)
+            visible = bool(np.all(np.isfinite(p)))
+            if visible:
+                place = np.eye(4)
+                place[:3, 3] = p
+                target[f"{ROOT}/{name}"].set_transform(place)
+            _set_visible(target[f"{ROOT}/{name}"], visible)
 
-    def animate(self, qs: list[np.ndarray], fps: float = 10.0, play: bool = True) -> int:
-        """Record the poses as a meshcat animation; returns the number of frames."""
+    def animate(
+        self, qs: list[np.ndarray], fps: float = 10.0, play: bool = True, markers=None
+    ) -> int:
+        """Record the poses as a meshcat animation; returns the number of frames.
+
+        ``markers``: {name: positions (m, one row per pose, NaN where hidden)}."""
         from meshcat.animation import Animation
 
         animation = Animation(default_framerate=fps)
         frames = 0
-        for q in qs:
+        for i, q in enumerate(qs):
             if q is None:  # a step that did not converge: no pose to show
                 continue
+            at = {name: rows[i] for name, rows in (markers or {}).items()}
             with animation.at_frame(self.viewer, frames) as frame:
-                self.show(q, viewer=frame)
+                self.show(q, viewer=frame, markers=at)
             frames += 1
         self.viewer.set_animation(animation, play=play, repetitions=0)
         self.frames = frames
@@ -342,3 +466,16 @@ class CornerScene:
             except subprocess.TimeoutExpired:
                 proc.kill()
                 proc.wait()
+
+
+CornerScene = Scene  # its name from before axles
+
+
+def _set_visible(node, visible: bool) -> None:
+    """Show or hide a node of the scene, or of an animation frame (a boolean track)."""
+    from meshcat.animation import AnimationFrameVisualizer
+
+    if isinstance(node, AnimationFrameVisualizer):
+        node.set_property("visible", "boolean", visible)
+    else:
+        node.set_property("visible", visible)
