@@ -180,7 +180,7 @@ def _mjcf_problem(text: str, tree: Tree) -> str | None:
         mine, yours = ours[kind], theirs[kind]
         differences += [f"missing {kind} {_name(n)}" for n in mine if n not in yours]
         differences += [
-            f"has a {kind} {_name(n)} this corner does not have" for n in yours if n not in mine
+            f"has a {kind} {_name(n)} this model does not have" for n in yours if n not in mine
         ]
         differences += [
             f"{kind} {_name(n)} is {' '.join(yours[n])}, not {' '.join(mine[n])}"
@@ -191,7 +191,7 @@ def _mjcf_problem(text: str, tree: Tree) -> str | None:
         return None
     more = f" (and {len(differences) - 1} more differences)" if len(differences) > 1 else ""
     return (
-        f"is not the MJCF of this corner ({tree.name}): {differences[0]}{more}; "
+        f"is not the MJCF of this geometry ({tree.name}): {differences[0]}{more}; "
         "write it with pin-susp mjcf GEOMETRY -o FILE"
     )
 

@@ -1,40 +1,123 @@
-"""An independent formulation of the corner: points as unknowns, scipy least_squares.
+"""An independent formulation of a corner or an axle: points as unknowns, scipy least_squares.
 
 It shares no kinematics with the Pinocchio path: the unknowns are the
 coordinates of the moving hardpoints (and the rack's displacement), the
 constraints are rigid-body distances between hardpoints of one part, the
 derived points are written again from spec/geometry.md. ``pin-susp
 validate`` and the tests solve every step with it and compare.
+
+An axle (spec/axle.md) is both corners' formulations with their names
+prefixed by side, one rack unknown that moves both trackrods' inboard ends,
+and the anti-roll bar's parts and droplinks (:data:`ANTI_ROLL`).
 """
 
 from __future__ import annotations
 
 import itertools
+from dataclasses import dataclass
+from types import SimpleNamespace
 
 import numpy as np
 from scipy.optimize import least_squares
 
-from .geometry import Geometry
+from .errors import PinSuspError
+from .geometry import Geometry, Wheel
+from .mechanisms import Pointwise
 
 Y = np.array([0.0, 1.0, 0.0])
+Z = np.array([0.0, 0.0, 1.0])
+SIDES = ("left", "right")
+WHEEL_POINTS = ("axle_midpoint", "wheel_center", "wheel_inboard", "wheel_outboard")
 
 
-class PointwiseCorner:
-    """A corner as points and distances (SI units).
+# ---------------------------------------------------------------- targets
+# A target is a scalar function of the points held at a value: ``error(p)`` (its
+# residual, SI) and ``gradient(p)`` (point → d error / d point, (3,) each).
 
-    The mechanism says which points move as one rigid part, which are joined
-    by links, which stay on a line (``Mechanism.pointwise``); here each part
-    becomes every distance between its points, each link one distance, each
-    line condition the cross product (p − a) × unit(b − a) = 0.
+
+@dataclass(frozen=True)
+class Along:
+    """A point's coordinate along a unit direction held at a value (m, absolute)."""
+
+    point: str
+    direction: np.ndarray
+    value: float
+
+    def error(self, p) -> float:
+        return p[self.point] @ self.direction - self.value
+
+    def gradient(self, p) -> dict[str, np.ndarray]:
+        return {self.point: self.direction}
+
+
+@dataclass(frozen=True)
+class Heave:
+    """½(ΔWC_z,L + ΔWC_z,R) held at a value (m); ``design``: ½(WC_z,L + WC_z,R) at design."""
+
+    design: float
+    value: float
+
+    def error(self, p) -> float:
+        z = p["left_wheel_center"][2] + p["right_wheel_center"][2]
+        return 0.5 * z - self.design - self.value
+
+    def gradient(self, p) -> dict[str, np.ndarray]:
+        return {"left_wheel_center": 0.5 * Z, "right_wheel_center": 0.5 * Z}
+
+
+@dataclass(frozen=True)
+class Roll:
+    """atan2(ΔWC_z,L − ΔWC_z,R, CP_y,L − CP_y,R) held at a value (rad; + = left wheel
+    higher relative to the chassis); ``design``: WC_z,L − WC_z,R at design."""
+
+    design: float
+    value: float
+
+    def _parts(self, p):
+        a = p["left_wheel_center"][2] - p["right_wheel_center"][2] - self.design
+        b = p["left_contact_patch_center"][1] - p["right_contact_patch_center"][1]
+        return a, b
+
+    def error(self, p) -> float:
+        a, b = self._parts(p)
+        return np.arctan2(a, b) - self.value
+
+    def gradient(self, p) -> dict[str, np.ndarray]:
+        a, b = self._parts(p)
+        da, db = b / (a * a + b * b), -a / (a * a + b * b)  # d atan2 / da, / db
+        return {
+            "left_wheel_center": da * Z,
+            "right_wheel_center": -da * Z,
+            "left_contact_patch_center": db * Y,
+            "right_contact_patch_center": -db * Y,
+        }
+
+
+def as_target(t):
+    """A target object; a tuple (point, unit direction, value m) is an :class:`Along`."""
+    return t if hasattr(t, "error") else Along(*t)
+
+
+# ---------------------------------------------------------------- the formulation
+
+
+class PointwiseLinkage:
+    """Rigid parts, links and lines as points and distances (SI units).
+
+    ``spec`` says which points move as one rigid part, which are joined by
+    links, which stay on a line (a :class:`~pin_susp.mechanisms.Pointwise`);
+    here each part becomes every distance between its points, each link one
+    distance, each line condition the cross product (p − a) × unit(b − a) = 0.
+    ``racks``: points that slide along y together (one unknown, the rack's
+    displacement); ``wheels``: name prefix → Wheel, whose derived points
+    (wheel centre, contact patch, …) follow ``<prefix>axle_inboard/outboard``.
     """
 
-    def __init__(self, geometry: Geometry, hardpoints: dict[str, np.ndarray] | None = None):
-        g = geometry
-        hp = dict(hardpoints or g.hardpoints)
-        self.geometry = g
-        spec = g.mechanism.pointwise(g)
-        self.inner = spec.rack
+    def __init__(self, spec: Pointwise, hp: dict, wheels: dict[str, Wheel], racks=()):
+        hp = dict(hp)
         fixed = set(spec.fixed)
+        self.racks = tuple(racks)
+        self.wheels = wheels
         # points of one part that coincide are one point (two links meeting in a ball)
         self.alias = {}
         for pts in spec.parts.values():
@@ -48,9 +131,9 @@ class PointwiseCorner:
         links = [(self.alias.get(a, a), self.alias.get(b, b)) for a, b in spec.links]
         self.lines = [tuple(self.alias.get(n, n) for n in line) for line in spec.lines]
         named = {n for pts in parts.values() for n in pts} | {n for ab in links for n in ab}
-        self.moving = sorted(named - fixed - {self.inner})
+        self.moving = sorted(named - fixed - set(self.racks))
         self.column = {n: 3 * i for i, n in enumerate(self.moving)}
-        self.rack = 3 * len(self.moving) if self.inner is not None else None
+        self.rack = 3 * len(self.moving) if self.racks else None
         self.pairs = [
             (a, b, float(np.linalg.norm(hp[a] - hp[b])))
             for pts in parts.values()
@@ -59,6 +142,12 @@ class PointwiseCorner:
         ]
         self.pairs += [(a, b, float(np.linalg.norm(hp[a] - hp[b]))) for a, b in links]
         self.hp = hp
+        # derived point name → (wheel prefix, point)
+        self.derived = {
+            f"{prefix}{name}": (prefix, name)
+            for prefix in wheels
+            for name in (*WHEEL_POINTS, "contact_patch_center")
+        }
         n = 3 * len(self.moving) + (1 if self.rack is not None else 0)
         self.x0 = np.zeros(n)
         for name, c in self.column.items():
@@ -69,54 +158,52 @@ class PointwiseCorner:
         out = dict(self.hp)
         out.update({n: x[c : c + 3] for n, c in self.column.items()})
         out.update({b: out[a] for b, a in self.alias.items()})
-        if self.rack is not None:
-            out[self.inner] = self.hp[self.inner] + x[self.rack] * Y
-        wheel = self.geometry.wheel
-        a = out["axle_outboard"] - out["axle_inboard"]
-        a = a / np.linalg.norm(a)
-        center = out["axle_outboard"] - wheel.offset * a
-        down = np.array([0.0, 0.0, -1.0]) + a[2] * a
-        out.update(
-            axle_midpoint=0.5 * (out["axle_inboard"] + out["axle_outboard"]),
-            wheel_center=center,
-            wheel_inboard=center - 0.5 * wheel.section_width * a,
-            wheel_outboard=center + 0.5 * wheel.section_width * a,
-            contact_patch_center=center + wheel.radius * down / np.linalg.norm(down),
-        )
+        for inner in self.racks:
+            out[inner] = self.hp[inner] + x[self.rack] * Y
+        for prefix, wheel in self.wheels.items():
+            inboard, outboard = out[f"{prefix}axle_inboard"], out[f"{prefix}axle_outboard"]
+            a = outboard - inboard
+            a = a / np.linalg.norm(a)
+            center = outboard - wheel.offset * a
+            down = np.array([0.0, 0.0, -1.0]) + a[2] * a
+            out.update(
+                {
+                    f"{prefix}axle_midpoint": 0.5 * (inboard + outboard),
+                    f"{prefix}wheel_center": center,
+                    f"{prefix}wheel_inboard": center - 0.5 * wheel.section_width * a,
+                    f"{prefix}wheel_outboard": center + 0.5 * wheel.section_width * a,
+                    f"{prefix}contact_patch_center": center
+                    + wheel.radius * down / np.linalg.norm(down),
+                }
+            )
         return out
 
     def residual(self, x: np.ndarray, targets) -> np.ndarray:
         p = self.points(x)
         rows = [np.linalg.norm(p[a] - p[b]) - d for a, b, d in self.pairs]
-        rows += [p[name] @ d - value for name, d, value in targets]
+        rows += [as_target(t).error(p) for t in targets]
         for point, a, b in self.lines:
             rows += list(np.cross(p[point] - p[a], (p[b] - p[a]) / np.linalg.norm(p[b] - p[a])))
         return np.array(rows)
 
     def jacobian(self, x: np.ndarray, targets) -> np.ndarray:
-        """Analytic: distance rows, and targets on hardpoints or on points fixed to the
-        upright (through â = unit(AO − AI)); a contact-patch target by central
-        differences."""
+        """Analytic: distance rows, and targets through the points they hold (derived
+        points through â = unit(AO − AI)); the line conditions by central differences."""
         p = self.points(x)
         J = np.zeros((len(self.pairs) + len(targets) + 3 * len(self.lines), len(x)))
         for row, (a, b, _) in enumerate(self.pairs):
             u = (p[a] - p[b]) / np.linalg.norm(p[a] - p[b])
             self._add(J[row], a, u)
             self._add(J[row], b, -u)
-        for k, (name, d, _) in enumerate(targets):
+        for k, t in enumerate(targets):
             row = J[len(self.pairs) + k]
-            if name in self.hp:
-                self._add(row, name, d)
-            elif name != "contact_patch_center":
-                for end, gradient in self._derived(name, p).items():
-                    self._add(row, end, gradient.T @ d)
-            else:
-                h = 1e-7
-                for i in range(len(x)):
-                    e = np.zeros(len(x))
-                    e[i] = h
-                    row[i] = (self.points(x + e)[name] - self.points(x - e)[name]) @ d / (2 * h)
-        if self.lines:  # the line conditions by central differences
+            for name, gradient in as_target(t).gradient(p).items():
+                if name in self.derived:
+                    for end, d in self._derived(name, p).items():
+                        self._add(row, end, d.T @ gradient)
+                else:
+                    self._add(row, name, gradient)
+        if self.lines:
             first, h = len(self.pairs) + len(targets), 1e-7
             for i in range(len(x)):
                 e = np.zeros(len(x))
@@ -131,25 +218,33 @@ class PointwiseCorner:
             row[self.column[name] : self.column[name] + 3] += gradient
         elif name in self.alias:
             self._add(row, self.alias[name], gradient)
-        elif name == self.inner and self.rack is not None:
+        elif name in self.racks:
             row[self.rack] += gradient[1]
 
     def _derived(self, name: str, p) -> dict[str, np.ndarray]:
         """d(derived point)/d(axle_inboard), d/d(axle_outboard) as 3×3 matrices."""
-        wheel = self.geometry.wheel
-        v = p["axle_outboard"] - p["axle_inboard"]
+        prefix, point = self.derived[name]
+        inboard, outboard = f"{prefix}axle_inboard", f"{prefix}axle_outboard"
+        wheel = self.wheels[prefix]
+        v = p[outboard] - p[inboard]
         a = v / np.linalg.norm(v)
         D = (np.eye(3) - np.outer(a, a)) / np.linalg.norm(v)  # dâ/d(AO − AI)
+        if point == "axle_midpoint":
+            return {inboard: 0.5 * np.eye(3), outboard: 0.5 * np.eye(3)}
         along = {
-            "axle_midpoint": None,
             "wheel_center": 0.0,
             "wheel_inboard": -0.5 * wheel.section_width,
             "wheel_outboard": 0.5 * wheel.section_width,
-        }[name]
-        if along is None:
-            return {"axle_inboard": 0.5 * np.eye(3), "axle_outboard": 0.5 * np.eye(3)}
-        k = along - wheel.offset  # the point is AO + k·â
-        return {"axle_outboard": np.eye(3) + k * D, "axle_inboard": -k * D}
+            "contact_patch_center": 0.0,
+        }[point]
+        dv = (along - wheel.offset) * D  # the point is AO + k·â (+ R·n̂ for the patch)
+        if point == "contact_patch_center":
+            # n̂ = unit(−ẑ + a_z·â): dn̂/dâ = (I − n̂n̂ᵀ)/|down| · (â ẑᵀ + a_z I)
+            down = -Z + a[2] * a
+            n = down / np.linalg.norm(down)
+            dn = (np.eye(3) - np.outer(n, n)) / np.linalg.norm(down)
+            dv = dv + wheel.radius * dn @ (np.outer(a, Z) + a[2] * np.eye(3)) @ D
+        return {outboard: np.eye(3) + dv, inboard: -dv}
 
     def solve(
         self,
@@ -158,12 +253,14 @@ class PointwiseCorner:
         jacobian: str = "analytic",
         longer: tuple[tuple[str, str], float] | None = None,
     ) -> tuple[np.ndarray, float]:
-        """Hold each (point, unit direction, absolute value m); returns x and max |residual|.
+        """Hold each target (an :class:`Along`, :class:`Heave`, :class:`Roll`, or a
+        tuple (point, unit direction, absolute value m)); returns x and max |residual|.
 
         ``jacobian="2-point"`` lets scipy difference the residuals instead;
         ``longer`` = ((a, b), δ): the link between points a and b made δ (m) longer.
         """
         x0 = self.x0 if x0 is None else x0
+        targets = [as_target(t) for t in targets]
         if longer is not None:
             (a, b), delta = longer
             saved = self.pairs
@@ -183,3 +280,140 @@ class PointwiseCorner:
             gtol=1e-15,
         )
         return sol.x, float(np.max(np.abs(sol.fun)))
+
+
+class PointwiseCorner(PointwiseLinkage):
+    """A corner: its mechanism's parts, links and lines (``Mechanism.pointwise``)."""
+
+    def __init__(self, geometry: Geometry, hardpoints: dict[str, np.ndarray] | None = None):
+        spec = geometry.mechanism.pointwise(geometry)
+        racks = () if spec.rack is None else (spec.rack,)
+        super().__init__(spec, hardpoints or geometry.hardpoints, {"": geometry.wheel}, racks)
+        self.geometry = geometry
+        self.inner = spec.rack
+
+
+class PointwiseAxle(PointwiseLinkage):
+    """An axle: each corner's formulation with its names prefixed ``left_``/``right_``,
+    one rack unknown for both trackrods' inboard ends, the anti-roll bar
+    (:data:`ANTI_ROLL`), and the heave link's ends riding on the rockers.
+
+    ``axle``: a :class:`pin_susp.axle.AxleGeometry` (None: two bare corners);
+    ``corners``: side → the corner Geometry to use instead of the axle's (the
+    as-set corners; required without an axle).
+    """
+
+    def __init__(self, axle, corners: dict[str, Geometry] | None = None):
+        corners = corners or {"left": axle.left, "right": axle.right}
+        if axle is None:
+            axle = SimpleNamespace(
+                center={}, side_points=dict.fromkeys(SIDES, {}), anti_roll="none", heave_link="none"
+            )
+        spec = Pointwise({}, [], [], set())
+        hp, racks = dict(axle.center), []
+        for side, g in corners.items():
+            own = g.mechanism.pointwise(g)
+
+            def name(n, side=side):
+                return f"{side}_{n}"
+
+            spec.parts.update({name(k): [name(n) for n in v] for k, v in own.parts.items()})
+            spec.links.extend((name(a), name(b)) for a, b in own.links)
+            spec.lines.extend(tuple(map(name, line)) for line in own.lines)
+            spec.fixed.update(map(name, own.fixed))
+            if own.rack is not None:
+                racks.append(name(own.rack))
+            hp.update({name(n): v for n, v in g.hardpoints.items()})
+            hp.update({name(n): v for n, v in axle.side_points[side].items()})
+        if axle.anti_roll not in ANTI_ROLL:
+            raise PinSuspError(
+                f"the point-based formulation has no {axle.anti_roll} anti-roll bar yet "
+                f"(it has: {', '.join(ANTI_ROLL)})"
+            )
+        ANTI_ROLL[axle.anti_roll](axle, corners, spec, hp)
+        if axle.heave_link != "none":  # measured only: a point on each rocker
+            for side in SIDES:
+                spec.parts[f"{side}_rocker"].append(f"{side}_heave_link_rocker")
+        wheels = {f"{side}_": g.wheel for side, g in corners.items()}
+        super().__init__(spec, hp, wheels, racks)
+        self.axle = axle
+        self.design = self.points(self.x0)
+
+    def targets(self, sweep_targets, values) -> list:
+        """One step of a sweep's targets (its own design state for heave and roll)."""
+        return axle_targets(sweep_targets, values, self.design)
+
+
+def axle_targets(sweep_targets, values, design: dict) -> list:
+    """One step of an axle sweep's targets as point-based targets: ``values`` in SI as
+    axle.target_values gives them (heave m, roll rad, a point's coordinate m,
+    absolute); ``design``: the design points (m), for heave's and roll's zero."""
+    left, right = design["left_wheel_center"][2], design["right_wheel_center"][2]
+    out = []
+    for t, value in zip(sweep_targets, values, strict=True):
+        if t.quantity == "heave":
+            out.append(Heave(0.5 * (left + right), float(value)))
+        elif t.quantity == "roll":
+            out.append(Roll(left - right, float(value)))
+        else:
+            out.append(Along(f"{t.side}_{t.point}", t.unit_direction, float(value)))
+    return out
+
+
+def _no_bar(axle, corners, spec, hp) -> None:
+    """No anti-roll bar: nothing joins the sides but the rack."""
+
+
+def _u_bar(axle, corners, spec, hp) -> None:
+    """Each side's bar arm is a part of three points: the bar's axis ends, fixed on
+    the chassis, and the arm's end, which keeps its distance to both (it turns on a
+    circle about the axis). A rigid droplink joins each arm's end to
+    ``droplink_rocker`` on the rocker or, without a rocker, to ``droplink_lower`` on
+    the body named by ``anti_roll.mount`` (``arm``: the wheel's body).
+
+    A rigid bar (``stiffness: rigid``) is one part: the axis, both arm ends, and
+    ``arb_bar_quarter``, a point a quarter turn round from the right arm's end — the
+    distance between two parallel arms' ends is at its minimum, so alone it would
+    not fix their relative turn (its gradient vanishes there)."""
+    axis = ("arb_u_bar_axis_a", "arb_u_bar_axis_b")
+    spec.fixed.update(axis)
+    rigid = getattr(axle, "anti_roll_rigid", False)
+    if rigid:
+        a, b = (hp[n] for n in axis)
+        u = (b - a) / np.linalg.norm(b - a)
+        end = hp["right_droplink_u_bar"]
+        foot = a + u * ((end - a) @ u)
+        hp["arb_bar_quarter"] = foot + np.cross(u, end - foot)
+        spec.parts["arb_bar"] = [*axis, "arb_bar_quarter"]
+    for side in SIDES:
+        end = f"{side}_droplink_u_bar"
+        if rigid:
+            spec.parts["arb_bar"].append(end)
+        else:
+            spec.parts[f"{side}_arb_arm"] = [*axis, end]
+        _droplink(axle, corners[side], side, end, spec)
+
+
+def _droplink(axle, g: Geometry, side: str, end: str, spec) -> None:
+    """A rigid link from the rocker's ``droplink_rocker`` (or ``droplink_lower`` on the
+    body ``anti_roll.mount`` names) to the bar's point ``end``."""
+    if "droplink_rocker" in axle.side_points[side]:
+        upper, body = "droplink_rocker", "rocker"
+    else:
+        mount = axle.anti_roll_mount
+        upper, body = "droplink_lower", g.mechanism.WHEEL_BODY if mount == "arm" else mount
+    if f"{side}_{body}" not in spec.parts:
+        own = [p.removeprefix(f"{side}_") for p in spec.parts if p.startswith(f"{side}_")]
+        raise PinSuspError(
+            f"the point-based formulation has no rigid part {body!r} to carry the "
+            f"droplink (its parts: {', '.join(own)})"
+        )
+    spec.parts[f"{side}_{body}"].append(f"{side}_{upper}")
+    spec.links.append((f"{side}_{upper}", end))
+
+
+# anti_roll.type → what it adds to the axle's parts, links, lines and fixed points.
+# A T-bar would be one part (arb_t_bar_pivot and both droplink_t_bar, the pivot
+# fixed: a ball), its droplinks as here, and one plane row: the crossbar's midpoint
+# in y = 0.
+ANTI_ROLL = {"none": _no_bar, "u_bar": _u_bar}

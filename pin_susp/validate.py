@@ -12,6 +12,10 @@ the derivative columns, the steer screw axis and the instant centres of a
 bump twist are checked too.
 The metrics are then computed from each engine's points and compared with
 pin_susp's, metric by metric and point by point.
+
+A corner or an axle (spec/axle.md) alike: what differs between them — their
+points, drivers, targets and columns — is a scope (:class:`CornerScope`,
+:class:`AxleScope`); the engines only see points and targets.
 """
 
 from __future__ import annotations
@@ -21,12 +25,20 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .axle import (
+    SIDES,
+    AxleModel,
+    axle_metric_columns,
+    axle_results,
+    solve_axle_sweep,
+    target_values,
+)
 from .closures import ContactPatchPoint
 from .errors import PinSuspError
 from .jet import Dual
 from .jet import value as plain
-from .metrics import METRICS, metric_columns
-from .pointwise import PointwiseCorner
+from .metrics import METRICS, TOE_LINK, metric_columns
+from .pointwise import Along, PointwiseAxle, PointwiseCorner, Y, Z, as_target, axle_targets
 
 TOLERANCE = 1e-6  # mm and deg
 # Instant centres of nearly parallel wishbones lie kilometres away, where a
@@ -62,73 +74,214 @@ class EngineReport:
 
 
 def compare(
-    corner, results, points_per_step: list[dict | None], engine: str, tolerance: float = TOLERANCE
+    subject, results, points_per_step: list | None, engine: str, tolerance: float = TOLERANCE
 ) -> EngineReport:
-    """Metric columns of an engine's points against pin_susp's results."""
+    """Metric columns of an engine's points against pin_susp's results (a corner's or
+    an axle's: ``subject`` is a Corner or an AxleModel)."""
+    scope = _scope(subject)
     report = EngineReport(engine, tolerance)
-    design = {k: v[None] for k, v in corner.design_positions.items()}
     for i, points in enumerate(points_per_step):
         if points is None:
             report.failed_steps.append(i)
             continue
         if not results["solver_converged"][i]:
             continue
-        columns = metric_columns(corner.geometry, points, design, corner.spring_sense)
-        for name, (values, unit) in columns.items():
-            if (
-                np.isnan(values[0])
-                and name in RATE_METRICS
-                and np.isnan(plain(points["wheel_center"].der)).any()
-            ):
-                report.not_compared.add(name)  # the engine cannot move one of the drivers
+        stalled = scope.stalled(points)  # a driver the engine cannot move
+        for name, (values, unit) in scope.columns(points).items():
+            if np.isnan(values[0]) and stalled and scope.from_rates(name):
+                report.not_compared.add(name)
                 continue
-            _record(report, name, unit, values[0], results[name][i])
-        for name in corner.point_names:
+            _record(report, name, unit, values[0], results[name][i], scope.size(name, results, i))
+        for name, position in scope.positions(points).items():
             for a, axis in enumerate("xyz"):
-                position = points[name].val[0, a] * 1e3
-                _record(report, "points", "mm", position, results[f"{name}_{axis}"][i])
+                _record(report, "points", "mm", position[a] * 1e3, results[f"{name}_{axis}"][i])
     return report
 
 
-def _record(report, name, unit, theirs, ours) -> None:
+def _record(report, name, unit, theirs, ours, size=None) -> None:
+    """Keep the largest difference; beyond the tolerance plus RELATIVE·size (default
+    |ours|), the column disagrees."""
     if np.isnan(ours) and np.isnan(theirs):
         return
     diff = abs(ours - theirs) if not (np.isnan(ours) or np.isnan(theirs)) else np.inf
     report.differences[name] = max(report.differences.get(name, 0.0), float(diff))
     report.units[name] = unit
-    if not diff <= report.tolerance + RELATIVE * abs(ours):
+    size = abs(ours) if size is None or np.isnan(size) else size
+    if not diff <= report.tolerance + RELATIVE * size:
         report.disagree.add(name)
 
 
-def step_targets(corner, sweep) -> list[list[tuple[str, np.ndarray, float]]]:
-    """(point, unit direction, absolute value m) for every target of every step."""
-    values = corner.target_values(sweep.targets)
-    return [
-        [(t.point, t.unit_direction, float(values[i, k])) for k, t in enumerate(sweep.targets)]
-        for i in range(len(values))
-    ]
+def step_targets(subject, sweep) -> list[list]:
+    """Every step's targets: (point, unit direction, absolute value m) for a corner;
+    point-based targets (:mod:`pin_susp.pointwise`) for an axle."""
+    return _scope(subject).step_targets(sweep)
 
 
 def held_drivers(corner, points: dict) -> list[tuple[str, np.ndarray, float]]:
     """The drivers as targets held where the engine's pose is: wheel-centre z, and the
     rack (trackrod_inboard y) on a rack corner."""
-    held = [("wheel_center", np.array([0.0, 0.0, 1.0]), float(points["wheel_center"][2]))]
+    held = [("wheel_center", Z, float(points["wheel_center"][2]))]
     g = corner.geometry
     if g.steering == "rack":
         inner = g.steering_points[0]
-        held.append((inner, np.array([0.0, 1.0, 0.0]), float(points[inner][1])))
+        held.append((inner, Y, float(points[inner][1])))
     return held
 
 
-def with_rates(corner, points: dict | None, rates) -> dict[str, Dual] | None:
-    """An engine's points at one step as Duals: position (1, 3), rates (k, 1, 3) along
-    the corner's drivers, ``rates``: name → (k, 3), from the engine's own Jacobian."""
-    if points is None:
-        return None
-    return {name: Dual(p[None], rates[name][:, None]) for name, p in points.items()}
+class CornerScope:
+    """What the engines need from a corner: its points and drivers, the sweep as
+    targets, the columns computed from an engine's points (name → Dual)."""
+
+    kind = "corner"
+
+    def __init__(self, corner):
+        self.subject = corner
+        self.tree = corner.tree
+        self.drivers = len(corner.drivers)
+        g = corner.geometry
+        # a driver no target holds: the fixed toe link's length (a link of the engine)
+        self.links = [g.steering_points] if TOE_LINK in corner.drivers else []
+        self.wheels = {"": (g.wheel.radius, corner.mechanism.WHEEL_BODY)}
+        self.sites = [n for n in corner.point_names if n != "contact_patch_center"]
+
+    def results(self, sweep):
+        return self.subject.run_sweep(sweep)
+
+    def pointwise(self) -> PointwiseCorner:
+        return PointwiseCorner(self.subject.geometry)
+
+    def step_targets(self, sweep) -> list[list]:
+        values = self.subject.target_values(sweep.targets)
+        return [
+            [(t.point, t.unit_direction, float(v[k])) for k, t in enumerate(sweep.targets)]
+            for v in values
+        ]
+
+    def held(self, points: dict) -> list:
+        return held_drivers(self.subject, points)
+
+    def duals(self, points: dict, rates: dict) -> dict[str, Dual]:
+        return {name: Dual(p[None], rates[name][:, None]) for name, p in points.items()}
+
+    def columns(self, points: dict) -> dict:
+        c = self.subject
+        design = {k: v[None] for k, v in c.design_positions.items()}
+        return metric_columns(c.geometry, points, design, c.spring_sense)
+
+    def positions(self, points: dict) -> dict[str, np.ndarray]:
+        return {name: points[name].val[0] for name in self.subject.point_names}
+
+    def stalled(self, points: dict) -> bool:
+        return bool(np.isnan(plain(points["wheel_center"].der)).any())
+
+    def from_rates(self, name: str) -> bool:
+        return name in RATE_METRICS
+
+    def size(self, name: str, results, i: int) -> float:
+        """What the column's RELATIVE tolerance is a fraction of: its own value."""
+        return abs(results[name][i])
 
 
-def pointwise_points(corner, sweep) -> list[dict | None]:
+class AxleScope:
+    """An axle's (spec/axle.md): the drivers are each wheel centre's z and the rack
+    (or each side's fixed toe link); a point is a Dual per side (its rates along
+    that side's hub z, the other wheel and the rack held, and along the rack or its
+    toe link's length), as axle_results takes them."""
+
+    kind = "axle"
+    # the roll centre's columns: name → the vector it is a coordinate of
+    ROLL_CENTRE = {
+        name: pair
+        for pair in (
+            ("roll_center_y", "roll_center_z"),
+            ("deriv_roll_center_y_wrt_roll", "deriv_roll_center_z_wrt_roll"),
+        )
+        for name in pair
+    }
+
+    def __init__(self, model: AxleModel):
+        self.subject = model
+        self.tree = model.tree
+        self.rack = model.geometries["left"].steering == "rack"
+        held = len(SIDES) + self.rack
+        # each side's drivers: its hub z, the rack, or its fixed toe link's length
+        # (a driver no target holds: a link of the engine), as axle_results orders them
+        self.side_drivers, self.links = {}, []
+        for c, (side, g) in enumerate(model.geometries.items()):
+            self.side_drivers[side] = [c, len(SIDES)] if self.rack else [c]
+            if g.steering == "none" and g.steering_points:
+                self.side_drivers[side].append(held + len(self.links))
+                self.links.append(tuple(f"{side}_{n}" for n in g.steering_points))
+        self.drivers = held + len(self.links)
+        self.wheels = {
+            f"{side}_": (g.wheel.radius, f"{side}_{g.mechanism.WHEEL_BODY}")
+            for side, g in model.geometries.items()
+        }
+        self.sites = [n for n in model.output_points if not n.endswith("contact_patch_center")]
+
+    def results(self, sweep):
+        model = self.subject
+        return axle_results(model, sweep, solve_axle_sweep(model, sweep))
+
+    def pointwise(self) -> PointwiseAxle:
+        return PointwiseAxle(self.subject.axle, self.subject.geometries)
+
+    def step_targets(self, sweep) -> list[list]:
+        model = self.subject
+        values = target_values(model, sweep.targets)
+        return [axle_targets(sweep.targets, v, model.design_positions) for v in values]
+
+    def held(self, points: dict) -> list:
+        held = [Along(f"{s}_wheel_center", Z, float(points[f"{s}_wheel_center"][2])) for s in SIDES]
+        if self.rack:
+            inner = f"left_{self.subject.geometries['left'].steering_points[0]}"
+            held.append(Along(inner, Y, float(points[inner][1])))
+        return held
+
+    def duals(self, points: dict, rates: dict) -> dict[str, dict[str, Dual]]:
+        return {
+            name: {s: Dual(p[None], rates[name][self.side_drivers[s]][:, None]) for s in SIDES}
+            for name, p in points.items()
+        }
+
+    def columns(self, points: dict) -> dict:
+        """Every metric column, computed from the points as axle_results computes them
+        (with its own pieces: the per-side columns, the axle's, the roll rates)."""
+        return axle_metric_columns(self.subject, points)
+
+    def positions(self, points: dict) -> dict[str, np.ndarray]:
+        return {name: points[name]["left"].val[0] for name in self.subject.output_points}
+
+    def stalled(self, points: dict) -> bool:
+        return any(np.isnan(plain(points[f"{s}_wheel_center"][s].der)).any() for s in SIDES)
+
+    def from_rates(self, name: str) -> bool:
+        return name.removesuffix("_left").removesuffix("_right") in RATE_METRICS
+
+    def size(self, name: str, results, i: int) -> float:
+        """What the column's RELATIVE tolerance is a fraction of: its own value; for the
+        roll centre and its rates, the vector's length times |RC| / track at least 1.
+
+        The roll centre crosses two lines from contact patches a track apart; when
+        they are nearly parallel (instant centres a hundred metres out) it lies at
+        |RC| ≫ track, and a rounding δ in a line's slope moves it by (|RC|²/track)·δ:
+        a relative error |RC|/track times larger than its inputs', in either
+        coordinate and in its rates alike.
+        """
+        if name not in self.ROLL_CENTRE:
+            return abs(results[name][i])
+        rc = np.hypot(results["roll_center_y"][i], results["roll_center_z"][i])
+        lever = max(1.0, rc / results["track"][i])
+        return np.hypot(*(results[n][i] for n in self.ROLL_CENTRE[name])) * lever
+
+
+def _scope(subject) -> CornerScope | AxleScope:
+    if isinstance(subject, CornerScope | AxleScope):
+        return subject
+    return AxleScope(subject) if isinstance(subject, AxleModel) else CornerScope(subject)
+
+
+def pointwise_points(subject, sweep) -> list[dict | None]:
     """The point-based formulation's points at every step, with their rates along the
     drivers; None where it did not converge.
 
@@ -138,47 +291,48 @@ def pointwise_points(corner, sweep) -> list[dict | None]:
     the points then move along dx (Richardson differences of the explicit point
     formulas, error ~1e-12).
     """
-    model = PointwiseCorner(corner.geometry)
-    g = corner.geometry
+    scope = _scope(subject)
+    model = scope.pointwise()
     out = []
-    for targets in step_targets(corner, sweep):
+    for targets in scope.step_targets(sweep):
         x, residual = model.solve(targets)
         if not residual < 1e-12:
             out.append(None)
             continue
         points = model.points(x)
-        held = held_drivers(corner, points)
+        held = scope.held(points)
         J = model.jacobian(x, held)
-        rhs = np.zeros((len(J), len(corner.drivers)))
+        rhs = np.zeros((len(J), scope.drivers))
         first = len(model.pairs)
         for j in range(len(held)):
             rhs[first + j, j] = 1.0
-        if len(held) < len(corner.drivers):  # the toe link's length
-            a, b = g.steering_points
+        for j, (a, b) in enumerate(scope.links, start=len(held)):  # a link's length
             row = next(i for i, (p, q, _) in enumerate(model.pairs) if {p, q} == {a, b})
-            rhs[row, len(held)] = 1.0
+            rhs[row, j] = 1.0
         dx = np.linalg.lstsq(J, rhs, rcond=None)[0]
-        rates = {name: np.zeros((len(corner.drivers), 3)) for name in points}
+        rates = {name: np.zeros((scope.drivers, 3)) for name in points}
         h = 1e-4
-        for j in range(len(corner.drivers)):
+        for j in range(scope.drivers):
             at = {s: model.points(x + s * h * dx[:, j]) for s in (-2, -1, 1, 2)}
             for name in points:
                 d1, d2 = at[1][name] - at[-1][name], at[2][name] - at[-2][name]
                 rates[name][j] = (8.0 * d1 - d2) / (12.0 * h)
-        out.append(with_rates(corner, points, rates))
+        out.append(scope.duals(points, rates))
     return out
 
 
 class MujocoCorner:
-    """The exported MJCF in MuJoCo, solved to targets by Newton on its own Jacobians.
+    """The exported MJCF (a corner's or an axle's) in MuJoCo, solved to targets by
+    Newton on its own Jacobians.
 
     Build and use it inside :func:`quiet_mujoco`: MuJoCo otherwise prints its
     warnings and appends them to ``MUJOCO_LOG.TXT`` in the working directory.
     """
 
-    def __init__(self, mjcf_text: str, corner, source: str = "the MJCF"):
+    def __init__(self, mjcf_text: str, subject, source: str = "the MJCF"):
         import mujoco
 
+        scope = _scope(subject)
         self.mj = mujoco
         try:
             self.model = mujoco.MjModel.from_xml_string(mjcf_text)
@@ -186,19 +340,28 @@ class MujocoCorner:
             detail = " ".join(str(exc).split())
             raise PinSuspError(f"{source}: MuJoCo cannot load it: {detail}") from None
         self.data = mujoco.MjData(self.model)
-        self.sites = {
-            name: _Site(self, name, source)
-            for name in corner.point_names
-            if name != "contact_patch_center"
-        }
-        self.sites["contact_patch_center"] = ContactPatchPoint(
-            "contact_patch_center",
-            self.sites["wheel_center"],
-            self.sites["axle_inboard"],
-            self.sites["axle_outboard"],
-            corner.geometry.wheel.radius,
-            corner.mechanism.WHEEL_BODY,
-        )
+        self.sites = {name: _Site(self, name, source) for name in scope.sites}
+        for prefix, (radius, body) in scope.wheels.items():
+            self.sites[f"{prefix}contact_patch_center"] = ContactPatchPoint(
+                f"{prefix}contact_patch_center",
+                self.sites[f"{prefix}wheel_center"],
+                self.sites[f"{prefix}axle_inboard"],
+                self.sites[f"{prefix}axle_outboard"],
+                radius,
+                body,
+            )
+
+    def _rows(self, targets) -> tuple[list, list]:
+        """Each target's residual and its row of d residual / dv (chain rule through
+        the sites' Jacobians)."""
+        p = {name: site.position(self) for name, site in self.sites.items()}
+        errors, rows = [], []
+        for t in map(as_target, targets):
+            errors.append(t.error(p))
+            rows.append(
+                sum(g @ self.sites[name].jacobian(self) for name, g in t.gradient(p).items())
+            )
+        return errors, rows
 
     def solve(self, targets, iterations: int = 30) -> dict | None:
         """Newton from the design state to the targets."""
@@ -207,18 +370,14 @@ class MujocoCorner:
         for _ in range(iterations + 1):
             mj.mj_forward(m, d)
             eq = d.efc_type[: d.nefc] == mj.mjtConstraint.mjCNSTR_EQUALITY
-            rows = [d.efc_pos[: d.nefc][eq]]
-            jac = [d.efc_J.reshape(d.nefc, m.nv)[eq]] if d.nefc else []
-            for name, direction, value in targets:
-                site = self.sites[name]
-                rows.append([site.position(self) @ direction - value])
-                jac.append(direction @ site.jacobian(self))
-            r = np.concatenate(rows)
+            errors, rows = self._rows(targets)
+            r = np.concatenate([d.efc_pos[: d.nefc][eq], errors])
             if not np.all(np.isfinite(r)):
                 return None  # diverged, or a NaN in the MJCF: lstsq would fail on it
             if np.max(np.abs(r)) < 1e-13:
                 return {name: s.position(self).copy() for name, s in self.sites.items()}
-            J = np.vstack(jac)
+            jac = [d.efc_J.reshape(d.nefc, m.nv)[eq]] if d.nefc else []
+            J = np.vstack(jac + rows)
             if not np.all(np.isfinite(J)):
                 return None
             dv = np.linalg.lstsq(J, -r, rcond=None)[0]
@@ -234,8 +393,7 @@ class MujocoCorner:
         mj.mj_forward(m, d)
         eq = d.efc_type[: d.nefc] == mj.mjtConstraint.mjCNSTR_EQUALITY
         jac = [d.efc_J.reshape(d.nefc, m.nv)[eq]] if d.nefc else []
-        jac += [direction @ self.sites[name].jacobian(self) for name, direction, _ in held]
-        J = np.vstack(jac)
+        J = np.vstack(jac + self._rows(held)[1])
         rhs = np.zeros((len(J), len(held)))
         rhs[len(J) - len(held) :] = np.eye(len(held))
         dv = np.linalg.lstsq(J, rhs, rcond=None)[0]
@@ -296,7 +454,7 @@ class _Site:
         self.name = name
         self.id = engine.mj.mj_name2id(engine.model, engine.mj.mjtObj.mjOBJ_SITE, name)
         if self.id < 0:
-            raise PinSuspError(f"{source}: is not the MJCF of this corner: missing site {name}")
+            raise PinSuspError(f"{source}: is not the MJCF of this geometry: missing site {name}")
 
     def position(self, engine: MujocoCorner) -> np.ndarray:
         return engine.data.site_xpos[self.id]
@@ -307,25 +465,26 @@ class _Site:
         return jacp
 
 
-def mujoco_points(corner, sweep, mjcf_text: str, source: str = "the MJCF") -> list[dict | None]:
+def mujoco_points(subject, sweep, mjcf_text: str, source: str = "the MJCF") -> list:
     """MuJoCo's points at every step (None where it did not converge), quietly."""
-    return _mujoco_points(corner, sweep, mjcf_text, source)[0]
+    return _mujoco_points(_scope(subject), sweep, mjcf_text, source)[0]
 
 
-def _mujoco_points(corner, sweep, mjcf_text: str, source: str):
+def _mujoco_points(scope, sweep, mjcf_text: str, source: str):
     """(points, warnings counter); MuJoCo's errors as PinSuspError naming ``source``."""
     import mujoco
 
     with quiet_mujoco(mujoco) as counter:
         try:
-            engine = MujocoCorner(mjcf_text, corner, source)
+            engine = MujocoCorner(mjcf_text, scope, source)
             points = []
-            for targets in step_targets(corner, sweep):
+            for targets in scope.step_targets(sweep):
                 at = engine.solve(targets)
-                rates = None
-                if at is not None:
-                    rates = engine.rates(held_drivers(corner, at), len(corner.drivers))
-                points.append(with_rates(corner, at, rates))
+                if at is None:
+                    points.append(None)
+                    continue
+                rates = engine.rates(scope.held(at), scope.drivers)
+                points.append(scope.duals(at, rates))
         except (mujoco.FatalError, mujoco.UnexpectedError) as exc:
             detail = " ".join(str(exc).split())
             raise PinSuspError(f"{source}: MuJoCo failed on it: {detail}") from None
@@ -333,7 +492,7 @@ def _mujoco_points(corner, sweep, mjcf_text: str, source: str):
 
 
 def validate(
-    corner,
+    subject,
     sweep,
     mjcf_text: str | None = None,
     tolerance: float = TOLERANCE,
@@ -341,20 +500,27 @@ def validate(
 ):
     """Solve the sweep with pin_susp, then with each available engine; compare.
 
-    Returns (results, reports). ``mjcf_text`` defaults to the corner's own
-    export; given, it must be that export (:func:`pin_susp.mjcf.check_mjcf`,
-    checked before any solving) and ``mjcf_source`` names it in errors (the
-    file's path). A file that is not this corner's MJCF, or that MuJoCo cannot
-    load, raises PinSuspError; MuJoCo's warnings are counted in the report's
-    ``warnings``, never printed nor written to MUJOCO_LOG.TXT.
+    ``subject``: a Corner or an AxleModel. Returns (results, reports).
+    ``mjcf_text`` defaults to the subject's own export; given, it must be that
+    export (:func:`pin_susp.mjcf.check_mjcf`, checked before any solving) and
+    ``mjcf_source`` names it in errors (the file's path). A file that is not
+    this corner's (axle's) MJCF, or that MuJoCo cannot load, raises
+    PinSuspError; MuJoCo's warnings are counted in the report's ``warnings``,
+    never printed nor written to MUJOCO_LOG.TXT. An engine that cannot model
+    the subject gets a report with a ``note`` saying why.
     """
     from .mjcf import check_mjcf, tree_to_mjcf
 
+    scope = _scope(subject)
     if mjcf_text is not None:
-        check_mjcf(mjcf_text, corner.tree, mjcf_source)
-    results = corner.run_sweep(sweep)
-    points = pointwise_points(corner, sweep)
-    reports = [compare(corner, results, points, "pointwise", tolerance)]
+        check_mjcf(mjcf_text, scope.tree, mjcf_source)
+    results = scope.results(sweep)
+    try:
+        points = pointwise_points(scope, sweep)
+    except PinSuspError as exc:
+        reports = [EngineReport("pointwise", note=str(exc))]
+    else:
+        reports = [compare(scope, results, points, "pointwise", tolerance)]
     try:
         import mujoco  # noqa: F401
     except ImportError:
@@ -367,11 +533,11 @@ def validate(
         )
         return results, reports
     if mjcf_text is None:
-        text, source = tree_to_mjcf(corner.tree), "the corner's exported MJCF"
+        text, source = tree_to_mjcf(scope.tree), f"the {scope.kind}'s exported MJCF"
     else:
         text, source = mjcf_text, mjcf_source
-    points, warnings = _mujoco_points(corner, sweep, text, source)
-    report = compare(corner, results, points, "mujoco", tolerance)
+    points, warnings = _mujoco_points(scope, sweep, text, source)
+    report = compare(scope, results, points, "mujoco", tolerance)
     report.warnings, report.first_warning = warnings.count, warnings.first
     reports.append(report)
     return results, reports

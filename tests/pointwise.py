@@ -124,3 +124,30 @@ def shim_assembly(data: dict) -> dict[str, np.ndarray]:
     for name in on_body:
         moved[name] = lbj + rodrigues(hp[name] - lbj, x[4:7])
     return moved
+
+
+class PointwiseAxle:
+    """pin_susp.pointwise's axle (both corners, the rack, the bar: points as unknowns,
+    scipy) with the sweep's own units: mm, deg, relative point targets from its own
+    design state."""
+
+    def __init__(self, axle):
+        from pin_susp.pointwise import PointwiseAxle as Points
+
+        self.points_model = Points(axle)
+
+    def solve(self, targets, step: int):
+        """Step ``step`` of a sweep's targets, from the design state: (points in mm,
+        max |residual| in SI)."""
+        m = self.points_model
+        values = []
+        for t in targets:
+            v = float(t.values[step])
+            if t.quantity == "roll":
+                values.append(np.radians(v))
+            elif t.quantity == "heave" or t.mode == "absolute":
+                values.append(v * 1e-3)
+            else:  # relative: from the design position along the direction
+                values.append(v * 1e-3 + m.design[f"{t.side}_{t.point}"] @ t.unit_direction)
+        x, residual = m.solve(m.targets(targets, values))
+        return {k: v * 1e3 for k, v in m.points(x).items()}, residual

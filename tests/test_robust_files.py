@@ -329,7 +329,7 @@ def test_malformed_mjcf(corner, sweep):
     [
         ('<robot name="corner"><link name="a"/></robot>', "is not MJCF (a URDF?): its root"),
         ("<html><body/></html>", "is not MJCF: its root element is <html>, not <mujoco>"),
-        ("<mujoco/>", "is not the MJCF of this corner (example_corner): missing site"),
+        ("<mujoco/>", "is not the MJCF of this geometry (example_corner): missing site"),
     ],
     ids=["urdf", "html", "empty mujoco"],
 )
@@ -351,8 +351,8 @@ def test_mjcf_of_another_corner_via_the_cli(tmp_path, capsys):
             str(exported),
         ],
     )
-    assert err.startswith(f"pin-susp: error: {exported}: is not the MJCF of this corner")
-    assert "has a site rocker_axis_a this corner does not have" in err
+    assert err.startswith(f"pin-susp: error: {exported}: is not the MJCF of this geometry")
+    assert "has a site rocker_axis_a this model does not have" in err
     assert "agrees" not in err
 
 
@@ -360,7 +360,7 @@ def test_mjcf_of_another_corner_the_other_way(sweep):
     pushrod = pin_susp.Corner(EXAMPLES / "pushrod_rocker.yaml")
     text = tree_to_mjcf(pin_susp.Corner(EXAMPLES / "double_wishbone.yaml").tree)
     with pytest.raises(
-        PinSuspError, match="pushrod.xml: is not the MJCF of this corner .*missing site"
+        PinSuspError, match="pushrod.xml: is not the MJCF of this geometry .*missing site"
     ):
         check_mjcf(text, pushrod.tree, "pushrod.xml")
 
