@@ -759,24 +759,12 @@ def axle_results(model: AxleModel, sweep, solutions: list) -> AxleResults:
     """Every corner column per side (suffix ``_left``/``_right``, derivatives along
     that side's wheel-centre z and the rack, the other wheel held), the axle's
     columns, then the points (``left_…``, ``right_…``, the bar's)."""
-    from .metrics import metric_columns
-
     columns, units = AxleResults.solver_columns(solutions)
     qs = [s.q if s.converged else None for s in solutions]
     points = model.motion(qs, solutions)
-    sides = {}
-    for side, g in model.geometries.items():
-        design = {k: model.design_positions[f"{side}_{k}"][None] for k in model.point_names[side]}
-        own = {k: points[f"{side}_{k}"][side] for k in model.point_names[side]}
-        sides[side] = metric_columns(g, own, design, model.spring_sense[side])
-    for side, cols in sides.items():
-        for name, (values, column_unit) in cols.items():
-            columns[f"{name}_{side}"], units[f"{name}_{side}"] = values, column_unit
+    for name, (values, column_unit) in axle_metric_columns(model, points).items():
+        columns[name], units[name] = values, column_unit
     plain = {k: v["left"].val for k, v in points.items()}
-    for name, (values, column_unit) in _axle_metrics(model, plain, sides).items():
-        columns[name], units[name] = values, column_unit
-    for name, (values, column_unit) in _roll_rates(model, points, sides).items():
-        columns[name], units[name] = values, column_unit
     for name in model.output_points:
         for i, axis in enumerate("xyz"):
             columns[f"{name}_{axis}"] = plain[name][:, i] * 1e3
@@ -784,6 +772,22 @@ def axle_results(model: AxleModel, sweep, solutions: list) -> AxleResults:
     source = model.axle.source if model.axle is not None else "<geometries>"
     sha = model.axle.sha256 if model.axle is not None else None
     return AxleResults(columns, units, AxleResults.solver_meta(solutions, (source, sha), sweep))
+
+
+def axle_metric_columns(model: AxleModel, points: dict) -> dict:
+    """name → (values, unit): each side's corner columns (suffixed), the axle's, and
+    the roll derivatives, from the points of ``AxleModel.motion`` (or any engine's
+    points with their rates in that form)."""
+    from .metrics import metric_columns
+
+    sides = {}
+    for side, g in model.geometries.items():
+        design = {k: model.design_positions[f"{side}_{k}"][None] for k in model.point_names[side]}
+        own = {k: points[f"{side}_{k}"][side] for k in model.point_names[side]}
+        sides[side] = metric_columns(g, own, design, model.spring_sense[side])
+    out = {f"{name}_{side}": c for side, cols in sides.items() for name, c in cols.items()}
+    plain = {k: v["left"].val for k, v in points.items()}
+    return out | _axle_metrics(model, plain, sides) | _roll_rates(model, points, sides)
 
 
 def _motion(model: AxleModel, qs: list, solutions: list | None = None) -> dict:

@@ -111,6 +111,8 @@ class NewtonSolver:
         """dq per unit of each target value, at the last evaluated state: J·T = [0; I]
         (or J·T = ``rhs``: a column per change of the rows' values, e.g. a link's length)."""
         rhs = self._unit_rhs if rhs is None else rhs
+        if self.jacobian.shape[0] != self.jacobian.shape[1]:  # more rows than freedoms
+            return np.full((self.jacobian.shape[1], rhs.shape[1]), np.nan)
         _, _, T, info = lapack.dgesv(self.jacobian, rhs)
         return T if info == 0 else np.full((self.jacobian.shape[1], rhs.shape[1]), np.nan)
 

@@ -656,6 +656,10 @@ def test_a_rigid_bar_cannot_roll(tmp_path, bar):
     assert model.positions(solutions[0].q)["left_wheel_center"][2] == pytest.approx(
         model.design_positions["left_wheel_center"][2] - 0.03
     )
+    # one wheel cannot move with the other held: those rates are blank, the rest is written
+    columns = axle_results(model, sweep, solutions).columns
+    assert np.isfinite(columns["camber_left"]).all() and np.isfinite(columns["arb_twist"]).all()
+    assert np.isnan(columns["deriv_camber_wrt_hub_z_left"]).all()
 
 
 def test_an_older_open_kinematics_axle_layout_is_named(tmp_path):

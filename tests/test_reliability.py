@@ -195,6 +195,7 @@ def test_a_step_past_a_loop_toggle_is_flagged_branch_not_converged(tmp_path, cap
         assert (r["solver_max_residual"][ok] <= 1e-9).all()
 
 
+@pytest.mark.filterwarnings("ignore::pin_susp.errors.PlausibilityWarning")  # a flipped upright
 def test_without_the_branch_check_the_same_targets_give_a_flipped_upright():
     """The check is not vacuous: Newton alone meets the residual on the other branch."""
     corner = pin_susp.Corner(FLIP)
