@@ -207,7 +207,12 @@ def _sweep_command(sub) -> None:
     s.add_argument("sweep", metavar="SWEEP", help="sweep YAML (targets per step)")
     s.add_argument("-o", "--output", required=True, metavar="OUT.csv", help="results CSV")
     s.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
-    s.add_argument("--plot", metavar="OUT.png", help="also draw the standard kinematics report")
+    s.add_argument(
+        "--plot",
+        metavar="OUT.png",
+        help="also draw the standard kinematics report (an axle's: camber, toe, steer, roll "
+        "centre, bar twist, ... against roll, heave or rack)",
+    )
     s.set_defaults(run=_sweep)
 
 
@@ -222,6 +227,16 @@ def _sweep(args) -> int:
     corner.solver_for(sweep.targets, sweep.source)  # target errors before any work
     results = corner.run_sweep(sweep, progress=_progress_bar(sweep.steps, args.quiet))
     _warn_transmission(results)
+    plot = _write_results(args, results)
+    if not args.quiet:
+        _summary(results, args.output)
+        if plot:
+            print(f"wrote {args.plot}")
+    return _report_failures(results)
+
+
+def _write_results(args, results) -> bool:
+    """The CSV and, with --plot, the report: both or neither; whether it was drawn."""
     plot = args.plot is not None and results["solver_converged"].any()
     text = csv_text(results)
     with all_or_none():
@@ -233,11 +248,7 @@ def _sweep(args) -> int:
             save_figure(report_figure([written]), args.plot)
     if args.plot is not None and not plot:
         print(f"pin-susp: no step converged: {args.plot} not drawn", file=sys.stderr)
-    if not args.quiet:
-        _summary(results, args.output)
-        if plot:
-            print(f"wrote {args.plot}")
-    return _report_failures(results)
+    return plot
 
 
 def _is_axle(path) -> bool:
@@ -258,13 +269,11 @@ def _sweep_axle(args) -> int:
     """An axle's sweep: both corners' columns (suffixed by side) and the axle's."""
     from .axle import axle_results, solve_axle_sweep
 
-    if args.plot is not None:
-        raise PinSuspError("--plot: the axle report is not drawn yet (the CSV is written)")
     model = _axle_model(args.geometry)
     sweep = load_sweep(args.sweep)
     solutions = solve_axle_sweep(model, sweep, progress=_progress_bar(sweep.steps, args.quiet))
     results = axle_results(model, sweep, solutions)
-    write_text(csv_text(results), args.output)
+    plot = _write_results(args, results)
     if not args.quiet:
         ok = results["solver_converged"]
         print(
@@ -280,6 +289,8 @@ def _sweep_axle(args) -> int:
                     f"{np.nanmin(v):>13.6g}{np.nanmax(v):>13.6g}"
                 )
         print("  (every column of both corners, suffixed _left/_right, is in the CSV)")
+        if plot:
+            print(f"wrote {args.plot}")
     return _report_failures(results)
 
 
@@ -420,7 +431,8 @@ def _validate_command(sub) -> None:
         description="Solve SWEEP with pin_susp, then re-solve every step independently with "
         "MuJoCo (from the exported MJCF) and with a point-based formulation (hardpoints as "
         "unknowns, rigid distances, scipy); print the largest difference per column and "
-        "engine; exit 1 where one exceeds the tolerance. MuJoCo is optional: "
+        "engine; exit 1 where one exceeds the tolerance. GEOMETRY is a corner or an axle "
+        "(scope: axle: each side's columns, the axle's, the bar). MuJoCo is optional: "
         "pip install 'pin_susp[validate]'.",
     )
     _geometry_argument(va)
@@ -443,9 +455,12 @@ def _validate_command(sub) -> None:
 def _validate(args) -> int:
     from .validate import validate
 
-    corner = Corner(load_geometry(args.geometry))
+    axle = _is_axle(args.geometry)
+    corner = _axle_model(args.geometry) if axle else Corner(load_geometry(args.geometry))
     sweep = load_sweep(args.sweep)
-    corner.solver_for(sweep.targets, sweep.source)
+    if not axle:  # an axle's target errors come from its solve, before any work
+        corner.solver_for(sweep.targets, sweep.source)
+    name = corner.axle.name if axle else corner.geometry.name
     mjcf_text = None
     if args.mjcf is not None:
         try:
@@ -459,7 +474,7 @@ def _validate(args) -> int:
     )
     names = list(dict.fromkeys(n for r in reports for n in r.differences))
     print(
-        f"{corner.geometry.name}: {len(results)} steps of {sweep.source}, each re-solved from "
+        f"{name}: {len(results)} steps of {sweep.source}, each re-solved from "
         "the design state; largest |difference| to pin_susp"
     )
     width = max(map(len, names), default=6) + 2
@@ -488,10 +503,10 @@ def _validate(args) -> int:
         if getattr(r, "warnings", 0):
             print(f"  {r.engine}: {r.warnings} warnings (first: {r.first_warning})")
         if r.agrees:
-            print(
-                f"  {r.engine}: agrees within {args.tolerance:g} mm/deg "
-                "(instant centres also within 1e-9 of their size)"
+            centres = "instant centres also within 1e-9 of their size" + (
+                "; the roll centre of its size times max(1, |RC|/track)" if axle else ""
             )
+            print(f"  {r.engine}: agrees within {args.tolerance:g} mm/deg ({centres})")
         else:
             ok = False
             print(
@@ -803,6 +818,12 @@ def _setup_command(sub) -> None:
         help="with targets: write the geometry with the setup found",
     )
     t.add_argument("--csv", metavar="OUT.csv", help="also write the sheet's rows as CSV")
+    t.add_argument(
+        "--side",
+        choices=("left", "right"),
+        help="an axle with its own right points: listed values and targets set this side "
+        "alone (default: both sides; a mirrored axle has one setup for both)",
+    )
     t.set_defaults(run=_setup)
 
 
@@ -810,7 +831,6 @@ def _setup(args) -> int:
     from . import setup
 
     _check_outputs(args, args.output, args.csv)
-    geometry = load_geometry(args.geometry)
     targets = {
         name: value
         for name, value in (
@@ -822,43 +842,126 @@ def _setup(args) -> int:
     }
     if args.output is not None and not targets:
         raise PinSuspError("-o writes a solved setup: give --camber, --toe or --ride-height-change")
+    if _is_axle(args.geometry):
+        return _setup_axle(args, targets)
+    if args.side is not None:
+        raise PinSuspError(f"--side: {args.geometry} is a corner (--side sets one side of an axle)")
+    geometry = load_geometry(args.geometry)
     title = f"{geometry.name}: setup sheet ({geometry.source})"
     link = _link(geometry)
     if targets:
         found = setup.solve_setup(geometry, targets)
         print(title)
         _sheet([found.before, found.after], ["before", "after"], _link(geometry))
-        print(
-            f"  hit {', '.join(f'{k} {v:g}' for k, v in targets.items())} "
-            f"in {found.iterations} Newton iterations"
-        )
+        _hit(targets, found.iterations)
         with all_or_none():
             if args.output is not None:
-                data = setup.geometry_data(found.geometry)
-                text = yaml.safe_dump(data, sort_keys=False, default_flow_style=None)
-                head = f"# {geometry.name}: setup solved by pin-susp setup\n"
-                write_text(head + text, args.output)
+                _write_setup(setup.geometry_data(found.geometry), geometry.name, args.output)
             if args.csv is not None:
                 _sheet_csv([found.before, found.after], ["before", "after"], args.csv, link)
-        for path in (args.output, args.csv):
-            if path is not None:
-                print(f"wrote {path}")
+        _wrote(args.output, args.csv)
         return 0
     rows = setup.setup_sheet(geometry, args.shim, args.trackrod, args.pushrod)
-    labels = (
-        ["as set"]
-        + ["shim"] * len(args.shim)
-        + [link] * len(args.trackrod)
-        + ["pushrod"] * len(args.pushrod)
-    )
+    labels = _sheet_labels(args, link)
     print(title)
     _sheet(rows, labels, link)
     if args.sensitivities:
         _sensitivities(rows[0], geometry, args.thread_pitch)
     if args.csv is not None:
         _sheet_csv(rows, labels, args.csv, link)
-        print(f"wrote {args.csv}")
+    _wrote(args.csv)
     return 0
+
+
+def _setup_axle(args, targets: dict) -> int:
+    """An axle: each side's sheet as its corner's (its own shim and adjusters), the axle's
+    static columns of both sides together, or the inverse solve per side."""
+    from . import setup
+    from .axle import SIDES, load_axle
+
+    axle = load_axle(args.geometry)
+    chosen = setup.set_sides(axle, args.side)
+    link = _link(axle.left)
+    if targets:
+        found = setup.solve_axle_setup(axle, targets, args.side)
+        rows = {s: [found[s].before, found[s].after] for s in SIDES}
+        labels = ["before", "after"]
+    else:
+        rows = setup.axle_setup_sheet(axle, args.shim, args.trackrod, args.pushrod, args.side)
+        labels = _sheet_labels(args, link)
+    # the axle's columns per row: both sides as set in that row (a side not set: as set)
+    statics = [
+        setup.axle_static(axle, {s: rows[s][min(i, len(rows[s]) - 1)] for s in SIDES})
+        for i in range(len(labels))
+    ]
+    print(f"{axle.name}: setup sheet per side ({axle.source})")
+    for s in SIDES:
+        if s == "right" and axle.mirrored:
+            print(
+                "  right corner (the left mirrored: it takes the left's setup, the same shim "
+                "stack and length deltas):"
+            )
+        else:
+            setting = "" if s in chosen else f"; not set: --side {args.side}"
+            print(f"  {s} corner (axle_config.{s}_setup{setting}):")
+        _sheet(rows[s], labels[: len(rows[s])], link)
+        if targets and found[s].iterations:
+            _hit(targets, found[s].iterations)
+        if args.sensitivities and not targets:
+            _sensitivities(rows[s][0], axle.corner(s), args.thread_pitch)
+    print("  axle (both sides as set in each row):")
+    print(f"  {'':9}" + "".join(f"{head:>12}" for _, head in setup.AXLE_STATIC))
+    print(f"  {'':9}" + "".join(f"{'mm':>12}" for _ in setup.AXLE_STATIC))
+    for label, row in zip(labels, statics, strict=True):
+        cells = (round(row[name], 3) + 0.0 for name, _ in setup.AXLE_STATIC)
+        print(
+            f"  {label:9}"
+            + "".join(f"{v:>12.3f}" if np.isfinite(v) else f"{'-':>12}" for v in cells)
+        )
+    with all_or_none():
+        if args.output is not None:
+            data = setup.axle_data(axle, {s: found[s].geometry for s in chosen})
+            _write_setup(data, axle.name, args.output)
+        if args.csv is not None:
+            sides = [(s, i) for s in SIDES for i in range(len(rows[s]))]
+            _sheet_csv(
+                [rows[s][i] for s, i in sides],
+                [f"{s} {labels[i]}" for s, i in sides],
+                args.csv,
+                link,
+                [statics[i] for _, i in sides],
+            )
+    _wrote(args.output, args.csv)
+    return 0
+
+
+def _sheet_labels(args, link: str) -> list[str]:
+    """The sheet's row labels: the as-set row, then one per listed value."""
+    return (
+        ["as set"]
+        + ["shim"] * len(args.shim)
+        + [link] * len(args.trackrod)
+        + ["pushrod"] * len(args.pushrod)
+    )
+
+
+def _hit(targets: dict, iterations: int) -> None:
+    print(
+        f"  hit {', '.join(f'{k} {v:g}' for k, v in targets.items())} "
+        f"in {iterations} Newton iterations"
+    )
+
+
+def _write_setup(data: dict, name: str, path) -> None:
+    """A geometry (corner or axle) file with the setup found."""
+    text = yaml.safe_dump(data, sort_keys=False, default_flow_style=None)
+    write_text(f"# {name}: setup solved by pin-susp setup\n" + text, path)
+
+
+def _wrote(*paths) -> None:
+    for path in paths:
+        if path is not None:
+            print(f"wrote {path}")
 
 
 def _link(geometry) -> str:
@@ -909,17 +1012,21 @@ def _sensitivities(state, geometry, pitch) -> None:
         )
 
 
-def _sheet_csv(rows, labels, path, link: str = "trackrod") -> None:
+def _sheet_csv(rows, labels, path, link: str = "trackrod", extra=None) -> None:
+    """The sheet's rows; ``extra``: per row, more columns (name → value), e.g. an
+    axle's track and roll centre."""
     from .export import atomic_write, format_cell
 
     setup_columns = [c.replace("trackrod", link.replace(" ", "_")) for c in SETUP_COLUMNS]
     names = ["row", *setup_columns] + [name for name, _, _ in SHEET_METRICS]
+    extra = extra or [{}] * len(rows)
     with atomic_write(path) as f:
         f.write(f"# pin_susp {__version__} setup sheet; lengths mm, angles deg\n")
-        f.write(",".join(names) + "\n")
-        for label, row in zip(labels, rows, strict=True):
+        f.write(",".join(names + list(extra[0])) + "\n")
+        for label, row, more in zip(labels, rows, extra, strict=True):
             cells = [label, *map(format_cell, row.setup)]
             cells += [format_cell(row.metrics[name]) for name, _, _ in SHEET_METRICS]
+            cells += [format_cell(v) for v in more.values()]
             f.write(",".join(cells) + "\n")
 
 
@@ -952,14 +1059,24 @@ def _sensitivity_command(sub) -> None:
         "and link ends, not the spindle points), chassis, upright, all, or names separated "
         "by commas (the CSV always has every hardpoint)",
     )
+    h.add_argument(
+        "--one-sided",
+        action="store_true",
+        help="an axle: move each side's point alone (hardpoints left_P, right_P); default "
+        "a symmetric move, the left P by (dx, dy, dz) and the right P by (dx, -dy, dz)",
+    )
     h.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
     h.set_defaults(run=_sensitivity)
 
 
 def _sensitivity(args) -> int:
-    from .sensitivity import POINT_GROUPS, STEP, hardpoint_sensitivities, largest, select_points
+    from .sensitivity import hardpoint_sensitivities, select_points
 
     _check_outputs(args, args.output)
+    if _is_axle(args.geometry):
+        return _sensitivity_axle(args)
+    if args.one_sided:
+        raise PinSuspError("--one-sided: a corner has one side (it moves one side of an axle)")
     corner = Corner(load_geometry(args.geometry))
     points = select_points(corner, args.points)
     sweep = None
@@ -968,21 +1085,92 @@ def _sensitivity(args) -> int:
         corner.solver_for(sweep.targets, sweep.source)
     progress = _progress_bar(sweep.steps if sweep else 1, args.quiet)
     states, results = hardpoint_sensitivities(corner, sweep, progress, with_results=True)
+    notes = []
+    if corner.geometry.drawn is not None:
+        notes.append("(with respect to the as-set hardpoints: shim and adjusters applied)")
+    groups = [("", list(states[0].values) if states else [])]
+    return _sensitivity_report(args, corner.geometry, sweep, states, results, points, groups, notes)
+
+
+def _sensitivity_axle(args) -> int:
+    """An axle's: each side's corner columns (_left, _right) and the axle's (track, roll
+    centre, roll rates), for a symmetric move of both sides' points or a one-sided one."""
+    from .axle import SIDES
+    from .sensitivity import (
+        AXLE_COLUMNS,
+        ONE_SIDED_MOVE,
+        SYMMETRIC_MOVE,
+        AxleSensitivity,
+        axle_held,
+        axle_sensitivities,
+        select_points,
+    )
+
+    model = _axle_model(args.geometry)
+    sens = AxleSensitivity(model, args.one_sided)
+    points = select_points(sens.sides["left"].corner, args.points)
+    if args.one_sided:
+        points = [f"{side}_{p}" for side in SIDES for p in points]
+    sweep = None if args.sweep is None else load_sweep(args.sweep)
+    progress = _progress_bar(sweep.steps if sweep else 1, args.quiet)
+    states, results = axle_sensitivities(sens, sweep, progress)
+    move = ONE_SIDED_MOVE if args.one_sided else SYMMETRIC_MOVE
+    notes = [f"exact; {axle_held(model)}; {move}"]
+    if any(g.drawn is not None for g in model.geometries.values()):
+        notes.append("(with respect to the as-set hardpoints: shims and adjusters applied)")
+    columns = list(states[0].values) if states else []
+    groups = [("the axle:", AXLE_COLUMNS)]
+    for side in ("left",) if model.axle.mirrored else SIDES:
+        names = [n for n in columns if n.endswith(f"_{side}") and n not in AXLE_COLUMNS]
+        groups.append((f"the {side} corner (columns suffixed _{side}):", names))
+    if model.axle.mirrored:
+        groups.append(("the right corner's columns mirror the left's (a mirrored axle)", ()))
+    head = (f"hardpoint: {move}", axle_held(model))
+    return _sensitivity_report(
+        args, model.axle, sweep, states, results, points, groups, notes, head
+    )
+
+
+def _sensitivity_report(
+    args, geometry, sweep, states, results, points, groups, notes=(), csv_notes=()
+) -> int:
+    """The CSV (``csv_notes`` in its head), the steps without sensitivities, and the
+    printed table: a title, ``notes``, then per group (heading, columns) the largest
+    entries among ``points``. The exit code."""
+    from .sensitivity import POINT_GROUPS
+
     if args.output is not None:
-        _sensitivity_csv(states, corner, args.output)
+        _sensitivity_csv(states, geometry.source, args.output, csv_notes)
     status = 0 if results is None else _report_failures(results, "have no sensitivities")
     if args.quiet or not states:
         return status
     s = states[0]
     where = "the design state" if sweep is None else f"step {s.step} of {sweep.source}"
-    print(f"{corner.geometry.name}: hardpoint sensitivities at {where}")
-    if corner.geometry.drawn is not None:
-        print("  (with respect to the as-set hardpoints: shim and adjusters applied)")
+    print(f"{geometry.name}: hardpoint sensitivities at {where}")
+    for note in notes:
+        print(f"  {note}")
     chosen = POINT_GROUPS.get(args.points, ", ".join(points))
     print(f"  moving {chosen}; other points: --points chassis|upright|all|NAME,NAME")
+    for heading, names in groups:
+        if heading:
+            print(f"  {heading}")
+        _sensitivity_table(s, names, args.top, set(points))
+    if args.output is not None:
+        print(
+            f"wrote {args.output}: {len(states)} state(s) x {len(s.values)} metrics x "
+            f"{3 * len(s.hardpoints)} hardpoint coordinates (every hardpoint)"
+        )
+    return status
+
+
+def _sensitivity_table(s, names, top: int, points: set) -> None:
+    """The ``top`` largest entries of each column in ``names`` among ``points``; then the
+    columns these points do not move, and those undefined here."""
+    from .sensitivity import STEP, largest
+
     unmoved, undefined = [], []
-    for name in s.values:
-        entries = largest(s, name, args.top, set(points))
+    for name in names:
+        entries = largest(s, name, top, points)
         unit = s.units[name].removesuffix("/mm")
         if not np.isfinite(s.metrics[name]):
             undefined.append(name)
@@ -1002,20 +1190,15 @@ def _sensitivity(args) -> int:
         print(f"  not moved by these points here: {', '.join(unmoved)}")
     if undefined:
         print(f"  undefined here (blank in the results): {', '.join(undefined)}")
-    if args.output is not None:
-        print(
-            f"wrote {args.output}: {len(states)} state(s) x {len(s.values)} metrics x "
-            f"{3 * len(s.hardpoints)} hardpoint coordinates (every hardpoint)"
-        )
-    return status
 
 
-def _sensitivity_csv(states, corner, path) -> None:
+def _sensitivity_csv(states, source: str, path, notes=()) -> None:
     from .export import atomic_write, format_cell
 
     with atomic_write(path) as f:
-        f.write(f"# pin_susp {__version__} hardpoint sensitivities of {corner.geometry.source}\n")
+        f.write(f"# pin_susp {__version__} hardpoint sensitivities of {source}\n")
         f.write("# value = d(metric)/d(hardpoint coordinate), per mm of the coordinate\n")
+        f.writelines(f"# {note}\n" for note in notes)
         f.write("step_index,metric,hardpoint,axis,value,unit\n")
         for s in states:
             for name, values in s.values.items():
@@ -1034,7 +1217,10 @@ def _plot_command(sub) -> None:
         description="Camber, toe, caster, KPI, scrub, trail, half track (and instant centres, "
         "anti geometry, motion ratio, camber gain and bump steer where present) against wheel "
         "travel, or rack travel from centre for a steer sweep. Several CSVs compare designs "
-        "(of the same kind of sweep: a bump and a steer sweep cannot share one figure).",
+        "(of the same kind of sweep: a bump and a steer sweep cannot share one figure). An "
+        "axle's CSV gives the axle report: camber (to the chassis and to the ground), toe, "
+        "steer angle, roll centre height and lateral position, bar twist, per side, against "
+        "roll (else heave, else rack), and Ackermann against the mean steer angle.",
     )
     pl.add_argument("results", nargs="+", metavar="RESULTS.csv", help="pin-susp sweep output")
     pl.add_argument(
@@ -1057,11 +1243,14 @@ def _plot(args) -> int:
 def _draw_command(sub) -> None:
     dr = sub.add_parser(
         "draw",
-        help="front and side view drawing of a corner",
+        help="front and side view drawing of a corner (front view of an axle)",
         description="Draw GEOMETRY at its design (as-set) state in front and side view, with "
         "the instant-centre construction (ball joints to the front- and side-view instant "
         "centres, the contact patch through them, and the roll centre of a symmetric axle on "
-        "the centreline); a shimmed corner shows its drawn geometry dashed.",
+        "the centreline); a shimmed corner shows its drawn geometry dashed. An axle "
+        "(scope: axle) is drawn in front view, both corners, each contact patch through its "
+        "FVIC and the roll centre where the two lines cross; --at draws it at a step of its "
+        "sweep results.",
     )
     _geometry_argument(dr)
     dr.add_argument(
@@ -1070,16 +1259,35 @@ def _draw_command(sub) -> None:
     dr.add_argument(
         "--labels", action="store_true", help="name every hardpoint and add a colour legend"
     )
+    dr.add_argument(
+        "--at",
+        metavar="RESULTS.csv:STEP",
+        help="an axle: draw the pose of that step of its `pin-susp sweep` results "
+        "(default: the design state)",
+    )
     dr.set_defaults(run=_draw)
 
 
 def _draw(args) -> int:
-    from .plots import drawing_figure, save_figure
+    from .plots import ResultsFile, axle_drawing_figure, axle_pose, drawing_figure, save_figure
 
     _check_outputs(args, args.output)
     _check_image(args.output)
-    corner = Corner(load_geometry(args.geometry))
-    save_figure(drawing_figure(corner, labels=args.labels), args.output)
+    if args.at is not None:
+        path, _, step = args.at.rpartition(":")
+        if not path or not re.fullmatch(r"[0-9]{1,9}", step):
+            raise PinSuspError(f"--at {args.at}: expected RESULTS.csv:STEP, e.g. axle.csv:15")
+    if _is_axle(args.geometry):
+        model = _axle_model(args.geometry)
+        q, caption = None, "design state"
+        if args.at is not None:
+            q, caption = axle_pose(model, ResultsFile(path), int(step))
+        figure = axle_drawing_figure(model, q, labels=args.labels, caption=caption)
+    elif args.at is not None:
+        raise PinSuspError(f"--at: {args.geometry} is a corner, drawn at its design state only")
+    else:
+        figure = drawing_figure(Corner(load_geometry(args.geometry)), labels=args.labels)
+    save_figure(figure, args.output)
     print(f"wrote {args.output}")
     return 0
 
@@ -1090,7 +1298,8 @@ def _view_command(sub) -> None:
         help="3D view in meshcat (live, or a self-contained HTML replay)",
         description="Open GEOMETRY in a meshcat scene served locally (works offline) and print "
         "its URL; with SWEEP, play the solved motion as an animation. --html writes the scene "
-        "and animation as one HTML file that opens in a browser with no server.",
+        "and animation as one HTML file that opens in a browser with no server. An axle file "
+        "shows both corners, the anti-roll bar and the roll centre (hidden where it is blank).",
     )
     _geometry_argument(v)
     v.add_argument("sweep", metavar="SWEEP", nargs="?", help="sweep YAML to animate")
@@ -1104,25 +1313,33 @@ def _view(args) -> int:
     import io
     import time
 
-    from .viz import CornerScene
+    from .viz import Scene, roll_centres
 
     _check_outputs(args, args.html)
-    corner = Corner(load_geometry(args.geometry))
-    qs, results = None, None
+    axle = _is_axle(args.geometry)
+    model = _axle_model(args.geometry) if axle else Corner(load_geometry(args.geometry))
+    qs, results, markers = None, None, None
     if args.sweep is not None:
         sweep = load_sweep(args.sweep)
-        corner.solver_for(sweep.targets, sweep.source)
-        results = corner.run_sweep(sweep, progress=_progress_bar(sweep.steps, False))
-        _warn_transmission(results)
+        progress = _progress_bar(sweep.steps, False)
+        if axle:  # both corners, the bar, and the roll centre from the results' columns
+            from .axle import axle_results, solve_axle_sweep
+
+            results = axle_results(model, sweep, solve_axle_sweep(model, sweep, progress=progress))
+            markers = {"roll_centre": roll_centres(results)}
+        else:
+            model.solver_for(sweep.targets, sweep.source)
+            results = model.run_sweep(sweep, progress=progress)
+            _warn_transmission(results)
         qs = [
             q if ok else None
             for q, ok in zip(results.meta["q"], results["solver_converged"], strict=True)
         ]
     quiet = io.StringIO()
     with contextlib.redirect_stdout(quiet):  # meshcat announces its server on stdout
-        scene = CornerScene(corner)
+        scene = Scene(model)
     try:
-        frames = scene.animate(qs, fps=args.fps) if qs is not None else 0
+        frames = scene.animate(qs, fps=args.fps, markers=markers) if qs is not None else 0
         if args.html is not None:
             write_text(scene.html(), args.html)
             print(f"wrote {args.html}" + (f" ({frames} frames)" if frames else ""))
