@@ -726,16 +726,22 @@ def solve_axle_sweep(model: AxleModel, sweep, source: str | None = None, progres
         [getattr(row, "value", 0.0) for row in rows]
     )
     solver.keep_jacobian = True  # exact tangents: a better prediction, and the columns' rates
-    found = []
-    solutions = march(solver, values, model.q_design, previous, progress, tangents=found)
     drive = _drive_rows(model)
+    found = []
+
+    def per_driver(tangent: np.ndarray) -> np.ndarray | None:
+        """dq per driver from dq per target, T·(J_drive·T)⁻¹, at the solution (a rigid
+        bar has fewer freedoms than drivers: its per-side rates stay blank)."""
+        if tangent.shape[1] != len(drive):
+            return None
+        across = np.vstack([row.jacobian(model.kin) for row in drive]) @ tangent
+        return tangent @ np.linalg.inv(across)
+
+    solutions = march(
+        solver, values, model.q_design, previous, progress, tangents=found, keep=per_driver
+    )
     for solution, tangent in zip(solutions, found, strict=True):
-        # dq per driver from dq per target: T·(J_drive·T)⁻¹ (a rigid bar has fewer
-        # freedoms than drivers: its per-side rates stay blank)
-        if tangent is not None and tangent.shape[1] == len(drive):
-            model.kin.update(solution.q)
-            across = np.vstack([row.jacobian(model.kin) for row in drive]) @ tangent
-            solution.drive_tangent = tangent @ np.linalg.inv(across)
+        solution.drive_tangent = tangent
     return solutions
 
 

@@ -13,8 +13,6 @@ import math
 import numpy as np
 import pinocchio as pin
 
-from .geometry import wheel_down
-
 WORLD = pin.LOCAL_WORLD_ALIGNED
 
 
@@ -93,13 +91,17 @@ class ContactPatchPoint:
         v = P[2] - P[1]
         n = math.sqrt(v @ v)
         a = v / n
-        down, norm = wheel_down(a)
+        u = a * a[2]  # wheel_down's, inline (a hot path): d̂ = unit(a_z·â − Ẑ)
+        u[2] -= 1.0
+        norm = math.sqrt(u @ u)
+        down = u / norm
         position = P[0] + self.radius * down
         if J is None:
             return position, None
-        da = (J[2] - J[1] - np.outer(a, a @ (J[2] - J[1]))) / n
-        du = np.outer(a, da[2]) + a[2] * da
-        dd = (du - np.outer(down, down @ du)) / norm
+        dv = J[2] - J[1]
+        da = (dv - a[:, None] * (a @ dv)) / n
+        du = a[:, None] * da[2] + a[2] * da
+        dd = (du - down[:, None] * (down @ du)) / norm
         return position, J[0] + self.radius * dd
 
 

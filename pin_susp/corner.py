@@ -139,7 +139,7 @@ class Corner(Linkage):
             progress=progress,
             step_times=step_times,
             tangents=tangents if order is not None else None,
-            order=order,
+            keep=None if order is None else lambda tangent: tangent[:, order],
         )
 
     def _values_at(self, solver: NewtonSolver, q: np.ndarray) -> np.ndarray:

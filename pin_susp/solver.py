@@ -201,7 +201,7 @@ def march(
     progress=None,
     step_times=None,
     tangents: list | None = None,
-    order=None,
+    keep=None,
 ) -> list[Solution]:
     """Solve a sweep's steps (``values``: a row of target values each) in order, each
     from a prediction off the last solutions (halving toward it on failure).
@@ -209,7 +209,8 @@ def march(
     ``q``, ``previous``: a solved configuration and its target values to start from;
     ``progress(done, total)`` after each step; ``step_times``: a list that receives
     each step's solve time (s); ``tangents``: a list that receives each step's exact
-    tangent (solver.keep_jacobian must be set), its columns in ``order`` if given.
+    tangent (solver.keep_jacobian must be set), or ``keep(tangent)`` if given — called
+    with the kinematics (Jacobians too) at the solution.
     """
     predictor = Predictor(solver.kin.model)
     # which steps repeat the one before (a uniform sweep): worked out once for all
@@ -234,8 +235,7 @@ def march(
             tangent = solver.tangent()
             predictor.add(q, previous, tangent, exact=solver.keep_jacobian)
         if tangents is not None:
-            keep = tangent if order is None or tangent is None else tangent[:, order]
-            tangents.append(keep)
+            tangents.append(tangent if keep is None or tangent is None else keep(tangent))
         if step_times is not None:
             step_times.append(clock() - started)
         solutions.append(solution)
