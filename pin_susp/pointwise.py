@@ -8,7 +8,7 @@ validate`` and the tests solve every step with it and compare.
 
 An axle (spec/axle.md) is both corners' formulations with their names
 prefixed by side, one rack unknown that moves both trackrods' inboard ends,
-and the anti-roll bar's parts and droplinks (:data:`ANTI_ROLL`).
+and the anti-roll bar's parts, droplinks and plane rows (:data:`ANTI_ROLL`).
 """
 
 from __future__ import annotations
@@ -93,6 +93,23 @@ class Roll:
         }
 
 
+@dataclass(frozen=True)
+class Midpoint:
+    """The midpoint of two points held in a plane: its coordinate along the plane's
+    unit normal at a value (m, absolute)."""
+
+    a: str
+    b: str
+    normal: np.ndarray
+    value: float
+
+    def error(self, p) -> float:
+        return 0.5 * (p[self.a] + p[self.b]) @ self.normal - self.value
+
+    def gradient(self, p) -> dict[str, np.ndarray]:
+        return {self.a: 0.5 * self.normal, self.b: 0.5 * self.normal}
+
+
 def as_target(t):
     """A target object; a tuple (point, unit direction, value m) is an :class:`Along`."""
     return t if hasattr(t, "error") else Along(*t)
@@ -110,13 +127,16 @@ class PointwiseLinkage:
     distance, each line condition the cross product (p − a) × unit(b − a) = 0.
     ``racks``: points that slide along y together (one unknown, the rack's
     displacement); ``wheels``: name prefix → Wheel, whose derived points
-    (wheel centre, contact patch, …) follow ``<prefix>axle_inboard/outboard``.
+    (wheel centre, contact patch, …) follow ``<prefix>axle_inboard/outboard``;
+    ``planes``: conditions always held, written as targets (a :class:`Midpoint`),
+    their rows after the line conditions'.
     """
 
-    def __init__(self, spec: Pointwise, hp: dict, wheels: dict[str, Wheel], racks=()):
+    def __init__(self, spec: Pointwise, hp: dict, wheels: dict[str, Wheel], racks=(), planes=()):
         hp = dict(hp)
         fixed = set(spec.fixed)
         self.racks = tuple(racks)
+        self.planes = list(planes)
         self.wheels = wheels
         # points of one part that coincide are one point (two links meeting in a ball)
         self.alias = {}
@@ -184,32 +204,35 @@ class PointwiseLinkage:
         rows += [as_target(t).error(p) for t in targets]
         for point, a, b in self.lines:
             rows += list(np.cross(p[point] - p[a], (p[b] - p[a]) / np.linalg.norm(p[b] - p[a])))
+        rows += [t.error(p) for t in self.planes]
         return np.array(rows)
 
     def jacobian(self, x: np.ndarray, targets) -> np.ndarray:
-        """Analytic: distance rows, and targets through the points they hold (derived
-        points through â = unit(AO − AI)); the line conditions by central differences."""
+        """Analytic: distance rows, targets and planes through the points they hold
+        (derived points through â = unit(AO − AI)); the line conditions by central
+        differences."""
         p = self.points(x)
-        J = np.zeros((len(self.pairs) + len(targets) + 3 * len(self.lines), len(x)))
+        lines = len(self.pairs) + len(targets)  # the first line row
+        J = np.zeros((lines + 3 * len(self.lines) + len(self.planes), len(x)))
         for row, (a, b, _) in enumerate(self.pairs):
             u = (p[a] - p[b]) / np.linalg.norm(p[a] - p[b])
             self._add(J[row], a, u)
             self._add(J[row], b, -u)
-        for k, t in enumerate(targets):
-            row = J[len(self.pairs) + k]
-            for name, gradient in as_target(t).gradient(p).items():
+        held = [*map(as_target, targets), *([None] * (3 * len(self.lines))), *self.planes]
+        for row, t in zip(J[len(self.pairs) :], held, strict=True):
+            for name, gradient in t.gradient(p).items() if t is not None else ():
                 if name in self.derived:
                     for end, d in self._derived(name, p).items():
                         self._add(row, end, d.T @ gradient)
                 else:
                     self._add(row, name, gradient)
         if self.lines:
-            first, h = len(self.pairs) + len(targets), 1e-7
+            end, h = lines + 3 * len(self.lines), 1e-7
             for i in range(len(x)):
                 e = np.zeros(len(x))
                 e[i] = h
                 up, down = self.residual(x + e, targets), self.residual(x - e, targets)
-                J[first:, i] = (up[first:] - down[first:]) / (2 * h)
+                J[lines:end, i] = (up[lines:end] - down[lines:end]) / (2 * h)
         return J
 
     def _add(self, row: np.ndarray, name: str, gradient: np.ndarray) -> None:
@@ -330,12 +353,12 @@ class PointwiseAxle(PointwiseLinkage):
                 f"the point-based formulation has no {axle.anti_roll} anti-roll bar yet "
                 f"(it has: {', '.join(ANTI_ROLL)})"
             )
-        ANTI_ROLL[axle.anti_roll](axle, corners, spec, hp)
+        planes = ANTI_ROLL[axle.anti_roll](axle, corners, spec, hp)
         if axle.heave_link != "none":  # measured only: a point on each rocker
             for side in SIDES:
                 spec.parts[f"{side}_rocker"].append(f"{side}_heave_link_rocker")
         wheels = {f"{side}_": g.wheel for side, g in corners.items()}
-        super().__init__(spec, hp, wheels, racks)
+        super().__init__(spec, hp, wheels, racks, planes)
         self.axle = axle
         self.design = self.points(self.x0)
 
@@ -360,60 +383,90 @@ def axle_targets(sweep_targets, values, design: dict) -> list:
     return out
 
 
-def _no_bar(axle, corners, spec, hp) -> None:
+def _no_bar(axle, corners, spec, hp) -> list:
     """No anti-roll bar: nothing joins the sides but the rack."""
+    return []
 
 
-def _u_bar(axle, corners, spec, hp) -> None:
+def _u_bar(axle, corners, spec, hp) -> list:
     """Each side's bar arm is a part of three points: the bar's axis ends, fixed on
     the chassis, and the arm's end, which keeps its distance to both (it turns on a
     circle about the axis). A rigid droplink joins each arm's end to
     ``droplink_rocker`` on the rocker or, without a rocker, to ``droplink_lower`` on
     the body named by ``anti_roll.mount`` (``arm``: the wheel's body).
 
-    A rigid bar (``stiffness: rigid``) is one part: the axis, both arm ends, and
-    ``arb_bar_quarter``, a point a quarter turn round from the right arm's end — the
-    distance between two parallel arms' ends is at its minimum, so alone it would
-    not fix their relative turn (its gradient vanishes there)."""
+    A rigid bar (``stiffness: rigid``) is one part on the axis (:func:`_rigid_bar`)."""
     axis = ("arb_u_bar_axis_a", "arb_u_bar_axis_b")
+    ends = [f"{side}_droplink_u_bar" for side in SIDES]
     spec.fixed.update(axis)
-    rigid = getattr(axle, "anti_roll_rigid", False)
-    if rigid:
-        a, b = (hp[n] for n in axis)
-        u = (b - a) / np.linalg.norm(b - a)
-        end = hp["right_droplink_u_bar"]
-        foot = a + u * ((end - a) @ u)
-        hp["arb_bar_quarter"] = foot + np.cross(u, end - foot)
-        spec.parts["arb_bar"] = [*axis, "arb_bar_quarter"]
-    for side in SIDES:
-        end = f"{side}_droplink_u_bar"
-        if rigid:
-            spec.parts["arb_bar"].append(end)
-        else:
-            spec.parts[f"{side}_arb_arm"] = [*axis, end]
-        _droplink(axle, corners[side], side, end, spec)
-
-
-def _droplink(axle, g: Geometry, side: str, end: str, spec) -> None:
-    """A rigid link from the rocker's ``droplink_rocker`` (or ``droplink_lower`` on the
-    body ``anti_roll.mount`` names) to the bar's point ``end``."""
-    if "droplink_rocker" in axle.side_points[side]:
-        upper, body = "droplink_rocker", "rocker"
+    if getattr(axle, "anti_roll_rigid", False):
+        _rigid_bar(axis, ends, spec, hp)
     else:
-        mount = axle.anti_roll_mount
-        upper, body = "droplink_lower", g.mechanism.WHEEL_BODY if mount == "arm" else mount
-    if f"{side}_{body}" not in spec.parts:
-        own = [p.removeprefix(f"{side}_") for p in spec.parts if p.startswith(f"{side}_")]
-        raise PinSuspError(
-            f"the point-based formulation has no rigid part {body!r} to carry the "
-            f"droplink (its parts: {', '.join(own)})"
-        )
-    spec.parts[f"{side}_{body}"].append(f"{side}_{upper}")
-    spec.links.append((f"{side}_{upper}", end))
+        for side in SIDES:
+            spec.parts[f"{side}_arb_arm"] = [*axis, f"{side}_droplink_u_bar"]
+    _droplinks(axle, corners, "droplink_u_bar", spec)
+    return []
 
 
-# anti_roll.type → what it adds to the axle's parts, links, lines and fixed points.
-# A T-bar would be one part (arb_t_bar_pivot and both droplink_t_bar, the pivot
-# fixed: a ball), its droplinks as here, and one plane row: the crossbar's midpoint
-# in y = 0.
-ANTI_ROLL = {"none": _no_bar, "u_bar": _u_bar}
+def _t_bar(axle, corners, spec, hp) -> list:
+    """The crossbar's ends and the pivot ``arb_t_bar_pivot`` (fixed: a ball) are one
+    part, a rigid triangle; one plane row holds the crossbar's midpoint in y = 0 (at
+    its design y, which the axle's check keeps within 0.02 mm of it); a rigid
+    droplink from each end as for the U-bar.
+
+    A rigid bar (``stiffness: rigid``) cannot twist: the crossbar only pitches about
+    the chassis y axis through the pivot — the U-bar's rigid bar on that axis, its
+    second point ``arb_t_bar_axis`` (the pivot moved along y as far as the left end
+    is from it). Its midpoint then stays in its plane by itself."""
+    pivot = "arb_t_bar_pivot"
+    ends = [f"{side}_droplink_t_bar" for side in SIDES]
+    spec.fixed.add(pivot)
+    planes = []
+    if getattr(axle, "anti_roll_rigid", False):
+        hp["arb_t_bar_axis"] = hp[pivot] + np.linalg.norm(hp[ends[0]] - hp[pivot]) * Y
+        spec.fixed.add("arb_t_bar_axis")
+        _rigid_bar((pivot, "arb_t_bar_axis"), ends, spec, hp)
+    else:
+        spec.parts["arb_t_bar"] = [pivot, *ends]
+        planes.append(Midpoint(*ends, Y, 0.5 * (hp[ends[0]] + hp[ends[1]]) @ Y))
+    _droplinks(axle, corners, "droplink_t_bar", spec)
+    return planes
+
+
+def _rigid_bar(axis, ends, spec, hp) -> None:
+    """A rigid bar turning about the fixed ``axis`` (two point names): one part of the
+    axis, ``arb_bar_quarter`` — a point a quarter turn round from the last end — and
+    the ``ends``. The distance between two ends alike placed about the axis is at its
+    minimum, so alone it would not fix their relative turn (its gradient vanishes
+    there)."""
+    a, b = (hp[n] for n in axis)
+    u = (b - a) / np.linalg.norm(b - a)
+    end = hp[ends[-1]]
+    foot = a + u * ((end - a) @ u)
+    hp["arb_bar_quarter"] = foot + np.cross(u, end - foot)
+    spec.parts["arb_bar"] = [*axis, "arb_bar_quarter", *ends]
+
+
+def _droplinks(axle, corners: dict[str, Geometry], end: str, spec) -> None:
+    """Per side a rigid link from the rocker's ``droplink_rocker`` (or
+    ``droplink_lower`` on the body ``anti_roll.mount`` names) to the bar's point
+    ``<side>_<end>``."""
+    for side, g in corners.items():
+        if "droplink_rocker" in axle.side_points[side]:
+            upper, body = "droplink_rocker", "rocker"
+        else:
+            mount = axle.anti_roll_mount
+            upper, body = "droplink_lower", g.mechanism.WHEEL_BODY if mount == "arm" else mount
+        if f"{side}_{body}" not in spec.parts:
+            own = [p.removeprefix(f"{side}_") for p in spec.parts if p.startswith(f"{side}_")]
+            raise PinSuspError(
+                f"the point-based formulation has no rigid part {body!r} to carry the "
+                f"droplink (its parts: {', '.join(own)})"
+            )
+        spec.parts[f"{side}_{body}"].append(f"{side}_{upper}")
+        spec.links.append((f"{side}_{upper}", f"{side}_{end}"))
+
+
+# anti_roll.type → what it adds to the axle's parts, links, lines and fixed points;
+# it returns its plane rows (conditions always held, as targets).
+ANTI_ROLL = {"none": _no_bar, "u_bar": _u_bar, "t_bar": _t_bar}

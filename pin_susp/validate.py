@@ -239,8 +239,17 @@ class AxleScope:
         return held
 
     def duals(self, points: dict, rates: dict) -> dict[str, dict[str, Dual]]:
+        """Each side's rates; none for a rigid bar, as the sweep writes none (one wheel
+        cannot move with the other held: the engines' held system has no solution)."""
+        axle = self.subject.axle
+        blank = axle is not None and axle.anti_roll_rigid
         return {
-            name: {s: Dual(p[None], rates[name][self.side_drivers[s]][:, None]) for s in SIDES}
+            name: {
+                s: Dual(
+                    p[None], rates[name][self.side_drivers[s]][:, None] * (np.nan if blank else 1.0)
+                )
+                for s in SIDES
+            }
             for name, p in points.items()
         }
 
@@ -253,6 +262,8 @@ class AxleScope:
         return {name: points[name]["left"].val[0] for name in self.subject.output_points}
 
     def stalled(self, points: dict) -> bool:
+        if self.subject.axle is not None and self.subject.axle.anti_roll_rigid:
+            return False  # no rates by design (duals): compared as blank, like the sweep's
         return any(np.isnan(plain(points[f"{s}_wheel_center"][s].der)).any() for s in SIDES)
 
     def from_rates(self, name: str) -> bool:

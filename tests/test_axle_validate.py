@@ -1,7 +1,8 @@
 """`pin-susp validate` on an axle (spec/axle.md): every step of an axle sweep re-solved
 by the point-based formulation — both corners' points as unknowns, one rack unknown
-for both trackrods, the U-bar's arm ends on circles about the bar's axis with rigid
-droplinks, numpy/scipy only — and by MuJoCo from the exported MJCF, column by column.
+for both trackrods, the U-bar's arm ends on circles about the bar's axis, the T-bar's
+crossbar a rigid triangle with its pivot and its midpoint in y = 0, rigid droplinks,
+numpy/scipy only — and by MuJoCo from the exported MJCF, column by column.
 """
 
 from dataclasses import replace
@@ -12,6 +13,7 @@ import yaml
 from conftest import EXAMPLES, example, mirrored
 from pointwise import PointwiseAxle
 
+from pin_susp import pointwise
 from pin_susp.axle import AxleModel, axle_results, load_axle, solve_axle_sweep
 from pin_susp.cli import main
 from pin_susp.geometry import load_geometry
@@ -19,6 +21,7 @@ from pin_susp.sweep import load_sweep
 from pin_susp.validate import validate
 
 AXLE = EXAMPLES / "axle_front.yaml"
+T_BAR = EXAMPLES.parent / "tests" / "data" / "axle_t_bar.yaml"
 SOLVER = {"step_index", "solver_converged", "solver_max_residual", "solver_iterations"}
 
 
@@ -76,11 +79,12 @@ def test_axle_sweep_equals_the_point_based_formulation(name):
     assert np.ptp(results["arb_twist"]) > 1.0  # the bar is wound: its droplinks did work
 
 
+@pytest.mark.parametrize("geometry", [AXLE, T_BAR], ids=["u_bar", "t_bar"])
 @pytest.mark.parametrize("name", SWEEPS)
-def test_validate_compares_every_axle_column_with_both_engines(name):
+def test_validate_compares_every_axle_column_with_both_engines(name, geometry):
     """Both engines agree on every column pin_susp writes (per side, the axle's, the
     derivatives along hub z, the rack and roll) that either has a value in."""
-    axle = AxleModel(load_axle(AXLE))
+    axle = AxleModel(load_axle(geometry))
     results, reports = validate(axle, SWEEPS[name]())
     written = {c for c in results.columns if c not in SOLVER and not np.isnan(results[c]).all()}
     point_columns = {f"{p}_{a}" for p in axle.output_points for a in "xyz"}
@@ -303,3 +307,126 @@ def test_a_toe_link_axle_is_validated_along_each_sides_toe_link():
     assert pointwise.agrees and not pointwise.not_compared
     assert steer_axis <= set(pointwise.differences)
     assert mujoco.agrees and steer_axis <= mujoco.not_compared
+
+
+def t_bar(rigid: bool = False) -> dict:
+    """tests/data/axle_t_bar.yaml; ``rigid``: its bar locked (stiffness: rigid)."""
+    data = yaml.safe_load(T_BAR.read_text())
+    if rigid:
+        data["axle_config"]["anti_roll"]["stiffness"] = "rigid"
+    return data
+
+
+def crossbar_middle(results) -> np.ndarray:
+    return 0.5 * (solved(results, "left_droplink_t_bar") + solved(results, "right_droplink_t_bar"))
+
+
+@pytest.mark.parametrize("name", SWEEPS)
+def test_t_bar_axle_sweep_equals_the_point_based_formulation(name):
+    """The point-based T-bar: the pivot (fixed, a ball) and the crossbar's ends one
+    rigid part, one plane row holding the crossbar's midpoint in y = 0, a rigid
+    droplink per side. Both wheels at their own heights and the rack: pin_susp's
+    points equal its within 1e-9 mm, the crossbar twisted about its stem."""
+    results = assert_points_equal_the_point_based_formulation(t_bar(), SWEEPS[name]())
+    assert np.ptp(results["arb_twist"]) > 4.0  # deg: the crossbar twisted
+    assert np.abs(crossbar_middle(results)[:, 1]).max() < 1e-9
+
+
+RIGID_T_BAR_SWEEPS = {
+    "heave": {
+        "targets": [
+            {"quantity": "heave", "values": [-30.0, 25.0, 40.0]},
+            {"point": "trackrod_inboard", "side": "left", "direction": {"axis": "y"},
+             "values": [3.0, -4.0, 8.0]},
+        ]
+    },
+    "one_wheel": {
+        "targets": [
+            {"point": "wheel_center", "side": "right", "direction": {"axis": "z"},
+             "values": [15.0, -20.0, 30.0]},
+            {"point": "trackrod_inboard", "side": "left", "direction": {"axis": "y"},
+             "values": [0.0, -4.0, 5.0]},
+        ]
+    },
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("name", RIGID_T_BAR_SWEEPS)
+def test_a_rigid_t_bar_only_pitches(name):
+    """stiffness: rigid — the point-based crossbar one part with a fixed axis along y
+    through the pivot: pin_susp's points equal its within 1e-9 mm; the crossbar
+    pitched (its ends keep their y) and did not twist, one wheel moved the other."""
+    results = assert_points_equal_the_point_based_formulation(
+        t_bar(rigid=True), load_sweep(RIGID_T_BAR_SWEEPS[name])
+    )
+    design = mm(t_bar()["hardpoints"]["left"]["droplink_t_bar"])
+    np.testing.assert_allclose(solved(results, "left_droplink_t_bar")[:, 1], design[1], atol=1e-9)
+    np.testing.assert_allclose(results["arb_twist"], 0.0, atol=1e-9)
+    assert np.ptp(crossbar_middle(results)[:, 2]) > 10.0  # mm: it pitched
+    assert np.ptp(results["left_wheel_center_z"]) > 30.0  # both wheels moved
+
+
+def no_plane_row(bar):
+    """The T-bar's formulation without its midpoint plane row."""
+
+    def without(*args):
+        bar(*args)
+        return []
+
+    return without
+
+
+def free_to_twist(bar):
+    """The T-bar's formulation as if its bar were not rigid."""
+    return lambda axle, *args: bar(replace(axle, anti_roll_stiffness=None), *args)
+
+
+@pytest.mark.parametrize(
+    "rigid, sweep, broken",
+    [
+        (False, SWEEPS["bump_steer"], no_plane_row),
+        (False, SWEEPS["roll"], no_plane_row),
+        (True, lambda: load_sweep(RIGID_T_BAR_SWEEPS["heave"]), free_to_twist),
+    ],
+)
+def test_the_t_bar_checks_fail_on_a_wrong_point_based_bar(monkeypatch, rigid, sweep, broken):
+    """The checks above can fail: without the plane row the point-based crossbar may
+    also turn its midpoint off y = 0; a rigid bar let twist leaves the wheels free to
+    roll in heave. Either lands points millimetres from pin_susp's (the solve itself
+    still converges: the comparison fails, not the residual)."""
+    monkeypatch.setitem(pointwise.ANTI_ROLL, "t_bar", broken(pointwise.ANTI_ROLL["t_bar"]))
+    with pytest.raises(AssertionError, match="Not equal to tolerance rtol=0, atol=1e-09"):
+        assert_points_equal_the_point_based_formulation(t_bar(rigid), sweep())
+
+
+def test_cli_validates_a_t_bar_axle_with_the_point_based_engine_too(capsys):
+    code = main(["validate", str(T_BAR), str(EXAMPLES / "roll.yaml")])
+    out = capsys.readouterr().out
+    assert code == 0, out
+    assert "pointwise: agrees within 1e-06" in out and "mujoco: agrees within 1e-06" in out
+    row = next(line.split() for line in out.splitlines() if line.startswith("  arb_twist "))
+    assert float(row[2]) < 1e-6 and float(row[3]) < 1e-6  # both engines compared it
+
+
+@pytest.mark.parametrize("bar", ["u_bar", "t_bar"])
+def test_a_rigid_bar_validates_with_its_per_side_rates_blank_everywhere(tmp_path, capsys, bar):
+    """A rigid bar: one wheel cannot move with the other held, so neither the sweep
+    nor the engines have per-side rates; everything else is compared and agrees."""
+    source = AXLE if bar == "u_bar" else AXLE.parent.parent / "tests/data/axle_t_bar.yaml"
+    data = yaml.safe_load(source.read_text())
+    data["axle_config"]["anti_roll"]["stiffness"] = "rigid"
+    geometry = tmp_path / "rigid.yaml"
+    geometry.write_text(yaml.safe_dump(data))
+    heave = {
+        "steps": 5,
+        "targets": [
+            {"quantity": "heave", "start": -20, "stop": 20},
+            {"point": "trackrod_inboard", "side": "left", "direction": {"axis": "y"},
+             "start": -5, "stop": 5},
+        ],
+    }  # fmt: skip
+    sweep = tmp_path / "heave.yaml"
+    sweep.write_text(yaml.safe_dump(heave))
+    assert main(["validate", str(geometry), str(sweep)]) == 0
+    out = capsys.readouterr().out
+    assert "pointwise: agrees" in out and "mujoco: agrees" in out and "not compared" not in out
