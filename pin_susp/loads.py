@@ -1,0 +1,288 @@
+"""Quasi-static loads: the force in every member and joint at a solved pose
+(spec/loads.md).
+
+At a pose q the closures' Jacobian J_c, the spring's row J_s (d length/dq of a
+coilover, d angle/dq of a torsion bar) and the rack's row J_r hold every
+freedom; a load w_p at a point p of the upright does virtual work through the
+Jacobian J_p of the upright's material point there. Equilibrium is one linear
+solve, [J_c; J_s; J_r]ᵀ λ = −Σ J_pᵀ w_p (no friction, no mass), and each
+multiplier is a member's force: a distance closure's −λ is its tension, a ball
+closure's λ the force the inboard part puts on the outboard one, the spring's λ
+its compression, the rack's −λ the trackrods' pull on it along +Y.
+
+The forces through the tree's own joints (pivots, the lower ball joint, a
+multilink's lower front link) follow from Pinocchio's inverse dynamics at rest
+(``rnea`` with v = a = 0 and no gravity) with the applied loads and the closure
+forces as external forces: ``data.f[j]`` is then the force the parent puts on
+the subtree through joint j. A pivot's two bushings share its force and moment
+(the axial part equally: spec/loads.md's convention); a wishbone whose only
+load is its outboard ball joint is a pair of two-force legs.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from .closures import BallClosure, DistanceClosure, JointTarget
+from .errors import PinSuspError
+from .yamlio import Reader, load_yaml
+
+# |J| condition number above which a pose is at a toggle: a member's force is unbounded
+TOGGLE = 1e10
+CASE_KEYS = ("contact_patch", "wheel_center", "moment")
+
+
+@dataclass(frozen=True)
+class LoadCase:
+    """Loads on one wheel, world (chassis) axes: force at the contact patch (N, the
+    road on the tyre), force at the wheel centre (N) and a moment (N·m)."""
+
+    name: str
+    contact_patch: np.ndarray
+    wheel_center: np.ndarray
+    moment: np.ndarray
+
+
+def load_cases(source) -> list[LoadCase]:
+    """Read a load-case file (spec/loads.md): ``cases:`` a list of {name,
+    contact_patch: {fx, fy, fz}, wheel_center: {…}, moment: {mx, my, mz}}."""
+    data, name, _ = load_yaml(source)
+    r = Reader(name)
+    r.mapping(data, "", required=("cases",), optional=("version",))
+    cases = data["cases"]
+    if not isinstance(cases, list) or not cases:
+        r.fail("cases", "expected a list of load cases")
+    out, seen = [], set()
+    for i, case in enumerate(cases):
+        key = f"cases[{i}]"
+        r.mapping(case, key, required=("name",), optional=(*CASE_KEYS, "left", "right"))
+        for side in ("left", "right"):
+            if side in case:
+                r.fail(f"{key}.{side}", "a side block is for an axle's load cases")
+        title = r.text(case["name"], f"{key}.name")
+        if title in seen:
+            r.fail(f"{key}.name", f"{title!r} names two cases")
+        seen.add(title)
+        vectors = {}
+        for part, axes in (("contact_patch", "f"), ("wheel_center", "f"), ("moment", "m")):
+            block = case.get(part, {})
+            names = tuple(f"{axes}{a}" for a in "xyz")
+            block = r.mapping(block, f"{key}.{part}", optional=names)
+            vectors[part] = np.array(
+                [r.number(block.get(n, 0.0), f"{key}.{part}.{n}") for n in names]
+            )
+        out.append(LoadCase(str(title), **vectors))
+    return out
+
+
+class Statics:
+    """The equilibrium of one corner (a Linkage) at its poses."""
+
+    def __init__(self, corner):
+        g = corner.geometry
+        self.corner, self.model = corner, corner.model
+        self.data = self.model.createData()
+        self.upright = corner.mechanism.WHEEL_BODY
+        held = []
+        if g.spring == "none":
+            raise PinSuspError(
+                f"{g.source}: spring.type: none leaves bump without a load path (no member "
+                "holds the wheel up): give the corner a spring for its loads"
+            )
+        if g.spring == "coilover":
+            top, bottom = corner.points["strut_top"], corner.points["strut_bottom"]
+            held.append(DistanceClosure("spring", top, bottom, 0.0))
+        else:  # a torsion bar: the rocker's turn about its axis
+            held.append(_RockerTurn(corner))
+        if g.steering == "rack":
+            held.append(JointTarget(self.model, "rack_slide"))
+        self.rows = list(corner.closures) + held
+        self.size = sum(row.size for row in self.rows)
+        if self.size != self.model.nv:
+            raise PinSuspError(
+                f"{g.source}: the closures, spring and rack hold {self.size} of the "
+                f"{self.model.nv} freedoms: the loads are not determined"
+            )
+
+    def jacobian(self, q: np.ndarray) -> np.ndarray:
+        """The held rows' Jacobian at q (the corner's kinematics updated to q)."""
+        kin = self.corner.kin
+        kin.update(q)
+        return np.vstack([row.jacobian(kin) for row in self.rows])
+
+    def applied(self, case: LoadCase) -> np.ndarray:
+        """Σ J_pᵀ w_p: the generalised force of the case at the current pose."""
+        corner, kin = self.corner, self.corner.kin
+        wc = corner.points["wheel_center"]
+        J = kin.frame_jacobian(wc.frame_id)  # linear at WC, angular: the upright's
+        r = corner.points["contact_patch_center"].position(kin) - wc.position(kin)
+        at_patch = J[:3] - _skew(r) @ J[3:]  # the upright's material point at the patch
+        return (
+            at_patch.T @ case.contact_patch
+            + J[:3].T @ case.wheel_center
+            + J[3:].T @ case.moment  # a couple: the same at any point of the upright
+        )
+
+    def solve(self, q: np.ndarray, case: LoadCase) -> dict[str, float]:
+        """Every force column at the pose q under the case (N, N·m); NaN with
+        ``loads_unbounded`` = 1 at a toggle."""
+        J = self.jacobian(q)
+        Q = self.applied(case)
+        if np.linalg.cond(J) > TOGGLE:
+            out = dict.fromkeys(self.columns(), np.nan)
+            out["loads_unbounded"] = 1.0
+            return out
+        lam = np.linalg.solve(J.T, -Q)
+        return self._columns(q, lam, case) | {"loads_unbounded": 0.0}
+
+    def columns(self) -> list[str]:
+        q = self.corner.q_design
+        zero = LoadCase("", np.zeros(3), np.zeros(3), np.zeros(3))
+        self.jacobian(q)
+        return list(self._columns(q, np.zeros(self.size), zero))
+
+    # ---------------------------------------------------------------- the columns
+
+    def _columns(self, q, lam, case) -> dict[str, float]:
+        corner, kin, model = self.corner, self.corner.kin, self.model
+        out, external = {}, [pin.Force.Zero() for _ in range(model.njoints)]
+
+        def push(point, force, moment=None):
+            """A force (and couple) at a frame point, world axes, as the joint's fext."""
+            frame = model.frames[point.frame_id]
+            if frame.parentJoint == 0:
+                return
+            p = point.position(kin)
+            couple = np.cross(p, force) if moment is None else np.cross(p, force) + moment
+            world = pin.Force(force, couple)
+            external[frame.parentJoint] += kin.data.oMi[frame.parentJoint].actInv(world)
+
+        i = 0
+        for row in self.rows:
+            value = lam[i : i + row.size]
+            i += row.size
+            if isinstance(row, BallClosure):
+                out |= _vector(f"load_{row.name}", -value)  # outboard on inboard
+                push(row.b, value)
+                push(row.a, -value)
+            elif isinstance(row, DistanceClosure):
+                u = row.b.position(kin) - row.a.position(kin)
+                u /= np.linalg.norm(u)
+                name = "force_spring" if row.name == "spring" else f"force_{row.name}"
+                out[name] = value[0] if row.name == "spring" else -value[0]
+                push(row.b, value[0] * u)
+                push(row.a, -value[0] * u)
+            elif isinstance(row, _RockerTurn):
+                out["torque_spring"] = value[0]
+                push(row.point, np.zeros(3), value[0] * row.axis(kin))
+            else:  # the rack: held by the steering
+                out["force_rack"] = -value[0]
+        # the applied loads, on the upright
+        wc = corner.points["wheel_center"]
+        patch = corner.points["contact_patch_center"].position(kin)
+        push(
+            wc,
+            case.wheel_center,
+            case.moment + np.cross(patch - wc.position(kin), case.contact_patch),
+        )
+        push(wc, case.contact_patch)
+        out |= self._tree_loads(q, external)
+        return out
+
+    def _tree_loads(self, q, external) -> dict[str, float]:
+        """Forces through the tree's joints: pivot bushings (on the chassis), the
+        lower ball joint (outboard on inboard), a two-force link's tension, legs."""
+        corner, model, data = self.corner, self.model, self.data
+        gravity = model.gravity.copy()
+        model.gravity = pin.Motion.Zero()
+        zero = np.zeros(model.nv)
+        self.tau = pin.rnea(model, data, q, zero, zero, pin.StdVec_Force(external)).copy()
+        model.gravity = gravity
+        kin = corner.kin
+        design = corner.design_positions
+        out = {}
+        for body in corner.tree.bodies:
+            j = body.joint
+            if j is None:
+                continue
+            last = j.name + {"ball": "_x", "universal": "_b"}.get(j.kind, "")
+            index = model.getJointId(last)
+            world = kin.data.oMi[index].act(data.f[index])  # parent on child, world origin
+            force, moment = world.linear.copy(), world.angular.copy()
+            if j.kind == "ball":
+                out |= _vector(f"load_{j.name}", -force)
+            elif j.kind == "universal":  # a link: chassis → ball joint, two-force
+                inboard, outboard = (
+                    kin.data.oMf[corner.points[n].frame_id].translation
+                    for n in (f"{body.name}_inboard", f"{body.name}_outboard")
+                )
+                u = (inboard - outboard) / np.linalg.norm(inboard - outboard)
+                out[f"force_{body.name}"] = force @ u
+            elif j.kind == "revolute" and len(j.defined_by) == 2:
+                a, b = (design[n] for n in j.defined_by)
+                at_a = moment - np.cross(a, force)  # about bushing a
+                d = b - a
+                on_b = np.cross(at_a, d) / (d @ d) + 0.5 * (force @ d) / (d @ d) * d
+                on_a = force - on_b
+                for n, f in zip(j.defined_by, (on_a, on_b), strict=True):
+                    out |= _vector(f"load_{_bushing(n)}", -f)  # on the chassis
+                out |= self._legs(body.name, j.defined_by, force)
+        return out
+
+    def _legs(self, arm: str, pickups, force) -> dict[str, float]:
+        """A wishbone loaded at its outboard ball alone: the tension in each leg (N);
+        blank when anything else loads the arm (a pushrod, spring or droplink)."""
+        corner = self.corner
+        outboard = f"{arm}_outboard"
+        if not arm.endswith("wishbone") or outboard not in corner.points:
+            return {}
+        others = [n for n, (b, _) in corner.tree.points.items() if b == arm and n != outboard]
+        kin = corner.kin
+        out_p = corner.points[outboard].position(kin)
+        legs = [out_p - corner.design_positions[n] for n in pickups]
+        u = np.column_stack([leg / np.linalg.norm(leg) for leg in legs])
+        names = [f"force_{arm}_{'front' if 'front' in n else 'rear'}" for n in pickups]
+        if others:
+            return dict.fromkeys(names, np.nan)
+        # the chassis holds the arm through the legs: force = Σ tension · (pickup → ball)ˆ
+        # pulled toward the chassis: the chassis's force on the arm is −Σ t·u
+        t = np.linalg.lstsq(u, -force, rcond=None)[0]
+        return dict(zip(names, t, strict=True))
+
+
+class _RockerTurn:
+    """A torsion bar's row: the rocker's turn about its axis a→b (rad per dq)."""
+
+    size = 1
+    name = "spring"
+
+    def __init__(self, corner):
+        self.corner = corner
+        self.point = corner.points["pushrod_inboard"]  # any frame on the rocker
+
+    def axis(self, kin) -> np.ndarray:
+        p = self.corner.points
+        a, b = p["rocker_axis_a"].position(kin), p["rocker_axis_b"].position(kin)
+        return (b - a) / np.linalg.norm(b - a)
+
+    def jacobian(self, kin) -> np.ndarray:
+        return (self.axis(kin) @ kin.frame_jacobian(self.point.frame_id)[3:])[None]
+
+
+def _vector(name: str, v) -> dict[str, float]:
+    return {f"{name}_{a}": float(v[i]) for i, a in enumerate("xyz")}
+
+
+def _bushing(point: str) -> str:
+    """The bushing at a pivot pickup: lower_wishbone_inboard_front →
+    lower_wishbone_front_bushing, rocker_axis_a → rocker_a_bushing."""
+    for part in ("inboard_", "axis_", "pivot_"):
+        point = point.replace(part, "")
+    return f"{point}_bushing"
+
+
+def _skew(v: np.ndarray) -> np.ndarray:
+    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])

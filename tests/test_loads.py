@@ -1,0 +1,168 @@
+"""Member forces (spec/loads.md), against computations that share nothing with the
+multipliers: the upright's free body written from the solved points, and virtual
+work through a re-solved pose."""
+
+import numpy as np
+import pytest
+from conftest import EXAMPLES
+
+import pin_susp
+from pin_susp.closures import DistanceClosure, JointTarget
+from pin_susp.errors import InputError, PinSuspError
+from pin_susp.loads import LoadCase, Statics, load_cases
+from pin_susp.solver import NewtonSolver
+from pin_susp.sweep import Sweep, Target
+
+CASES = [
+    LoadCase("braking", np.array([-3000.0, 200.0, 2500.0]), np.zeros(3), np.zeros(3)),
+    LoadCase("cornering", np.array([0.0, -4500.0, 2300.0]), np.array([150.0, 0.0, -80.0]),
+             np.array([10.0, 60.0, -25.0])),
+]  # fmt: skip
+MEMBERS = {  # every member of the pushrod-rocker corner that ends on the upright
+    "lower_wishbone_front": ("lower_wishbone_inboard_front", "lower_wishbone_outboard"),
+    "lower_wishbone_rear": ("lower_wishbone_inboard_rear", "lower_wishbone_outboard"),
+    "upper_wishbone_front": ("upper_wishbone_inboard_front", "upper_wishbone_outboard"),
+    "upper_wishbone_rear": ("upper_wishbone_inboard_rear", "upper_wishbone_outboard"),
+    "trackrod": ("trackrod_inboard", "trackrod_outboard"),
+    "pushrod": ("pushrod_inboard", "pushrod_outboard"),
+}
+
+
+@pytest.fixture(scope="module")
+def rocker():
+    corner = pin_susp.Corner(EXAMPLES / "pushrod_rocker.yaml")
+    sweep = Sweep(
+        [
+            Target("wheel_center", "z", [-25.0, 0.0, 30.0]),
+            Target("trackrod_inboard", "y", [8.0, 0.0, -6.0]),
+        ],
+        "bump+steer",
+    )
+    return corner, Statics(corner), [s.q for s in corner.solve_steps(sweep)]
+
+
+@pytest.mark.parametrize("case", CASES, ids=lambda c: c.name)
+def test_six_members_equal_the_free_body_of_the_upright(rocker, case):
+    """Four wishbone legs, trackrod and pushrod all end on the upright: their six
+    tensions are the one solution of the upright's 6×6 equilibrium with the load."""
+    corner, statics, qs = rocker
+    for q in qs:
+        forces = statics.solve(q, case)
+        corner.kin.update_positions(q)
+        p = {n: corner.points[n].position(corner.kin).copy() for n in corner.points}
+        A = np.zeros((6, 6))
+        for i, (inboard, outboard) in enumerate(MEMBERS.values()):
+            u = p[inboard] - p[outboard]  # a member in tension pulls the upright inboard
+            u /= np.linalg.norm(u)
+            A[:3, i], A[3:, i] = u, np.cross(p[outboard], u)
+        cp, wc = p["contact_patch_center"], p["wheel_center"]
+        load = np.r_[
+            case.contact_patch + case.wheel_center,
+            np.cross(cp, case.contact_patch) + np.cross(wc, case.wheel_center) + case.moment,
+        ]
+        tension = np.linalg.solve(A, -load)
+        for (name, _), t in zip(MEMBERS.items(), tension, strict=True):
+            assert forces[f"force_{name}"] == pytest.approx(t, rel=1e-9, abs=1e-6), name
+        assert forces["loads_unbounded"] == 0.0
+
+
+def test_virtual_work_of_a_member_lengthened_is_its_tension(rocker):
+    """Lengthen one member by ±ε (every other closure rigid, the spring and the rack
+    held) and re-solve: the load's work W·δx equals the member's tension × ε."""
+    corner, statics, qs = rocker
+    case = CASES[1]
+    q0 = qs[2]
+    forces = statics.solve(q0, case)
+    statics.jacobian(q0)
+    Q = statics.applied(case)  # Σ J_pᵀ w_p at q0
+    eps = 1e-6
+    p = corner.points
+    spring = DistanceClosure("spring", p["strut_top"], p["strut_bottom"], 0.0)
+    corner.kin.update_positions(q0)
+    for name in ("trackrod", "pushrod"):
+        moved = []
+        for sign in (1.0, -1.0):
+            closures = [
+                DistanceClosure(c.name, c.a, c.b, c.length + sign * eps) if c.name == name else c
+                for c in corner.closures
+            ]
+            rack = JointTarget(corner.model, "rack_slide")
+            rack.value = q0[rack.index_q]
+            held = [_held(spring, corner, q0), rack]
+            solver = NewtonSolver(corner.kin, closures, held)
+            values = np.array([h.value for h in held])
+            solution = solver.solve(q0, values, values)
+            assert solution.converged
+            moved.append(solution.q)
+        dq = (moved[0] - moved[1]) / 2.0
+        assert Q @ dq == pytest.approx(forces[f"force_{name}"] * eps, rel=1e-6), name
+
+
+def _held(spring, corner, q):
+    """The spring's length held at its value at q (a target row)."""
+
+    class Length:
+        size, name = 1, "spring length"
+
+        def __init__(self):
+            corner.kin.update_positions(q)
+            self.value = np.linalg.norm(
+                spring.b.position(corner.kin) - spring.a.position(corner.kin)
+            )
+
+        def residual(self, kin):
+            return np.array(
+                [np.linalg.norm(spring.b.position(kin) - spring.a.position(kin)) - self.value]
+            )
+
+        def jacobian(self, kin):
+            return spring.jacobian(kin)
+
+    return Length()
+
+
+def test_the_free_joints_carry_no_torque_and_the_rack_its_force(rocker):
+    """Inverse dynamics at rest with the applied and closure forces as external loads:
+    every joint not held carries zero torque; the rack's is minus the rack force."""
+    corner, statics, qs = rocker
+    forces = statics.solve(qs[0], CASES[0])
+    names = [corner.model.names[j] for j in range(1, corner.model.njoints)]
+    for name, tau in zip(names, statics.tau, strict=True):
+        if name == "rack_slide":
+            assert tau == pytest.approx(-forces["force_rack"], rel=1e-12)
+        else:
+            assert abs(tau) < 1e-9 * max(abs(v) for v in forces.values()), name
+
+
+def test_a_corner_without_a_spring_has_no_load_path():
+    with pytest.raises(PinSuspError, match="spring.type: none"):
+        Statics(pin_susp.Corner(EXAMPLES / "double_wishbone.yaml"))
+
+
+@pytest.mark.parametrize(
+    ("text", "key"),
+    [
+        ("cases: [{name: a, contact_patch: {fx: lots}}]", "cases[0].contact_patch.fx"),
+        ("cases: [{contact_patch: {fx: 1}}]", "cases[0].name"),
+        ("cases: [{name: a, contact_patch: {fw: 1}}]", "cases[0].contact_patch.fw"),
+        ("cases: [{name: a, left: {contact_patch: {fx: 1}}}]", "cases[0].left"),
+        ("cases: [{name: a}, {name: a}]", "cases[1].name"),
+        ("cases: []", "cases"),
+        ("cases: [{name: a, torque: 3}]", "cases[0].torque"),
+    ],
+)
+def test_bad_load_case_names_its_key(tmp_path, text, key):
+    path = tmp_path / "loads.yaml"
+    path.write_text(text)
+    with pytest.raises(InputError) as info:
+        load_cases(path)
+    assert info.value.key == key and info.value.source == str(path)
+
+
+def test_load_cases_read_with_defaults(tmp_path):
+    path = tmp_path / "loads.yaml"
+    path.write_text("version: 1\ncases:\n  - name: bump\n    contact_patch: {fz: 5000}\n")
+    (case,) = load_cases(path)
+    assert case.name == "bump"
+    np.testing.assert_array_equal(case.contact_patch, [0.0, 0.0, 5000.0])
+    np.testing.assert_array_equal(case.wheel_center, np.zeros(3))
