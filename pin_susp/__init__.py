@@ -22,6 +22,7 @@ __version__ = "0.1.0"
 from .corner import Corner, Results  # noqa: E402
 from .errors import InputError, PinSuspError  # noqa: E402
 from .geometry import Geometry, load_geometry  # noqa: E402
+from .loads import LoadCase, load_cases, member_forces  # noqa: E402
 from .metrics import METRICS, Pose  # noqa: E402
 from .sensitivity import hardpoint_sensitivities  # noqa: E402
 from .setup import SetupModel, apply_setup, setup_sheet, solve_setup  # noqa: E402
@@ -32,12 +33,15 @@ __all__ = [
     "Corner",
     "Geometry",
     "InputError",
+    "LoadCase",
     "PinSuspError",
     "Pose",
     "Results",
     "SetupModel",
     "Sweep",
     "Target",
+    "load_cases",
+    "member_forces",
     "load_geometry",
     "apply_setup",
     "hardpoint_sensitivities",

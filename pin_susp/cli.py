@@ -151,6 +151,7 @@ def _parser() -> argparse.ArgumentParser:
     _plot_command(sub)
     _draw_command(sub)
     _view_command(sub)
+    _loads_command(sub)
     return p
 
 
@@ -249,6 +250,74 @@ def _write_results(args, results) -> bool:
     if args.plot is not None and not plot:
         print(f"pin-susp: no step converged: {args.plot} not drawn", file=sys.stderr)
     return plot
+
+
+def _loads_command(sub) -> None:
+    lo = sub.add_parser(
+        "loads",
+        help="member and joint forces at every step under load cases",
+        description="Solve SWEEP on the corner GEOMETRY and, at every step, the quasi-static "
+        "forces under each load case of CASES (spec/loads.md): the tension in every "
+        "two-force member (wishbone legs, trackrod or toe link, pushrod, links), the "
+        "spring's force, the rack's, and the load at every ball joint and pivot bushing. "
+        "One CSV row per step and case, then the sweep's own columns. Exit code 1 if a "
+        "step did not converge.",
+    )
+    _geometry_argument(lo)
+    lo.add_argument("sweep", metavar="SWEEP", help="sweep YAML (targets per step)")
+    lo.add_argument(
+        "--cases", required=True, metavar="LOADS.yaml", help="load cases (N, N·m, world axes)"
+    )
+    lo.add_argument("-o", "--output", required=True, metavar="OUT.csv", help="forces CSV")
+    lo.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
+    lo.set_defaults(run=_loads)
+
+
+def _loads(args) -> int:
+    from .loads import Statics, load_cases, member_forces
+
+    _check_outputs(args, args.output)
+    if _is_axle(args.geometry):
+        raise PinSuspError(
+            f"{args.geometry}: loads: an axle's loads are not built yet (corners are)"
+        )
+    corner = Corner(load_geometry(args.geometry))
+    sweep = load_sweep(args.sweep)
+    cases = load_cases(args.cases)
+    corner.solver_for(sweep.targets, sweep.source)  # target errors before any work
+    Statics(corner)  # a corner without a load path: said before any work
+    tangents = []
+    solutions = corner.solve_steps(
+        sweep, progress=_progress_bar(sweep.steps, args.quiet), tangents=tangents
+    )
+    results = Results.from_solutions(corner, solutions, sweep, tangents or None)
+    forces = member_forces(corner, sweep, cases, solutions, results)
+    write_text(csv_text(forces), args.output)
+    if not args.quiet:
+        unbounded = int(np.nansum(forces["loads_unbounded"]))
+        print(
+            f"wrote {args.output}: {len(solutions)} steps x {len(cases)} load cases"
+            + (f"; {unbounded} row(s) at a toggle (forces unbounded: blank)" if unbounded else "")
+        )
+        _force_summary(forces)
+    return _report_failures(results)
+
+
+def _force_summary(forces) -> None:
+    """The largest tension and compression of each member over the sweep, per case."""
+    names = [n for n in forces.columns if n.startswith(("force_", "torque_"))]
+    print(f"  {'member':28s} {'case':18s} {'min':>12s} {'max':>12s}")
+    for case in dict.fromkeys(forces["load_case"]):
+        rows = forces["load_case"] == case
+        for name in names:
+            values = forces[name][rows].astype(float)
+            if np.isnan(values).all():
+                continue
+            unit = forces.units.get(name, "N")
+            print(
+                f"  {name:28s} {str(case)[:18]:18s} {np.nanmin(values):12.1f} "
+                f"{np.nanmax(values):12.1f} {unit}"
+            )
 
 
 def _is_axle(path) -> bool:

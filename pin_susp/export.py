@@ -204,6 +204,9 @@ def format_cell(value) -> str:
         return "True" if value else "False"
     if isinstance(value, int | np.integer):
         return str(int(value))
+    if isinstance(value, str):  # a name (a load case's): quoted as CSV quotes
+        quote = any(c in value for c in ',"\n\r')
+        return '"' + value.replace('"', '""') + '"' if quote else value
     x = float(value)
     return "" if np.isnan(x) else repr(x)
 

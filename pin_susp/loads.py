@@ -28,6 +28,7 @@ import pinocchio as pin
 
 from .closures import BallClosure, DistanceClosure, JointTarget
 from .errors import PinSuspError
+from .sweep import Sweep
 from .yamlio import Reader, load_yaml
 
 # |J| condition number above which a pose is at a toggle: a member's force is unbounded
@@ -76,6 +77,52 @@ def load_cases(source) -> list[LoadCase]:
             )
         out.append(LoadCase(str(title), **vectors))
     return out
+
+
+def member_forces(corner, sweep, cases: list, solutions=None, results=None, progress=None):
+    """Every force column at every step of a sweep under every load case (spec/loads.md):
+    a Results with one row per step and case — ``step_index``, ``load_case``,
+    ``loads_unbounded`` (1 at a toggle: the forces there are blank, not huge), the
+    forces, then the sweep's own columns. ``corner``: a Corner; ``sweep``: a Sweep,
+    path or dict; ``cases``: LoadCases or a load-case file."""
+    from .corner import Results
+    from .sweep import load_sweep
+
+    if not isinstance(sweep, Sweep):
+        sweep = load_sweep(sweep)
+    if not isinstance(cases, list):
+        cases = load_cases(cases)
+    statics = Statics(corner)
+    if solutions is None:
+        solutions = corner.solve_steps(sweep)
+    if results is None:
+        results = Results.from_solutions(corner, solutions, sweep)
+    names = statics.columns()
+    rows = []
+    for i, solution in enumerate(solutions):
+        for case in cases:
+            if solution.converged:
+                rows.append(statics.solve(solution.q, case))
+            else:
+                rows.append(dict.fromkeys(names, np.nan) | {"loads_unbounded": np.nan})
+        if progress is not None:
+            progress(i + 1, len(solutions))
+    n = len(cases)
+    columns = {
+        "step_index": np.repeat(results["step_index"], n),
+        "load_case": np.array([c.name for c in cases] * len(solutions), dtype=object),
+    }
+    units = {"step_index": "", "load_case": ""}
+    for name in ["loads_unbounded", *names]:
+        columns[name] = np.array([row[name] for row in rows])
+        units[name] = (
+            "N·m" if name.startswith("torque") else "" if name == "loads_unbounded" else "N"
+        )
+    for name, values in results.columns.items():
+        if name != "step_index":
+            columns[name] = np.repeat(values, n)
+            units[name] = results.units.get(name, "")
+    return Results(columns, units, results.meta)
 
 
 class Statics:

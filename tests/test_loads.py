@@ -166,3 +166,56 @@ def test_load_cases_read_with_defaults(tmp_path):
     assert case.name == "bump"
     np.testing.assert_array_equal(case.contact_patch, [0.0, 0.0, 5000.0])
     np.testing.assert_array_equal(case.wheel_center, np.zeros(3))
+
+
+def _read(path):
+    lines = [x for x in path.read_text().splitlines() if not x.startswith("#")]
+    header = lines[0].split(",")
+    return header, [r.split(",") for r in lines[1:]]
+
+
+def test_loads_through_the_cli_a_row_per_step_and_case(tmp_path, capsys):
+    from pin_susp.cli import main
+
+    cases = tmp_path / "loads.yaml"
+    cases.write_text(
+        "version: 1\ncases:\n  - name: braking\n    contact_patch: {fx: -3000, fz: 2500}\n"
+        "  - name: bump\n    contact_patch: {fz: 6000}\n"
+    )
+    out = tmp_path / "forces.csv"
+    code = main(["loads", str(EXAMPLES / "pushrod_rocker.yaml"), str(EXAMPLES / "bump_steer.yaml"),
+                 "--cases", str(cases), "-o", str(out)])  # fmt: skip
+    assert code == 0
+    header, rows = _read(out)
+    assert header[:3] == ["step_index", "load_case", "loads_unbounded"]
+    assert len(rows) == 2 * 41 and [r[1] for r in rows[:2]] == ["braking", "bump"]
+    i = header.index("force_spring")
+    assert all(float(r[i]) > 0 for r in rows)  # the spring holds the car up: compression
+    assert "camber" in header and "wheel_center_z" in header  # the sweep's own columns
+    assert "force_pushrod" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("geometry", "cases", "words"),
+    [
+        (
+            "pushrod_rocker.yaml",
+            "cases: [{name: a, contact_patch: {fx: lots}}]",
+            "cases[0].contact_patch.fx",
+        ),
+        ("pushrod_rocker.yaml", "cases: [{name: a, left: {}}]", "cases[0].left"),
+        ("pushrod_rocker.yaml", "cases: [{name: a, wheel: {}}]", "cases[0].wheel"),
+        ("double_wishbone.yaml", "cases: [{name: a}]", "spring.type: none"),
+    ],
+)
+def test_bad_loads_input_one_line_exit_2_nothing_written(tmp_path, capsys, geometry, cases, words):
+    from pin_susp.cli import main
+
+    path = tmp_path / "loads.yaml"
+    path.write_text(cases)
+    out = tmp_path / "forces.csv"
+    code = main(["loads", str(EXAMPLES / geometry), str(EXAMPLES / "bump_steer.yaml"),
+                 "--cases", str(path), "-o", str(out)])  # fmt: skip
+    err = capsys.readouterr().err
+    assert code == 2 and len(err.strip().splitlines()) == 1 and words in err, err
+    assert not out.exists() and sorted(p.name for p in tmp_path.iterdir()) == ["loads.yaml"]
