@@ -25,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
+from scipy.linalg import lapack
 
 from .closures import BallClosure, DistanceClosure, JointTarget
 from .errors import PinSuspError
@@ -97,14 +98,13 @@ def member_forces(corner, sweep, cases: list, solutions=None, results=None, prog
         solutions = corner.solve_steps(sweep)
     if results is None:
         results = Results.from_solutions(corner, solutions, sweep)
-    names = statics.columns()
+    names = statics.names
     rows = []
     for i, solution in enumerate(solutions):
-        for case in cases:
-            if solution.converged:
-                rows.append(statics.solve(solution.q, case))
-            else:
-                rows.append(dict.fromkeys(names, np.nan) | {"loads_unbounded": np.nan})
+        if solution.converged:
+            rows += statics.solve_cases(solution.q, cases)
+        else:
+            rows += [dict.fromkeys(names, np.nan) | {"loads_unbounded": np.nan} for _ in cases]
         if progress is not None:
             progress(i + 1, len(solutions))
     n = len(cases)
@@ -147,6 +147,7 @@ class Statics:
         if g.steering == "rack":
             held.append(JointTarget(self.model, "rack_slide"))
         self.rows = list(corner.closures) + held
+        self._names = None
         self.size = sum(row.size for row in self.rows)
         if self.size != self.model.nv:
             raise PinSuspError(
@@ -174,22 +175,34 @@ class Statics:
         )
 
     def solve(self, q: np.ndarray, case: LoadCase) -> dict[str, float]:
-        """Every force column at the pose q under the case (N, N·m); NaN with
-        ``loads_unbounded`` = 1 at a toggle."""
-        J = self.jacobian(q)
-        Q = self.applied(case)
-        if np.linalg.cond(J) > TOGGLE:
-            out = dict.fromkeys(self.columns(), np.nan)
-            out["loads_unbounded"] = 1.0
-            return out
-        lam = np.linalg.solve(J.T, -Q)
-        return self._columns(q, lam, case) | {"loads_unbounded": 0.0}
+        """Every force column at the pose q under the case (N, N·m)."""
+        return self.solve_cases(q, [case])[0]
 
-    def columns(self) -> list[str]:
-        q = self.corner.q_design
-        zero = LoadCase("", np.zeros(3), np.zeros(3), np.zeros(3))
-        self.jacobian(q)
-        return list(self._columns(q, np.zeros(self.size), zero))
+    def solve_cases(self, q: np.ndarray, cases: list[LoadCase]) -> list[dict[str, float]]:
+        """The columns under each case at q: one factorisation of the held rows for all
+        cases. At a toggle (the rows singular: a member cannot hold its load, the force
+        is unbounded) every force is NaN and ``loads_unbounded`` is 1."""
+        J = self.jacobian(q)
+        lu, pivots, info = lapack.dgetrf(J.T)
+        rcond = lapack.dgecon(lu, np.abs(J).sum(axis=1).max())[0] if info == 0 else 0.0
+        if rcond < 1.0 / TOGGLE:
+            return [dict.fromkeys(self.names, np.nan) | {"loads_unbounded": 1.0} for _ in cases]
+        applied = np.column_stack([self.applied(case) for case in cases])
+        lam = lapack.dgetrs(lu, pivots, -applied)[0]
+        return [
+            self._columns(q, lam[:, k], case) | {"loads_unbounded": 0.0}
+            for k, case in enumerate(cases)
+        ]
+
+    @property
+    def names(self) -> list[str]:
+        """The force columns, in order (worked out once, at the design state)."""
+        if self._names is None:
+            q = self.corner.q_design
+            zero = LoadCase("", np.zeros(3), np.zeros(3), np.zeros(3))
+            self.jacobian(q)
+            self._names = list(self._columns(q, np.zeros(self.size), zero))
+        return self._names
 
     # ---------------------------------------------------------------- the columns
 
@@ -212,7 +225,9 @@ class Statics:
             value = lam[i : i + row.size]
             i += row.size
             if isinstance(row, BallClosure):
-                out |= _vector(f"load_{row.name}", -value)  # outboard on inboard
+                out |= _vector(
+                    f"load_{row.name.removesuffix('_mount')}", -value
+                )  # outboard on inboard
                 push(row.b, value)
                 push(row.a, -value)
             elif isinstance(row, DistanceClosure):

@@ -219,3 +219,60 @@ def test_bad_loads_input_one_line_exit_2_nothing_written(tmp_path, capsys, geome
     err = capsys.readouterr().err
     assert code == 2 and len(err.strip().splitlines()) == 1 and words in err, err
     assert not out.exists() and sorted(p.name for p in tmp_path.iterdir()) == ["loads.yaml"]
+
+
+@pytest.mark.parametrize("case", CASES, ids=lambda c: c.name)
+def test_what_the_chassis_and_rack_give_balances_the_load(rocker, case):
+    """The free body of everything but the chassis and the rack: the bushing loads
+    (written as forces on the chassis), the spring's top and the trackrod's pull at
+    the rack, with the load, sum to zero force and moment."""
+    corner, statics, qs = rocker
+    for q in qs:
+        f = statics.solve(q, case)
+        corner.kin.update_positions(q)
+        p = {n: corner.points[n].position(corner.kin).copy() for n in corner.points}
+        total = np.zeros(6)
+
+        def add(at, force, total=total):
+            total[:3] += force
+            total[3:] += np.cross(at, force)
+
+        for pickup in ("lower_wishbone_inboard_front", "lower_wishbone_inboard_rear",
+                       "upper_wishbone_inboard_front", "upper_wishbone_inboard_rear",
+                       "rocker_axis_a", "rocker_axis_b"):  # fmt: skip
+            name = pickup.replace("inboard_", "").replace("axis_", "")
+            add(p[pickup], -np.array([f[f"load_{name}_bushing_{a}"] for a in "xyz"]))
+        top, bottom = p["strut_top"], p["strut_bottom"]
+        add(top, f["force_spring"] * (bottom - top) / np.linalg.norm(bottom - top))
+        inner, outer = p["trackrod_inboard"], p["trackrod_outboard"]
+        add(inner, f["force_trackrod"] * (inner - outer) / np.linalg.norm(inner - outer))
+        add(p["contact_patch_center"], case.contact_patch)
+        add(p["wheel_center"], case.wheel_center)
+        total[3:] += case.moment
+        scale = np.abs(case.contact_patch).sum()
+        np.testing.assert_allclose(total[:3], 0.0, atol=1e-9 * scale)
+        np.testing.assert_allclose(total[3:], 0.0, atol=1e-9 * scale)
+
+
+def test_a_member_at_its_toggle_is_unbounded_not_a_huge_number():
+    """The coilover's line through the rocker's axis: its end moves square to it, so
+    it cannot turn the rocker, and no finite force holds the wheel up."""
+    import yaml
+
+    data = yaml.safe_load((EXAMPLES / "pushrod_rocker.yaml").read_text())
+    hp = data["hardpoints"]
+    point = {k: np.array([hp[k][a] for a in "xyz"], dtype=float) for k in hp}
+    foot = point["rocker_axis_a"] + (point["rocker_axis_b"] - point["rocker_axis_a"]) * (
+        (point["strut_bottom"] - point["rocker_axis_a"])
+        @ (point["rocker_axis_b"] - point["rocker_axis_a"])
+    ) / np.sum((point["rocker_axis_b"] - point["rocker_axis_a"]) ** 2)
+    top = point["strut_bottom"] + 6.0 * (point["strut_bottom"] - foot)
+    hp["strut_top"] = dict(zip("xyz", top.tolist(), strict=True))
+    corner = pin_susp.Corner(data)
+    (forces,) = Statics(corner).solve_cases(corner.q_design, CASES[:1])
+    assert forces["loads_unbounded"] == 1.0
+    assert all(np.isnan(v) for k, v in forces.items() if k != "loads_unbounded")
+    hp["strut_top"]["z"] += 30.0  # off the toggle: finite again
+    corner = pin_susp.Corner(data)
+    moved = Statics(corner).solve(corner.q_design, CASES[0])
+    assert moved["loads_unbounded"] == 0.0 and np.isfinite(moved["force_spring"])
