@@ -225,6 +225,11 @@ class Results:
         metrics = metric_columns(corner.geometry, points, design, corner.spring_sense)
         for name, (values, column_unit) in metrics.items():
             columns[name], units[name] = values, column_unit
+        from .loads import rate_columns
+
+        qs = [s.q if s.converged else None for s in solutions]
+        for name, (values, column_unit) in rate_columns(corner, qs).items():
+            columns[name], units[name] = values, column_unit
         positions = {name: p.val for name, p in points.items()}
         for name, (values, column_unit) in point_columns(corner.point_names, positions).items():
             columns[name], units[name] = values, column_unit

@@ -62,6 +62,7 @@ class Wheel:
     section_width: float
     aspect_ratio: float
     rim_diameter: float
+    tyre_rate: float | None = None  # N/mm (config.wheel.tyre.rate), for the ride rate
 
     @property
     def radius(self) -> float:
@@ -118,6 +119,10 @@ class Geometry:
     ride_height_change: float = 0.0
     type: str = "double_wishbone"  # the mechanism (pin_susp.mechanisms)
     strut: dict | None = None  # config.strut (MacPherson): rate N/mm, preload N
+    # spring.rate (config.strut.rate for a MacPherson strut): N/mm, a torsion bar's
+    # N·m/deg; spring.preload at design: N (N·m). None: no rate given (no rate columns)
+    spring_rate: float | None = None
+    spring_preload: float = 0.0
     opposite_axle_axis_height: float | None = None  # m, config (read, for the axle's pitch)
     source: str = "<dict>"
     sha256: str | None = None
@@ -332,8 +337,9 @@ def _parse(data: dict, r: Reader, sha: str | None) -> Geometry:
     act = r.mapping(data.get("actuation", {}), "actuation", optional=("type", "mount"))
     actuation = r.choice(act.get("type", mech.ACTUATION[0]), "actuation.type", mech.ACTUATION)
     mount = r.choice(act.get("mount", mech.MOUNTS[0]), "actuation.mount", mech.MOUNTS)
-    spring_map = r.mapping(data.get("spring", {}), "spring", optional=("type",))
+    spring_map = r.mapping(data.get("spring", {}), "spring", optional=("type", "rate", "preload"))
     spring = r.choice(spring_map.get("type", mech.SPRINGS[0]), "spring.type", mech.SPRINGS)
+    rate, preload = _spring_rate(spring_map, spring, config.get("strut"), r)
     if spring == "torsion_bar" and actuation != "pushrod_rocker":
         r.fail("spring.type", "a torsion bar needs actuation type pushrod_rocker")
 
@@ -420,6 +426,8 @@ def _parse(data: dict, r: Reader, sha: str | None) -> Geometry:
         pushrod_length_delta=adjusters[1],
         type=kind,
         strut=None if "strut" not in config else _strut(config["strut"], r),
+        spring_rate=rate,
+        spring_preload=preload,
         opposite_axle_axis_height=(
             None if height is None else r.length(height, "config.opposite_axle_axis_height") * MM
         ),
@@ -440,8 +448,29 @@ def _strut(value, r: Reader) -> dict:
     return out
 
 
+def _spring_rate(spring_map: dict, spring: str, strut, r: Reader) -> tuple:
+    """(rate, preload) in the file's units from spring.{rate, preload} or, for a
+    MacPherson strut, config.strut; (None, 0) without a rate."""
+    if strut is not None:
+        strut = _strut(strut, r)
+        return strut.get("rate"), strut.get("preload", 0.0)
+    given = [k for k in ("rate", "preload") if k in spring_map]
+    if given and spring == "none":
+        r.fail(f"spring.{given[0]}", "a rate needs a spring: spring.type is none")
+    if "preload" in spring_map and "rate" not in spring_map:
+        r.fail("spring.preload", "a preload needs the spring's rate (spring.rate)")
+    if "rate" not in spring_map:
+        return None, 0.0
+    return (
+        r.positive(spring_map["rate"], "spring.rate"),
+        r.number(spring_map.get("preload", 0.0), "spring.preload"),
+    )
+
+
 def _wheel(value, r: Reader) -> Wheel:
-    w = r.mapping(value, "config.wheel", required=("tire",), optional=("offset",))
+    w = r.mapping(value, "config.wheel", required=("tire",), optional=("offset", "tyre"))
+    tyre = r.mapping(w.get("tyre", {}), "config.wheel.tyre", optional=("rate",))
+    tyre_rate = None if "rate" not in tyre else r.positive(tyre["rate"], "config.wheel.tyre.rate")
     tire = r.mapping(
         w["tire"],
         "config.wheel.tire",
@@ -453,6 +482,7 @@ def _wheel(value, r: Reader) -> Wheel:
         section_width=_size(tire["section_width"], f"{key}.section_width", r) * MM,
         aspect_ratio=_size(tire["aspect_ratio"], f"{key}.aspect_ratio", r, limit=100.0),
         rim_diameter=_size(tire["rim_diameter"], f"{key}.rim_diameter", r, INCH / MM) * INCH,
+        tyre_rate=tyre_rate,
     )
 
 

@@ -348,3 +348,137 @@ def _bushing(point: str) -> str:
 
 def _skew(v: np.ndarray) -> np.ndarray:
     return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+
+
+# ---------------------------------------------------------------- rates
+
+
+class SpringRates:
+    """The spring's force and the rates at the wheel along bump (spec/loads.md):
+    ``spring_force`` (N, compression +) or ``spring_torque`` (N·m, a torsion bar's,
+    + resisting bump) = preload + rate · deflection from design; ``wheel_rate`` =
+    d(F·MR)/dz = rate·MR² + F·dMR/dz (N/mm), and ``ride_rate`` = wheel and tyre rate in
+    series where the tyre's rate is given.
+
+    MR and dMR/dz are exact: the second derivative of the spring's length (a torsion
+    bar's angle) along the bump motion (hub z, the rack or toe link held) comes from
+    the second-order solution of the closures, J·q″ = −(J̇·q′), with J̇·q′ the rows'
+    drift read from Pinocchio's frame accelerations at velocity q′ and zero q̈.
+    """
+
+    def __init__(self, corner):
+        g = corner.geometry
+        self.corner, self.model = corner, corner.model
+        self.data = self.model.createData()
+        self.solver = corner._drive  # closures + hub z (+ the rack held)
+        self.torsion = g.spring == "torsion_bar"
+        if self.torsion:
+            self.turn = _RockerTurn(corner)
+            self.sense = 1.0
+            self.sense = 1.0 if self.derivatives(corner.q_design)[1] >= 0.0 else -1.0
+        else:
+            self.top, self.bottom = corner.points["strut_top"], corner.points["strut_bottom"]
+        self.design = self.derivatives(corner.q_design)[0]
+
+    def _linear(self, frame: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Position, velocity and classical acceleration of a frame origin (world)."""
+        model, data = self.model, self.data
+        p = data.oMf[frame].translation.copy()
+        v = pin.getFrameVelocity(model, data, frame, pin.LOCAL_WORLD_ALIGNED).linear
+        a = pin.getFrameClassicalAcceleration(model, data, frame, pin.LOCAL_WORLD_ALIGNED).linear
+        return p, v, a
+
+    def _length(self, a_frame: int, b_frame: int) -> tuple[float, float, float]:
+        """|p_b − p_a| and its first and second rates at the current motion state."""
+        pa, va, aa = self._linear(a_frame)
+        pb, vb, ab = self._linear(b_frame)
+        d, dv = pb - pa, vb - va
+        length = float(np.linalg.norm(d))
+        u = d / length
+        along = float(u @ dv)
+        return length, along, float(u @ (ab - aa) + (dv @ dv - along * along) / length)
+
+    def _state(self, q, v, a) -> None:
+        pin.forwardKinematics(self.model, self.data, q, v, a)
+        pin.updateFramePlacements(self.model, self.data)
+
+    def derivatives(self, q: np.ndarray) -> tuple[float, float, float]:
+        """The spring's length (m; a torsion bar's signed angle, rad) and its first and
+        second derivatives along the wheel centre's z (per m, per m²)."""
+        solver = self.solver
+        solver.evaluate(q)
+        v = solver.tangent()[:, 0]  # dq/dz, the other drivers held
+        zero = np.zeros(self.model.nv)
+        self._state(q, v, zero)
+        drift = []
+        for row in solver.rows:
+            if isinstance(row, BallClosure):
+                drift.extend(self._linear(row.b.frame_id)[2] - self._linear(row.a.frame_id)[2])
+            elif isinstance(row, DistanceClosure):
+                drift.append(self._length(row.a.frame_id, row.b.frame_id)[2])
+            elif isinstance(row, JointTarget):
+                drift.append(0.0)
+            else:  # the wheel centre's height: a point target along a fixed direction
+                drift.append(row.direction @ self._linear(row.point.frame_id)[2])
+        a = np.linalg.solve(solver.jacobian, -np.array(drift))
+        self._state(q, v, a)
+        if self.torsion:
+            frame = self.turn.point.frame_id
+            kin = self.corner.kin
+            kin.update(q)
+            axis = self.turn.axis(kin)
+            w = pin.getFrameVelocity(self.model, self.data, frame, pin.LOCAL_WORLD_ALIGNED)
+            dw = pin.getFrameAcceleration(self.model, self.data, frame, pin.LOCAL_WORLD_ALIGNED)
+            angle = _turned(self.corner, q)
+            return self.sense * angle, self.sense * axis @ w.angular, self.sense * axis @ dw.angular
+        return self._length(self.top.frame_id, self.bottom.frame_id)
+
+    def columns(self, qs: list) -> dict:
+        """name → (values per configuration, unit); None configurations give NaN."""
+        g = self.corner.geometry
+        n = len(qs)
+        force, wheel = np.full(n, np.nan), np.full(n, np.nan)
+        for i, q in enumerate(qs):
+            if q is None:
+                continue
+            x, dx, ddx = self.derivatives(q)
+            if self.torsion:  # wind-up (rad, + in bump) and its rates
+                stiffness = g.spring_rate * 180.0 / np.pi  # N·m/rad
+                force[i] = g.spring_preload + stiffness * (x - self.design)
+                ratio, dratio = dx, ddx
+            else:  # compression (m) and the motion ratio, −dℓ/dz
+                stiffness = g.spring_rate * 1e3  # N/m
+                force[i] = g.spring_preload + stiffness * (self.design - x)
+                ratio, dratio = -dx, -ddx
+            wheel[i] = (stiffness * ratio * ratio + force[i] * dratio) * 1e-3  # N/mm
+        out = {
+            ("spring_torque" if self.torsion else "spring_force"): (
+                force,
+                "N·m" if self.torsion else "N",
+            ),
+            "wheel_rate": (wheel, "N/mm"),
+        }
+        if g.wheel.tyre_rate is not None:
+            out["ride_rate"] = (1.0 / (1.0 / wheel + 1.0 / g.wheel.tyre_rate), "N/mm")
+        return out
+
+
+def _turned(corner, q: np.ndarray) -> float:
+    """The rocker's turn (rad) about rocker_axis_a→b from design, right-hand rule."""
+    p = corner.points
+    kin = corner.kin
+    kin.update_positions(q)
+    a, b = p["rocker_axis_a"].position(kin), p["rocker_axis_b"].position(kin)
+    u = (b - a) / np.linalg.norm(b - a)
+    arm = p["pushrod_inboard"].position(kin) - a
+    arm0 = corner.design_positions["pushrod_inboard"] - a
+    arm, arm0 = arm - u * (u @ arm), arm0 - u * (u @ arm0)
+    return float(np.arctan2(u @ np.cross(arm0, arm), arm0 @ arm))
+
+
+def rate_columns(corner, qs: list) -> dict:
+    """The spring's force and the wheel and ride rates, where the geometry gives the
+    spring's rate (else nothing)."""
+    if corner.geometry.spring_rate is None or corner.geometry.spring == "none":
+        return {}
+    return SpringRates(corner).columns(qs)

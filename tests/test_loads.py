@@ -276,3 +276,85 @@ def test_a_member_at_its_toggle_is_unbounded_not_a_huge_number():
     corner = pin_susp.Corner(data)
     moved = Statics(corner).solve(corner.q_design, CASES[0])
     assert moved["loads_unbounded"] == 0.0 and np.isfinite(moved["force_spring"])
+
+
+def _with_rate(name):
+    import yaml
+
+    source = "pushrod_rocker" if name == "torsion_bar" else name
+    data = yaml.safe_load((EXAMPLES / f"{source}.yaml").read_text())
+    if name == "macpherson":
+        data["config"]["strut"] = {"rate": 30.0, "preload": 3000.0}
+    elif name == "torsion_bar":
+        data["spring"] = {"type": "torsion_bar", "rate": 40.0, "preload": 100.0}
+        for k in ("strut_top", "strut_bottom"):
+            data["hardpoints"].pop(k)
+    else:
+        data["spring"] = {"type": "coilover", "rate": 60.0, "preload": 1500.0}
+    data["config"]["wheel"]["tyre"] = {"rate": 250.0}
+    return data
+
+
+@pytest.mark.filterwarnings("ignore::pin_susp.errors.PlausibilityWarning")
+@pytest.mark.parametrize(
+    "name", ["pushrod_rocker", "torsion_bar", "macpherson", "fixed_toe_link", "semi_trailing_arm"]
+)
+def test_wheel_rate_is_the_rate_of_spring_force_times_motion_ratio(name):
+    """wheel_rate = d(F·MR)/dz, both terms, against central differences of the written
+    F and MR over wheel travel (each side a full solve); the ride rate is the wheel
+    and tyre rates in series."""
+    corner = pin_susp.Corner(_with_rate(name))
+    rack = corner.geometry.steering == "rack"
+
+    def run(z):
+        targets = [Target("wheel_center", "z", [z])]
+        if rack:
+            targets.append(Target("trackrod_inboard", "y", [3.0]))
+        return corner.run_sweep(Sweep(targets, "x"))
+
+    torque = corner.geometry.spring == "torsion_bar"
+    force = "spring_torque" if torque else "spring_force"
+    unit = np.pi / 180.0 * 1e3 if torque else 1.0  # N·m·deg/mm² → N/mm
+    h = 0.01
+    for z in (-20.0, 25.0):
+        at, up, down = run(z), run(z + h), run(z - h)
+        fd = (up[force][0] * up["motion_ratio"][0] - down[force][0] * down["motion_ratio"][0]) / (
+            2 * h
+        )
+        assert at["wheel_rate"][0] == pytest.approx(fd * unit, rel=1e-7)
+        # and the rate is not just its first term: the force times the ratio's change
+        first = corner.geometry.spring_rate * at["motion_ratio"][0] ** 2 * unit  # rate·MR²
+        assert abs(at["wheel_rate"][0] - first) > 1e-3 * abs(first)
+        series = 1.0 / (1.0 / at["wheel_rate"][0] + 1.0 / 250.0)
+        assert at["ride_rate"][0] == pytest.approx(series, rel=1e-12)
+
+
+def test_rate_columns_appear_only_with_a_rate():
+    corner = pin_susp.Corner(EXAMPLES / "pushrod_rocker.yaml")
+    results = corner.run_sweep(EXAMPLES / "bump_steer.yaml")
+    assert not {"wheel_rate", "spring_force", "ride_rate"} & set(results.columns)
+
+
+@pytest.mark.parametrize(
+    ("change", "key"),
+    [
+        (lambda d: d.update(spring={"type": "none", "rate": 50}), "spring.rate"),
+        (lambda d: d.update(spring={"type": "coilover", "preload": 50}), "spring.preload"),
+        (lambda d: d.update(spring={"type": "coilover", "rate": -5}), "spring.rate"),
+        (lambda d: d["config"]["wheel"].update(tyre={"rate": "soft"}), "config.wheel.tyre.rate"),
+        (
+            lambda d: d["config"]["wheel"].update(tyre={"stiffness": 3}),
+            "config.wheel.tyre.stiffness",
+        ),
+    ],
+)
+def test_bad_rates_name_their_key(change, key):
+    import yaml
+
+    from pin_susp.geometry import load_geometry
+
+    data = yaml.safe_load((EXAMPLES / "pushrod_rocker.yaml").read_text())
+    change(data)
+    with pytest.raises(InputError) as info:
+        load_geometry(data)
+    assert info.value.key == key
