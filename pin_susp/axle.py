@@ -224,12 +224,16 @@ class AxleModel:
         self.mobility = self.model.nv - sum(c.size for c in self.closures)
         # the points written: each corner's, then the bar's and heave link's
         extras = [n for n in self.tree.points if not _corner_point(n, self.point_names)]
-        self.output_points = [
-            f"{side}_{n}" for side, names in self.point_names.items() for n in names
-        ] + extras
+        self.output_points = []  # left's points, then right's (the bar's by side), centre's
+        for side, names in self.point_names.items():
+            self.output_points += [f"{side}_{n}" for n in names]
+            self.output_points += [n for n in extras if n.startswith(f"{side}_")]
+        self.output_points += [n for n in extras if not n.startswith(SIDES)]
         self.frame_names = [n for n in self.output_points if "contact_patch_center" not in n]
         self.kin.update(self.q_design)
         self.design_positions = self.positions(self.q_design)
+        if elements is not None:
+            self._check_determined(elements.source)
         self.design_steer = {}
         for side, g in self.geometries.items():
             d = self.design_positions
@@ -239,6 +243,22 @@ class AxleModel:
             side: (Linkage(g).spring_sense if g.spring == "torsion_bar" else 1.0)
             for side, g in self.geometries.items()
         }
+
+    def _check_determined(self, source: str) -> None:
+        """Both wheel heights and the rack must fix the pose at design (the closures
+        with them of full rank): else a part turns freely — a droplink square to its
+        bar arm's motion (dead centre), a bar axis along a droplink."""
+        solver = NewtonSolver(self.kin, self.closures, _drive_rows(self), self.branches)
+        solver.evaluate(self.q_design)
+        s = np.linalg.svd(solver.jacobian, compute_uv=False)
+        if s[-1] <= 1e-9 * s[0]:
+            raise InputError(
+                source,
+                "hardpoints",
+                "the wheels and the rack do not fix the axle's pose at design: a part turns "
+                "freely (a droplink square to its bar arm's motion — at dead centre — or "
+                "in line with the bar's axis?)",
+            )
 
     def positions(self, q: np.ndarray) -> dict[str, np.ndarray]:
         """World position (m) of every named point (prefixed) at configuration q."""
@@ -467,6 +487,13 @@ def load_axle(source) -> AxleGeometry:
             * np.array([1.0, sign if mirrored and side == "right" else 1.0, 1.0])
             for k in extras
         }
+    for side in SIDES if anti_roll != "none" else ():
+        sp = side_points[side]
+        upper = "droplink_rocker" if "droplink_rocker" in sp else "droplink_lower"
+        lower = "droplink_u_bar" if anti_roll == "u_bar" else "droplink_t_bar"
+        if np.linalg.norm(sp[upper] - sp[lower]) < 1e-3:
+            key = "hardpoints.left" if side == "left" or mirrored else "hardpoints.right"
+            r.fail(f"{key}.{lower}", f"coincides with {upper}: the droplink has no length")
     center = {}
     wanted = CENTER.get(anti_roll, ())
     center_map = r.mapping(hp.get("center", {}), "hardpoints.center", optional=wanted)
@@ -641,10 +668,27 @@ class RollTarget(_FrameRow):
 
 def axle_rows(model: AxleModel, targets, source: str = "<targets>") -> list:
     """The solver's rows for a sweep's targets on an axle (one value each, set later)."""
-    rows = []
+    rows, seen = [], {}
     p = model.points
     d = model.design_positions
     for i, t in enumerate(targets):
+        if t.quantity is not None:
+            what = t.quantity
+        elif t.point == "trackrod_inboard":
+            what = "the rack"  # one freedom, whichever side names it
+        else:
+            what = (t.side, t.point, tuple(np.round(t.unit_direction, 12)))
+        if what in seen:
+            also = " (the rack is one freedom: target it on one side)" if what == "the rack" else ""
+            raise InputError(source, f"targets[{i}]", f"repeats targets[{seen[what]}]{also}")
+        seen[what] = i
+        if t.quantity == "roll" and np.any(np.abs(np.asarray(t.values, dtype=float)) >= 90.0):
+            raise InputError(
+                source,
+                f"targets[{i}]",
+                "roll is an angle over the track: it lies within ±90 deg (got "
+                f"{np.abs(np.asarray(t.values, dtype=float)).max():g})",
+            )
         if t.quantity == "heave":
             z0 = 0.5 * (d["left_wheel_center"][2] + d["right_wheel_center"][2])
             rows.append(HeaveTarget(p["left_wheel_center"], p["right_wheel_center"], z0))
@@ -699,8 +743,9 @@ def solve_axle_sweep(model: AxleModel, sweep, source: str | None = None, progres
             raise InputError(
                 source,
                 f"targets[{i}]",
-                "roll is unreachable: the anti-roll bar is rigid "
-                "(axle_config.anti_roll.stiffness), so the axle cannot roll",
+                "roll is fixed by the rigid anti-roll bar (axle_config.anti_roll.stiffness: "
+                "rigid): the axle only heaves, so a roll target is unreachable or redundant; "
+                "give heave (or one wheel height) and the rack",
             )
     if len(rows) != model.mobility:
         need = (
@@ -957,7 +1002,12 @@ def _axle_metrics(model: AxleModel, p: dict, sides: dict) -> dict:
     for side, s in (("left", 1.0), ("right", -1.0)):
         steer[side] = -s * sides[side]["roadwheel_angle"][0]
         out[f"steer_angle_{side}"] = (steer[side], "deg")
-    out["ackermann"] = (_ackermann(model, steer, track), "%")
+    ackermann = _ackermann(model, steer, track)
+    if "left_trackrod_inboard" not in p:  # no rack: no steering input
+        ackermann[:] = np.nan
+    else:  # bump or roll steer alone is not steering: blank with the rack at centre
+        ackermann[np.abs(rack) < 1e-6] = np.nan
+    out["ackermann"] = (ackermann, "%")
     a = model.axle
     if a is not None and a.anti_roll == "u_bar":
         axis = (a.center["arb_u_bar_axis_a"], a.center["arb_u_bar_axis_b"])

@@ -200,8 +200,9 @@ def _sweep_command(sub) -> None:
     s = sub.add_parser(
         "sweep",
         help="solve a sweep and write one CSV row per step",
-        description="Solve every step of SWEEP on the corner GEOMETRY and write the "
-        "metrics (camber, toe, caster, KPI, scrub, trail, ...) and every point to CSV. "
+        description="Solve every step of SWEEP on GEOMETRY (a corner, or an axle: scope: axle) "
+        "and write the metrics (camber, toe, caster, KPI, scrub, trail, ...; an axle's per "
+        "side, and its roll, roll centre, bar twist, ...) and every point to CSV. "
         "Exit code 1 if any step did not converge (its row is flagged).",
     )
     _geometry_argument(s)
@@ -342,6 +343,7 @@ def _sweep_axle(args) -> int:
     sweep = load_sweep(args.sweep)
     solutions = solve_axle_sweep(model, sweep, progress=_progress_bar(sweep.steps, args.quiet))
     results = axle_results(model, sweep, solutions)
+    _warn_transmission(results)
     plot = _write_results(args, results)
     if not args.quiet:
         ok = results["solver_converged"]
@@ -415,7 +417,7 @@ def _urdf(args) -> int:
         _check_outputs(args, args.output, sidecar)
     if _is_axle(args.geometry):
         if args.at is not None:
-            raise PinSuspError("--at: an axle's pose sidecar is not written yet")
+            raise PinSuspError("--at: not for an axle yet (a corner's URDF at a step only)")
         corner = _axle_model(args.geometry)  # the URDF of both corners on one chassis
     else:
         corner = Corner(load_geometry(args.geometry))
@@ -688,7 +690,15 @@ def _summary(results: Results, path) -> None:
     names = [m.name for m in METRICS if m.written and m.name in results.columns]
     names += [
         n
-        for n in ("deriv_camber_wrt_hub_z", "deriv_roadwheel_angle_wrt_hub_z", "motion_ratio")
+        for n in (
+            "deriv_camber_wrt_hub_z",
+            "deriv_roadwheel_angle_wrt_hub_z",
+            "motion_ratio",
+            "spring_force",
+            "spring_torque",
+            "wheel_rate",
+            "ride_rate",
+        )
         if n in results.columns
     ]
     print(f"  {'metric':<32}{'unit':>7}{'first':>13}{'last':>13}{'min':>13}{'max':>13}")
@@ -714,16 +724,21 @@ def _summary(results: Results, path) -> None:
 
 
 def _warn_transmission(results: Results) -> None:
-    """Name the steps where the rocker transmission angle leaves its band."""
-    angle = results.columns.get("rocker_transmission_angle")
-    if angle is None:
-        return
+    """Name the steps where a rocker transmission angle leaves its band (an axle's
+    per side)."""
+    for suffix, side in (("", ""), ("_left", "left "), ("_right", "right ")):
+        angle = results.columns.get(f"rocker_transmission_angle{suffix}")
+        if angle is not None:
+            _warn_band(angle, side)
+
+
+def _warn_band(angle: np.ndarray, side: str) -> None:
     low, high = TRANSMISSION_BAND
     outside = np.flatnonzero((angle < low) | (angle > high))
     if len(outside):
         worst = outside[np.argmax(np.abs(angle[outside] - 90.0))]
         warnings.warn(
-            f"rocker transmission angle outside {low:g}…{high:g} deg at steps "
+            f"{side}rocker transmission angle outside {low:g}…{high:g} deg at steps "
             f"{_list([int(i) for i in outside])} (worst {angle[worst]:.1f} deg at step {worst}): "
             "the rocker nears over-centre, its motion ratio falls toward zero and flips",
             PlausibilityWarning,
@@ -1164,7 +1179,10 @@ def _sensitivity(args) -> int:
 def _sensitivity_axle(args) -> int:
     """An axle's: each side's corner columns (_left, _right) and the axle's (track, roll
     centre, roll rates), for a symmetric move of both sides' points or a one-sided one."""
-    from .axle import SIDES
+    from .axle import CENTER, SIDE_EXTRAS, SIDES
+
+    side_points = {n for names in SIDE_EXTRAS.values() for n in names}
+    center_points = {n for names in CENTER.values() for n in names}
     from .sensitivity import (
         AXLE_COLUMNS,
         ONE_SIDED_MOVE,
@@ -1176,6 +1194,22 @@ def _sensitivity_axle(args) -> int:
     )
 
     model = _axle_model(args.geometry)
+    if model.axle is not None and model.axle.anti_roll_rigid:
+        raise PinSuspError(
+            f"{args.geometry}: sensitivity: not for an axle with a rigid anti-roll bar yet "
+            "(each wheel's height is held, which a rigid bar does not allow)"
+        )
+    bar = [
+        n
+        for n in (args.points or "").split(",")
+        if n.strip() in {*side_points, *center_points} or n.strip().startswith(SIDES)
+    ]
+    if bar:
+        raise PinSuspError(
+            f"--points: {bar[0].strip()} — the sensitivities of the anti-roll bar's and heave "
+            "link's points (and of side-prefixed names) are not computed yet: give the "
+            "corners' hardpoints (both sides move together; --one-sided for one side)"
+        )
     sens = AxleSensitivity(model, args.one_sided)
     points = select_points(sens.sides["left"].corner, args.points)
     if args.one_sided:

@@ -273,6 +273,10 @@ def warn_outside(what: str, value: float, low: float, high: float, unit_text: st
 def _parse(data: dict, r: Reader, sha: str | None) -> Geometry:
     from . import mechanisms
 
+    if isinstance(data, dict) and data.get("scope") != "axle":
+        for key in ("axle_config", "vehicle_config"):
+            if key in data:
+                r.fail("scope", f"an axle's file (it has {key}) needs scope: axle")
     r.mapping(
         data,
         "",

@@ -112,7 +112,12 @@ class NewtonSolver:
         (or J·T = ``rhs``: a column per change of the rows' values, e.g. a link's length)."""
         rhs = self._unit_rhs if rhs is None else rhs
         if self.jacobian.shape[0] != self.jacobian.shape[1]:  # more rows than freedoms
-            return np.full((self.jacobian.shape[1], rhs.shape[1]), np.nan)
+            # a column whose system is consistent has its exact tangent (e.g. the rack of
+            # an axle with a rigid bar); the others (a wheel moved alone) have none: NaN
+            T = np.linalg.lstsq(self.jacobian, rhs, rcond=None)[0]
+            miss = np.abs(self.jacobian @ T - rhs).max(axis=0)
+            T[:, miss > 1e-9 * (1.0 + np.abs(T).max(axis=0))] = np.nan
+            return T
         _, _, T, info = lapack.dgesv(self.jacobian, rhs)
         return T if info == 0 else np.full((self.jacobian.shape[1], rhs.shape[1]), np.nan)
 

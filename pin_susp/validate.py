@@ -239,15 +239,14 @@ class AxleScope:
         return held
 
     def duals(self, points: dict, rates: dict) -> dict[str, dict[str, Dual]]:
-        """Each side's rates; none for a rigid bar, as the sweep writes none (one wheel
-        cannot move with the other held: the engines' held system has no solution)."""
+        """Each side's rates; for a rigid bar none along a wheel's own height, as the
+        sweep writes none (one wheel cannot move with the other held)."""
         axle = self.subject.axle
-        blank = axle is not None and axle.anti_roll_rigid
+        hub = np.array([np.nan if axle is not None and axle.anti_roll_rigid else 1.0])
+        scale = {s: np.r_[hub, np.ones(len(self.side_drivers[s]) - 1)][:, None] for s in SIDES}
         return {
             name: {
-                s: Dual(
-                    p[None], rates[name][self.side_drivers[s]][:, None] * (np.nan if blank else 1.0)
-                )
+                s: Dual(p[None], rates[name][self.side_drivers[s]][:, None] * scale[s])
                 for s in SIDES
             }
             for name, p in points.items()
