@@ -20,7 +20,9 @@ where there is no rack, against the fixed-toe-link double wishbone) it prints:
 - the example axle (examples/axle_front.yaml: two pushrod-rocker corners, one
   rack, a U-bar) against its corner (examples/pushrod_rocker.yaml), per step,
   measured in alternation: bump + steer on both wheels and a roll sweep (roll
-  and heave targets), solve alone and solve with every column (target <= 2.5x).
+  and heave targets), solve alone and solve with every column (target <= 2.5x);
+- the member forces under examples/loads.yaml's 3 load cases on the pushrod-rocker
+  corner's 101-step sweep, as a share of the sweep's own time (target <= 30 %).
 
 Timing lives here, never in the tests (a test runs ``--quick`` and checks
 only iterations and residuals).
@@ -204,7 +206,36 @@ def run(repeat: int, quick: bool) -> dict:
     for name, ratio in interleaved(pairs, max(3, repeat // 2)).items():
         report["corners"][name]["vs"] = {"corner": pairs[name], "ratio": ratio}
     report["axle"] = axle_vs_corner(max(3, repeat // 2))
+    report["loads"] = loads_overhead(max(3, repeat // 4))
     return report
+
+
+def loads_overhead(rounds: int, steps: int = 101) -> dict:
+    """The sweep with every column, and the same with the forces of 3 load cases added
+    (pin-susp loads), per step, in alternation."""
+    from pin_susp.loads import load_cases, member_forces
+
+    corner = pin_susp.Corner(EXAMPLES / "pushrod_rocker.yaml")
+    cases = load_cases(EXAMPLES / "loads.yaml")
+    sweep = bump_steer(steps)
+
+    def with_forces():
+        tangents = []
+        solutions = corner.solve_steps(sweep, tangents=tangents)
+        results = pin_susp.Results.from_solutions(corner, solutions, sweep, tangents)
+        return member_forces(corner, sweep, cases, solutions, results)
+
+    jobs = {"sweep": lambda: corner.run_sweep(sweep), "sweep + forces": with_forces}
+    times = {name: [] for name in jobs}
+    for job in jobs.values():
+        job()
+    for _ in range(rounds):
+        for name, job in jobs.items():
+            started = time.perf_counter()
+            job()
+            times[name].append((time.perf_counter() - started) / steps * 1e6)
+    us = {name: float(np.median(t)) for name, t in times.items()}
+    return {"us_per_step": us, "added": us["sweep + forces"] / us["sweep"] - 1.0, "cases": 3}
 
 
 def axle_sweeps(steps: int) -> dict[str, Sweep]:
@@ -355,6 +386,15 @@ def show_axle(axle: dict) -> None:
         print(f"  {name:26s} {us[name]:8.1f} us = {ratio:.2f}x")
 
 
+def show_loads(loads: dict) -> None:
+    us = loads["us_per_step"]
+    print(
+        f"\nloads: pushrod_rocker.yaml, 101 steps, {loads['cases']} load cases: sweep "
+        f"{us['sweep']:.1f} us/step, with the forces {us['sweep + forces']:.1f} us/step = "
+        f"+{100 * loads['added']:.0f} % (target <= 30 %)"
+    )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=40, help="repetitions per measurement")
@@ -364,6 +404,7 @@ def main() -> None:
     report = run(3 if args.quick else args.repeat, args.quick)
     show(report)
     show_axle(report["axle"])
+    show_loads(report["loads"])
     if args.json:
         Path(args.json).write_text(json.dumps(report, indent=2, default=float))
         print(f"\nwrote {args.json}")

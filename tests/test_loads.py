@@ -330,9 +330,13 @@ def test_wheel_rate_is_the_rate_of_spring_force_times_motion_ratio(name):
 
 
 def test_rate_columns_appear_only_with_a_rate():
-    corner = pin_susp.Corner(EXAMPLES / "pushrod_rocker.yaml")
-    results = corner.run_sweep(EXAMPLES / "bump_steer.yaml")
+    corner = pin_susp.Corner(EXAMPLES / "fixed_toe_link.yaml")  # a coilover, no rate
+    results = corner.run_sweep(EXAMPLES / "bump.yaml")
     assert not {"wheel_rate", "spring_force", "ride_rate"} & set(results.columns)
+    rated = pin_susp.Corner(EXAMPLES / "pushrod_rocker.yaml").run_sweep(
+        EXAMPLES / "bump_steer.yaml"
+    )
+    assert {"wheel_rate", "spring_force", "ride_rate"} <= set(rated.columns)
 
 
 @pytest.mark.parametrize(
