@@ -21,6 +21,7 @@ load is its outboard ball joint is a pair of two-force legs.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,6 +30,7 @@ from scipy.linalg import lapack
 
 from .closures import BallClosure, DistanceClosure, JointTarget
 from .errors import PinSuspError
+from .solver import NewtonSolver
 from .sweep import Sweep
 from .yamlio import Reader, load_yaml
 
@@ -99,25 +101,27 @@ def member_forces(corner, sweep, cases: list, solutions=None, results=None, prog
     if results is None:
         results = Results.from_solutions(corner, solutions, sweep)
     names = statics.names
-    rows = []
+    W = statics.loads_matrix(cases)
+    n, m = len(cases), len(solutions)
+    values = np.full((len(names), m * n), np.nan)
+    unbounded = np.full(m * n, np.nan)
     for i, solution in enumerate(solutions):
         if solution.converged:
-            rows += statics.solve_cases(solution.q, cases)
-        else:
-            rows += [dict.fromkeys(names, np.nan) | {"loads_unbounded": np.nan} for _ in cases]
+            at = statics.solve_matrix(solution.q, W)
+            unbounded[i * n : (i + 1) * n] = at is None
+            if at is not None:
+                values[:, i * n : (i + 1) * n] = at
         if progress is not None:
-            progress(i + 1, len(solutions))
-    n = len(cases)
+            progress(i + 1, m)
     columns = {
         "step_index": np.repeat(results["step_index"], n),
-        "load_case": np.array([c.name for c in cases] * len(solutions), dtype=object),
+        "load_case": np.array([c.name for c in cases] * m, dtype=object),
+        "loads_unbounded": unbounded,
     }
-    units = {"step_index": "", "load_case": ""}
-    for name in ["loads_unbounded", *names]:
-        columns[name] = np.array([row[name] for row in rows])
-        units[name] = (
-            "N·m" if name.startswith("torque") else "" if name == "loads_unbounded" else "N"
-        )
+    units = {"step_index": "", "load_case": "", "loads_unbounded": ""}
+    for k, name in enumerate(names):
+        columns[name] = values[k]
+        units[name] = "N·m" if name.startswith("torque") else "N"
     for name, values in results.columns.items():
         if name != "step_index":
             columns[name] = np.repeat(values, n)
@@ -126,14 +130,19 @@ def member_forces(corner, sweep, cases: list, solutions=None, results=None, prog
 
 
 class Statics:
-    """The equilibrium of one corner (a Linkage) at its poses."""
+    """The equilibrium of one corner (a Linkage) at its poses, every load case at once.
+
+    Per pose: the held rows' Jacobian J from the solver's batch, one LU of Jᵀ for all
+    cases, λ = −J⁻ᵀ·G·W with G = [J_cp; J_wc; J_ω]ᵀ and W the cases' loads (a column
+    each). A tree joint's force (the parent's on its subtree) is minus the sum of the
+    external forces on the subtree — the applied loads and the closures' multipliers
+    at their ends, which bodies carry them being fixed by the tree — so no inverse
+    dynamics runs per case (the tests check it against Pinocchio's ``rnea``).
+    """
 
     def __init__(self, corner):
         g = corner.geometry
         self.corner, self.model = corner, corner.model
-        self.data = self.model.createData()
-        self.upright = corner.mechanism.WHEEL_BODY
-        held = []
         if g.spring == "none":
             raise PinSuspError(
                 f"{g.source}: spring.type: none leaves bump without a load path (no member "
@@ -141,178 +150,248 @@ class Statics:
             )
         if g.spring == "coilover":
             top, bottom = corner.points["strut_top"], corner.points["strut_bottom"]
-            held.append(DistanceClosure("spring", top, bottom, 0.0))
+            spring = DistanceClosure("spring", top, bottom, 0.0)
         else:  # a torsion bar: the rocker's turn about its axis
-            held.append(_RockerTurn(corner))
-        if g.steering == "rack":
-            held.append(JointTarget(self.model, "rack_slide"))
-        self.rows = list(corner.closures) + held
-        self._names = None
-        self.size = sum(row.size for row in self.rows)
+            spring = _RockerTurn(corner)
+        held = [JointTarget(self.model, "rack_slide")] if g.steering == "rack" else []
+        self.solver = NewtonSolver(corner.kin, [*corner.closures, spring], held)
+        self.rows = self.solver.rows
+        self.size = self.solver.nrows
         if self.size != self.model.nv:
             raise PinSuspError(
                 f"{g.source}: the closures, spring and rack hold {self.size} of the "
                 f"{self.model.nv} freedoms: the loads are not determined"
             )
+        self._plan()
 
-    def jacobian(self, q: np.ndarray) -> np.ndarray:
-        """The held rows' Jacobian at q (the corner's kinematics updated to q)."""
-        kin = self.corner.kin
-        kin.update(q)
-        return np.vstack([row.jacobian(kin) for row in self.rows])
+    # ---------------------------------------------------------------- the plan
 
-    def applied(self, case: LoadCase) -> np.ndarray:
-        """Σ J_pᵀ w_p: the generalised force of the case at the current pose."""
-        corner, kin = self.corner, self.corner.kin
-        wc = corner.points["wheel_center"]
-        J = kin.frame_jacobian(wc.frame_id)  # linear at WC, angular: the upright's
-        r = corner.points["contact_patch_center"].position(kin) - wc.position(kin)
-        at_patch = J[:3] - _skew(r) @ J[3:]  # the upright's material point at the patch
-        return (
-            at_patch.T @ case.contact_patch
-            + J[:3].T @ case.wheel_center
-            + J[3:].T @ case.moment  # a couple: the same at any point of the upright
+    def _plan(self) -> None:
+        """Which multiplier acts where, which tree joint's subtree holds each end, and
+        the column each output comes from (fixed by the tree: worked out once)."""
+        corner, model = self.corner, self.model
+        joint_of = lambda point: model.frames[point.frame_id].parentJoint  # noqa: E731
+        self.ends = []  # (first multiplier, size, point, sign, the other end or None)
+        self.direct = []  # (name, first multiplier, size, factor): the rows' own outputs
+        col = 0
+        for row in self.rows:
+            if isinstance(row, BallClosure):
+                self.ends += [(col, 3, row.b, 1.0, None), (col, 3, row.a, -1.0, None)]
+                name = row.name.removesuffix("_mount")
+                self.direct.append((f"load_{name}", col, 3, -1.0))  # outboard on inboard
+            elif isinstance(row, DistanceClosure):
+                self.ends += [(col, 1, row.b, 1.0, row.a), (col, 1, row.a, -1.0, row.b)]
+                spring = row.name == "spring"
+                self.direct.append(
+                    (
+                        "force_spring" if spring else f"force_{row.name}",
+                        col,
+                        1,
+                        1.0 if spring else -1.0,
+                    )
+                )
+            elif isinstance(row, _RockerTurn):
+                self.couple = (col, row)
+                self.direct.append(("torque_spring", col, 1, 1.0))
+            else:  # the rack, held by the steering: the trackrods' pull on it is −λ
+                self.direct.append(("force_rack", col, 1, -1.0))
+            col += row.size
+        self.couple = getattr(self, "couple", None)
+        self.wc = corner.points["wheel_center"]
+        upright = joint_of(self.wc)
+        self.joints = []  # (body, joint, pinocchio index, ends inside, load inside, rocker inside)
+        for body in corner.tree.bodies:
+            j = body.joint
+            if j is None:
+                continue
+            index = model.getJointId(j.name + {"ball": "_x", "universal": "_b"}.get(j.kind, ""))
+            first = model.getJointId(j.name + {"ball": "_z", "universal": "_a"}.get(j.kind, ""))
+            inside = lambda joint, first=first: first in model.supports[joint]  # noqa: E731
+            ends = [k for k, e in enumerate(self.ends) if inside(joint_of(e[2]))]
+            rocker = self.couple is not None and inside(joint_of(self.couple[1].point))
+            self.joints.append((body, j, index, ends, inside(upright), rocker))
+        # the ends as arrays: their frames (and the other end's), signs, multipliers
+        self.frames = list(dict.fromkeys(e[2].frame_id for e in self.ends))
+        place = {f: i for i, f in enumerate(self.frames)}
+        self.end_at = np.array([place[e[2].frame_id] for e in self.ends], dtype=int)
+        self.end_other = np.array([place[(e[4] or e[2]).frame_id] for e in self.ends], dtype=int)
+        self.end_sign = np.array([e[3] for e in self.ends])
+        self.end_rows = np.array(
+            [[e[0] + (i if e[1] == 3 else 0) for i in range(3)] for e in self.ends], dtype=int
         )
+        self.distance_ends = np.array([k for k, e in enumerate(self.ends) if e[1] == 1], dtype=int)
+        self.directions = np.array(
+            [np.eye(3) if e[1] == 3 else np.zeros((3, 3)) for e in self.ends]
+        )
+        self.specs = [self._joint_spec(body, j) for body, j, *_ in self.joints]
+        self.subtree = np.zeros((len(self.joints), len(self.ends)))
+        for k, (*_, ends, _, _) in enumerate(self.joints):
+            self.subtree[k, ends] = 1.0
+        self.names = [
+            n for name, _, size, _ in self.direct for n in (_xyz(name) if size == 3 else [name])
+        ]
+        for body, j, *_ in self.joints:
+            self.names += self._joint_names(body, j)
+
+    def _joint_names(self, body, j) -> list[str]:
+        if j.kind == "ball":
+            return _xyz(f"load_{j.name}")
+        if j.kind == "universal":
+            return [f"force_{body.name}"]
+        if j.kind == "revolute" and len(j.defined_by) == 2:
+            names = _xyz(f"load_{_bushing(j.defined_by[0])}") + _xyz(
+                f"load_{_bushing(j.defined_by[1])}"
+            )
+            return names + list(self._legs(body.name, j.defined_by) or {})
+        return []
+
+    def _legs(self, arm: str, pickups) -> dict | None:
+        """A wishbone's legs: name → pickup, when the arm is loaded at its outboard ball
+        alone (its legs two-force members); {} with blank columns when not; None for
+        an arm that is no wishbone."""
+        outboard = f"{arm}_outboard"
+        if not arm.endswith("wishbone") or outboard not in self.corner.points:
+            return None
+        names = {f"force_{arm}_{'front' if 'front' in n else 'rear'}": n for n in pickups}
+        others = [n for n, (b, _) in self.corner.tree.points.items() if b == arm and n != outboard]
+        return dict.fromkeys(names) if others else names
+
+    # ---------------------------------------------------------------- solving
+
+    def loads_matrix(self, cases: list[LoadCase]) -> np.ndarray:
+        """W (9 × cases): each case's contact-patch force, wheel-centre force, moment."""
+        return np.array(
+            [np.r_[c.contact_patch, c.wheel_center, c.moment] for c in cases], dtype=float
+        ).T
+
+    def solve_matrix(self, q: np.ndarray, W: np.ndarray) -> np.ndarray | None:
+        """Every output column (rows: self.names) for each case (columns of W) at the
+        pose q; None at a toggle (the held rows singular: a member cannot hold its
+        load, the force is unbounded)."""
+        solver, kin = self.solver, self.corner.kin
+        solver.evaluate(q)  # the kinematics (Jacobians too) and the held rows at q
+        J = solver.jacobian
+        lu, pivots, info = lapack.dgetrf(J.T)
+        rcond = lapack.dgecon(lu, np.abs(J).sum(axis=1).max())[0] if info == 0 else 0.0
+        if rcond < 1.0 / TOGGLE:
+            return None
+        G, cp, wc = self._load_map()
+        lam = lapack.dgetrs(lu, pivots, -(G @ W))[0]
+        out = [factor * lam[col : col + size] for _, col, size, factor in self.direct]
+        # every closure end's force (ends × 3 × cases), and its moment about the origin
+        oMf = kin.data.oMf
+        P = np.array([oMf[f].translation for f in self.frames])
+        at, other = P[self.end_at], P[self.end_other]
+        u = self.end_sign[:, None] * (at - other)  # a distance's (b − a) at either end
+        lengths = np.linalg.norm(u[self.distance_ends], axis=1)
+        directions = self.directions.copy()  # I for a ball's ends, û in column 0 else
+        directions[self.distance_ends, :, 0] = u[self.distance_ends] / lengths[:, None]
+        forces = self.end_sign[:, None, None] * np.einsum(
+            "eij,ejc->eic", directions, lam[self.end_rows]
+        )
+        moments = _cross(at.T[:, :, None], forces.transpose(1, 0, 2)).transpose(1, 0, 2)
+        # a tree joint's force on its subtree: minus the external forces inside it
+        through_f = -np.einsum("je,eic->jic", self.subtree, forces)
+        through_m = -np.einsum("je,eic->jic", self.subtree, moments)
+        load_f = W[0:3] + W[3:6]
+        load_m = _cross(cp, W[0:3]) + _cross(wc, W[3:6]) + W[6:9]
+        if self.couple is not None:
+            col, turn = self.couple
+            couple = np.outer(turn.axis(kin), lam[col])
+        for k, (*_, loaded, rocker) in enumerate(self.joints):
+            f, m = through_f[k], through_m[k]
+            if loaded:
+                f, m = f - load_f, m - load_m
+            if rocker:
+                m = m - couple
+            out += self._joint_columns(self.specs[k], f, m)
+        return np.vstack(out)
+
+    def _load_map(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """G = [J_cp; J_wc; J_ω]ᵀ (nv × 9) at the current kinematics, with the upright's
+        material point at the contact patch, and the patch and wheel centre."""
+        kin = self.corner.kin
+        Jw = kin.frame_jacobian(self.wc.frame_id)  # linear at WC, angular: the upright's
+        wc = self.wc.position(kin)
+        cp = self.corner.points["contact_patch_center"].position(kin)
+        at_patch = Jw[:3] - _skew(cp - wc) @ Jw[3:]
+        return np.vstack([at_patch, Jw[:3], Jw[3:]]).T, cp, wc
+
+    def generalized(self, q: np.ndarray, case: LoadCase) -> np.ndarray:
+        """Σ J_pᵀ w_p at q: the case's generalised force (its virtual work per dq)."""
+        self.corner.kin.update(q)
+        return self._load_map()[0] @ self.loads_matrix([case])[:, 0]
+
+    def _joint_spec(self, body, j) -> tuple:
+        """What a tree joint writes, with what is fixed about it worked out once."""
+        corner = self.corner
+        if j.kind == "ball":
+            return ("ball",)
+        if j.kind == "universal":  # a link from a universal joint to a ball: two-force
+            ends = (corner.points[f"{body.name}_inboard"], corner.points[f"{body.name}_outboard"])
+            return ("link", *ends)
+        if j.kind != "revolute" or len(j.defined_by) != 2:
+            return ("none",)
+        a, b = (corner.design_positions[n] for n in j.defined_by)
+        d = b - a
+        legs = self._legs(body.name, j.defined_by)
+        pickups = None
+        if legs is not None and all(v is not None for v in legs.values()):
+            pickups = np.array([corner.design_positions[n] for n in legs.values()])
+        ball = corner.points.get(f"{body.name}_outboard")
+        blank = 0 if legs is None else len(legs)
+        return ("pivot", a, d[:, None], d[:, None] / (d @ d), pickups, ball, blank)
+
+    def _joint_columns(self, spec, force, moment) -> list[np.ndarray]:
+        """From the parent's force on a subtree (3 × cases) and its moment about the
+        world origin: a ball joint's load, a link's tension, a pivot's bushings, legs."""
+        kind = spec[0]
+        if kind == "ball":
+            return [-force]  # outboard on inboard
+        kin = self.corner.kin
+        if kind == "link":
+            u = spec[1].position(kin) - spec[2].position(kin)
+            return [(u / math.sqrt(u @ u)) @ force]
+        if kind == "none":
+            return []
+        _, a, d, d_scaled, pickups, ball, blank = spec
+        at_a = moment - _cross(a, force)
+        on_b = _cross(at_a, d) / (d.T @ d) + d_scaled * (0.5 * (d.T @ force))
+        out = [on_b - force, -on_b]  # the bushings' loads on the chassis
+        if pickups is None:
+            return out if not blank else [*out, np.full((blank, force.shape[1]), np.nan)]
+        U = (ball.position(kin) - pickups).T
+        U = U / np.sqrt((U * U).sum(axis=0))
+        # the chassis holds the arm through its legs: force = −Σ tension · (pickup → ball)ˆ
+        return [*out, np.linalg.solve(U.T @ U, U.T @ -force)]  # exact: force in their plane
+
+    def solve_cases(self, q: np.ndarray, cases: list[LoadCase]) -> list[dict[str, float]]:
+        """The columns under each case at q, as dicts; at a toggle every force is NaN and
+        ``loads_unbounded`` is 1."""
+        values = self.solve_matrix(q, self.loads_matrix(cases))
+        if values is None:
+            return [dict.fromkeys(self.names, np.nan) | {"loads_unbounded": 1.0} for _ in cases]
+        return [
+            dict(zip(self.names, values[:, k].tolist(), strict=True)) | {"loads_unbounded": 0.0}
+            for k in range(len(cases))
+        ]
 
     def solve(self, q: np.ndarray, case: LoadCase) -> dict[str, float]:
         """Every force column at the pose q under the case (N, N·m)."""
         return self.solve_cases(q, [case])[0]
 
-    def solve_cases(self, q: np.ndarray, cases: list[LoadCase]) -> list[dict[str, float]]:
-        """The columns under each case at q: one factorisation of the held rows for all
-        cases. At a toggle (the rows singular: a member cannot hold its load, the force
-        is unbounded) every force is NaN and ``loads_unbounded`` is 1."""
-        J = self.jacobian(q)
-        lu, pivots, info = lapack.dgetrf(J.T)
-        rcond = lapack.dgecon(lu, np.abs(J).sum(axis=1).max())[0] if info == 0 else 0.0
-        if rcond < 1.0 / TOGGLE:
-            return [dict.fromkeys(self.names, np.nan) | {"loads_unbounded": 1.0} for _ in cases]
-        applied = np.column_stack([self.applied(case) for case in cases])
-        lam = lapack.dgetrs(lu, pivots, -applied)[0]
-        return [
-            self._columns(q, lam[:, k], case) | {"loads_unbounded": 0.0}
-            for k, case in enumerate(cases)
-        ]
 
-    @property
-    def names(self) -> list[str]:
-        """The force columns, in order (worked out once, at the design state)."""
-        if self._names is None:
-            q = self.corner.q_design
-            zero = LoadCase("", np.zeros(3), np.zeros(3), np.zeros(3))
-            self.jacobian(q)
-            self._names = list(self._columns(q, np.zeros(self.size), zero))
-        return self._names
+def _xyz(name: str) -> list[str]:
+    return [f"{name}_{a}" for a in "xyz"]
 
-    # ---------------------------------------------------------------- the columns
 
-    def _columns(self, q, lam, case) -> dict[str, float]:
-        corner, kin, model = self.corner, self.corner.kin, self.model
-        out, external = {}, [pin.Force.Zero() for _ in range(model.njoints)]
-
-        def push(point, force, moment=None):
-            """A force (and couple) at a frame point, world axes, as the joint's fext."""
-            frame = model.frames[point.frame_id]
-            if frame.parentJoint == 0:
-                return
-            p = point.position(kin)
-            couple = np.cross(p, force) if moment is None else np.cross(p, force) + moment
-            world = pin.Force(force, couple)
-            external[frame.parentJoint] += kin.data.oMi[frame.parentJoint].actInv(world)
-
-        i = 0
-        for row in self.rows:
-            value = lam[i : i + row.size]
-            i += row.size
-            if isinstance(row, BallClosure):
-                out |= _vector(
-                    f"load_{row.name.removesuffix('_mount')}", -value
-                )  # outboard on inboard
-                push(row.b, value)
-                push(row.a, -value)
-            elif isinstance(row, DistanceClosure):
-                u = row.b.position(kin) - row.a.position(kin)
-                u /= np.linalg.norm(u)
-                name = "force_spring" if row.name == "spring" else f"force_{row.name}"
-                out[name] = value[0] if row.name == "spring" else -value[0]
-                push(row.b, value[0] * u)
-                push(row.a, -value[0] * u)
-            elif isinstance(row, _RockerTurn):
-                out["torque_spring"] = value[0]
-                push(row.point, np.zeros(3), value[0] * row.axis(kin))
-            else:  # the rack: held by the steering
-                out["force_rack"] = -value[0]
-        # the applied loads, on the upright
-        wc = corner.points["wheel_center"]
-        patch = corner.points["contact_patch_center"].position(kin)
-        push(
-            wc,
-            case.wheel_center,
-            case.moment + np.cross(patch - wc.position(kin), case.contact_patch),
-        )
-        push(wc, case.contact_patch)
-        out |= self._tree_loads(q, external)
-        return out
-
-    def _tree_loads(self, q, external) -> dict[str, float]:
-        """Forces through the tree's joints: pivot bushings (on the chassis), the
-        lower ball joint (outboard on inboard), a two-force link's tension, legs."""
-        corner, model, data = self.corner, self.model, self.data
-        gravity = model.gravity.copy()
-        model.gravity = pin.Motion.Zero()
-        zero = np.zeros(model.nv)
-        self.tau = pin.rnea(model, data, q, zero, zero, pin.StdVec_Force(external)).copy()
-        model.gravity = gravity
-        kin = corner.kin
-        design = corner.design_positions
-        out = {}
-        for body in corner.tree.bodies:
-            j = body.joint
-            if j is None:
-                continue
-            last = j.name + {"ball": "_x", "universal": "_b"}.get(j.kind, "")
-            index = model.getJointId(last)
-            world = kin.data.oMi[index].act(data.f[index])  # parent on child, world origin
-            force, moment = world.linear.copy(), world.angular.copy()
-            if j.kind == "ball":
-                out |= _vector(f"load_{j.name}", -force)
-            elif j.kind == "universal":  # a link: chassis → ball joint, two-force
-                inboard, outboard = (
-                    kin.data.oMf[corner.points[n].frame_id].translation
-                    for n in (f"{body.name}_inboard", f"{body.name}_outboard")
-                )
-                u = (inboard - outboard) / np.linalg.norm(inboard - outboard)
-                out[f"force_{body.name}"] = force @ u
-            elif j.kind == "revolute" and len(j.defined_by) == 2:
-                a, b = (design[n] for n in j.defined_by)
-                at_a = moment - np.cross(a, force)  # about bushing a
-                d = b - a
-                on_b = np.cross(at_a, d) / (d @ d) + 0.5 * (force @ d) / (d @ d) * d
-                on_a = force - on_b
-                for n, f in zip(j.defined_by, (on_a, on_b), strict=True):
-                    out |= _vector(f"load_{_bushing(n)}", -f)  # on the chassis
-                out |= self._legs(body.name, j.defined_by, force)
-        return out
-
-    def _legs(self, arm: str, pickups, force) -> dict[str, float]:
-        """A wishbone loaded at its outboard ball alone: the tension in each leg (N);
-        blank when anything else loads the arm (a pushrod, spring or droplink)."""
-        corner = self.corner
-        outboard = f"{arm}_outboard"
-        if not arm.endswith("wishbone") or outboard not in corner.points:
-            return {}
-        others = [n for n, (b, _) in corner.tree.points.items() if b == arm and n != outboard]
-        kin = corner.kin
-        out_p = corner.points[outboard].position(kin)
-        legs = [out_p - corner.design_positions[n] for n in pickups]
-        u = np.column_stack([leg / np.linalg.norm(leg) for leg in legs])
-        names = [f"force_{arm}_{'front' if 'front' in n else 'rear'}" for n in pickups]
-        if others:
-            return dict.fromkeys(names, np.nan)
-        # the chassis holds the arm through the legs: force = Σ tension · (pickup → ball)ˆ
-        # pulled toward the chassis: the chassis's force on the arm is −Σ t·u
-        t = np.linalg.lstsq(u, -force, rcond=None)[0]
-        return dict(zip(names, t, strict=True))
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a × b for (3,) or (3, n) arrays, component by component (np.cross is slow here)."""
+    if a.ndim == 1:
+        a = a[:, None]
+    return np.array(
+        [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    )
 
 
 class _RockerTurn:
@@ -324,6 +403,9 @@ class _RockerTurn:
     def __init__(self, corner):
         self.corner = corner
         self.point = corner.points["pushrod_inboard"]  # any frame on the rocker
+
+    def residual(self, kin) -> np.ndarray:  # a held row: only its Jacobian counts
+        return np.zeros(1)
 
     def axis(self, kin) -> np.ndarray:
         p = self.corner.points

@@ -73,8 +73,7 @@ def test_virtual_work_of_a_member_lengthened_is_its_tension(rocker):
     case = CASES[1]
     q0 = qs[2]
     forces = statics.solve(q0, case)
-    statics.jacobian(q0)
-    Q = statics.applied(case)  # Σ J_pᵀ w_p at q0
+    Q = statics.generalized(q0, case)  # Σ J_pᵀ w_p at q0
     eps = 1e-6
     p = corner.points
     spring = DistanceClosure("spring", p["strut_top"], p["strut_bottom"], 0.0)
@@ -121,17 +120,62 @@ def _held(spring, corner, q):
     return Length()
 
 
-def test_the_free_joints_carry_no_torque_and_the_rack_its_force(rocker):
-    """Inverse dynamics at rest with the applied and closure forces as external loads:
-    every joint not held carries zero torque; the rack's is minus the rack force."""
+def test_tree_joint_loads_equal_pinocchios_inverse_dynamics_at_rest(rocker):
+    """Pinocchio's rnea (v = a = 0, no gravity) with the written member forces, ball
+    loads, spring force and the case as external forces: every free joint carries no
+    torque, the rack its force, and the force through the lower ball joint and each
+    pivot is the written one."""
+    import pinocchio as pin
+
     corner, statics, qs = rocker
-    forces = statics.solve(qs[0], CASES[0])
-    names = [corner.model.names[j] for j in range(1, corner.model.njoints)]
-    for name, tau in zip(names, statics.tau, strict=True):
-        if name == "rack_slide":
-            assert tau == pytest.approx(-forces["force_rack"], rel=1e-12)
-        else:
-            assert abs(tau) < 1e-9 * max(abs(v) for v in forces.values()), name
+    model, data = corner.model, corner.model.createData()
+    model.gravity = pin.Motion.Zero()
+    for q, case in zip(qs, CASES * 2, strict=False):
+        f = statics.solve(q, case)
+        corner.kin.update(q)
+        p = {n: corner.points[n].position(corner.kin).copy() for n in corner.points}
+        fext = [pin.Force.Zero() for _ in range(model.njoints)]
+
+        def push(point, force, couple=None, on=None, fext=fext, p=p):
+            """A force at a point's place, on the body of ``on`` (default: the point's)."""
+            joint = model.frames[corner.points[on or point].frame_id].parentJoint
+            if joint:
+                moment = np.cross(p[point], force) + (0.0 if couple is None else couple)
+                fext[joint] += corner.kin.data.oMi[joint].actInv(pin.Force(force, moment))
+
+        for name, (inboard, outboard) in list(MEMBERS.items())[4:]:  # trackrod, pushrod
+            u = (p[inboard] - p[outboard]) / np.linalg.norm(p[inboard] - p[outboard])
+            push(outboard, f[f"force_{name}"] * u)
+            push(inboard, -f[f"force_{name}"] * u)
+        upper = np.array([f[f"load_upper_ball_joint_{a}"] for a in "xyz"])  # upright on arm
+        push("upper_wishbone_outboard", upper)
+        push("upper_wishbone_outboard", -upper, on="wheel_center")  # the arm on the upright
+        u = p["strut_bottom"] - p["strut_top"]
+        push("strut_bottom", f["force_spring"] * u / np.linalg.norm(u))
+        r = p["contact_patch_center"] - p["wheel_center"]
+        push("wheel_center", case.contact_patch + case.wheel_center,
+             case.moment + np.cross(r, case.contact_patch))  # fmt: skip
+        tau = pin.rnea(model, data, q, np.zeros(model.nv), np.zeros(model.nv), fext)
+        scale = np.abs(case.contact_patch).sum()
+        for j in range(1, model.njoints):
+            if model.names[j] == "rack_slide":
+                assert tau[model.joints[j].idx_v] == pytest.approx(-f["force_rack"], rel=1e-9)
+            else:
+                assert abs(tau[model.joints[j].idx_v]) < 1e-9 * scale, model.names[j]
+
+        def through(joint):  # the parent's force on the subtree, world axes
+            i = model.getJointId(joint)
+            return corner.kin.data.oMi[i].act(data.f[i])
+
+        lbj = through("lower_ball_joint_x").linear
+        np.testing.assert_allclose([f[f"load_lower_ball_joint_{a}"] for a in "xyz"], -lbj,
+                                   atol=1e-9 * scale)  # fmt: skip
+        for arm in ("lower_wishbone", "upper_wishbone"):
+            bushings = sum(
+                np.array([f[f"load_{arm}_{end}_bushing_{a}"] for a in "xyz"])
+                for end in ("front", "rear")
+            )
+            np.testing.assert_allclose(bushings, -through(f"{arm}_pivot").linear, atol=1e-9 * scale)
 
 
 def test_a_corner_without_a_spring_has_no_load_path():
