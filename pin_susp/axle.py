@@ -646,24 +646,54 @@ class RollTarget(_FrameRow):
     (open-kinematics' roll: + = the left wheel higher relative to the chassis)."""
 
     name = "target roll"
+    angular = True  # from_frames gets the wheel centres' placements and 6-row Jacobians
 
-    def __init__(self, wheels, patches, design: float, value: float = 0.0):
-        self.patches = patches  # (left, right) ContactPatchPoints
-        self.frame_points = (*wheels, *patches[0].frame_points, *patches[1].frame_points)
+    def __init__(self, wheels, radii, kin, design: float, value: float = 0.0, spin=None):
+        self.frame_points = tuple(wheels)  # (left, right) wheel centres
+        self.radii = radii
         self.design, self.value = design, value  # design: ΔWC_z,L − ΔWC_z,R offset (m)
+        # each spin axis AI → AO in its wheel-centre frame (it turns with the upright)
+        self.spin = [
+            kin.data.oMf[w.frame_id].rotation.T @ a for w, a in zip(wheels, spin, strict=True)
+        ]
 
-    def from_frames(self, P, J=None) -> tuple:
-        (cl, jl), (cr, jr) = (
-            patch.from_frames(P[k : k + 3], None if J is None else J[k : k + 3])
-            for patch, k in zip(self.patches, (2, 5), strict=True)
-        )
-        a = P[0][2] - P[1][2] - self.design
-        b = cl[1] - cr[1]
+    def residual(self, kin) -> np.ndarray:
+        return self.from_frames([kin.data.oMf[p.frame_id] for p in self.frame_points])[0]
+
+    def jacobian(self, kin) -> np.ndarray:
+        placements = [kin.data.oMf[p.frame_id] for p in self.frame_points]
+        return self.from_frames(
+            placements, [kin.frame_jacobian(p.frame_id) for p in self.frame_points]
+        )[1]
+
+    def from_frames(self, M, J=None) -> tuple:
+        """From the wheel centres' placements M and Jacobians J (6 rows). A hot path: a
+        contact patch's y alone, in closed form — with â the spin axis and
+        s = √(1 − a_z²), CP_y = WC_y + R·a_z·a_y/s (ContactPatchPoint's d̂ = unit(a_z·â −
+        Ẑ), its y row), and â turning with the upright, dâ = ω × â, so
+        dCP_y = dWC_y + R·((a_z/s)·da_y + (a_y/s³)·da_z): a fixed combination of the
+        wheel-centre frame's Jacobian rows, and so is the row's."""
+        y, rows = [0.0, 0.0], []
+        for k in (0, 1):
+            ax, ay, az = (M[k].rotation @ self.spin[k]).tolist()
+            s = math.sqrt(1.0 - az * az)
+            R = self.radii[k]
+            y[k] = M[k].translation[1] + R * az * ay / s
+            # dCP_y = row 1 + R·(c_x ω_x + c_y ω_y + c_z ω_z), da = ω × â
+            c_x = R * (ay * ay / s**3 - az * az / s)
+            c_y = -R * ax * ay / s**3
+            c_z = R * az * ax / s
+            rows.append(np.array([0.0, 1.0, 0.0, c_x, c_y, c_z]))
+        a = M[0].translation[2] - M[1].translation[2] - self.design
+        b = y[0] - y[1]
         r = np.array([math.atan2(a, b) - self.value])
         if J is None:
             return r, None
-        da, db = J[0][2] - J[1][2], jl[1] - jr[1]
-        return r, ((b * da - a * db) / (a * a + b * b))[None]
+        scale = 1.0 / (a * a + b * b)  # d atan2(a, b) = (b·da − a·db)/(a² + b²)
+        rise = np.array([0.0, 0.0, b * scale, 0.0, 0.0, 0.0])
+        left = rise - a * scale * rows[0]
+        right = -rise + a * scale * rows[1]
+        return r, (left @ J[0] + right @ J[1])[None]
 
 
 def axle_rows(model: AxleModel, targets, source: str = "<targets>") -> list:
@@ -695,8 +725,10 @@ def axle_rows(model: AxleModel, targets, source: str = "<targets>") -> list:
         elif t.quantity == "roll":
             z0 = d["left_wheel_center"][2] - d["right_wheel_center"][2]
             wheels = (p["left_wheel_center"], p["right_wheel_center"])
-            patches = (p["left_contact_patch_center"], p["right_contact_patch_center"])
-            rows.append(RollTarget(wheels, patches, z0))
+            radii = [model.geometries[s].wheel.radius for s in SIDES]
+            spin = [unit(d[f"{s}_axle_outboard"] - d[f"{s}_axle_inboard"]) for s in SIDES]
+            model.kin.update_positions(model.q_design)
+            rows.append(RollTarget(wheels, radii, model.kin, z0, spin=spin))
         else:
             if t.side is None:
                 raise InputError(

@@ -330,12 +330,14 @@ class _Batch:
             elif isinstance(row, JointTarget):
                 self.joints.append((i, row.index_q, row))
             elif hasattr(row, "from_frames") and _framed(*row.frame_points):
-                self.composite.append((i, row, [frame(p) for p in row.frame_points]))
+                frames = [frame(p) for p in row.frame_points]
+                self.composite.append((i, row, frames, getattr(row, "angular", False)))
             else:
                 self.others.append((i, row))
             i += row.size
         self.fixed = [model.frames[f].parentJoint == 0 for f in self.frames]
-        self.zero = np.zeros((3, model.nv))
+        self.zero6 = np.zeros((6, model.nv))
+        self.zero = self.zero6[:3]
 
     def fill(self, kin: Kinematics, q: np.ndarray, r: np.ndarray, J: np.ndarray | None) -> None:
         """Residual rows, and their Jacobian rows unless J is None."""
@@ -343,10 +345,11 @@ class _Batch:
         oMf = data.oMf
         P = [oMf[f].translation for f in self.frames]  # fresh arrays: no copy needed
         if J is not None:  # a frame on the chassis does not move: its Jacobian is zero
-            Jf = [
-                self.zero if fixed else pin.getFrameJacobian(model, data, f, WORLD)[:3]
+            J6 = [
+                self.zero6 if fixed else pin.getFrameJacobian(model, data, f, WORLD)
                 for f, fixed in zip(self.frames, self.fixed, strict=True)
             ]
+            Jf = [j[:3] for j in J6]
         for rows, a, b in self.balls:
             r[rows] = P[b] - P[a]
             if J is not None:
@@ -371,10 +374,16 @@ class _Batch:
             r[i] = q[k] - row.value
             if J is not None:
                 J[i] = row.row[0]
-        for i, row, frames in self.composite:
-            value, jacobian = row.from_frames(
-                [P[k] for k in frames], None if J is None else [Jf[k] for k in frames]
-            )
+        for i, row, frames, angular in self.composite:
+            if angular:  # the frames' placements and 6-row Jacobians (with ω)
+                value, jacobian = row.from_frames(
+                    [oMf[self.frames[k]] for k in frames],
+                    None if J is None else [J6[k] for k in frames],
+                )
+            else:
+                value, jacobian = row.from_frames(
+                    [P[k] for k in frames], None if J is None else [Jf[k] for k in frames]
+                )
             r[i : i + row.size] = value
             if J is not None:
                 J[i : i + row.size] = jacobian

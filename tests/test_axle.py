@@ -826,3 +826,24 @@ def test_sensitivity_says_what_it_does_not_cover(tmp_path, capsys):
     rigid = axle_file(tmp_path, lambda d: d["axle_config"]["anti_roll"].update(stiffness="rigid"))
     assert main(["sensitivity", str(rigid), "-o", str(out)]) == 2
     assert "rigid anti-roll bar" in capsys.readouterr().err and not out.exists()
+
+
+def test_the_roll_rows_jacobian_is_its_residuals_derivative(tmp_path):
+    """The roll target's row (closed form, from the wheel centres' frames) against
+    central differences of its residual along random configuration directions."""
+    from pin_susp.axle import RollTarget, axle_rows
+
+    model = AxleModel(load_axle(axle_file(tmp_path)))
+    (roll,) = [r for r in axle_rows(model, roll_sweep().targets) if isinstance(r, RollTarget)]
+    rng = np.random.default_rng(3)
+    q = model.q_design + rng.normal(0.0, 0.02, model.model.nq)
+    model.kin.update(q)
+    row = roll.jacobian(model.kin)[0]
+    h = 1e-6
+    for _ in range(5):
+        dq = rng.normal(size=model.model.nv)
+        values = []
+        for sign in (1.0, -1.0):
+            model.kin.update(q + sign * h * dq)
+            values.append(roll.residual(model.kin)[0])
+        assert row @ dq == pytest.approx((values[0] - values[1]) / (2 * h), rel=1e-6, abs=1e-9)
