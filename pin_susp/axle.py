@@ -440,6 +440,15 @@ def load_axle(source) -> AxleGeometry:
         key = "hardpoints.left" if side == "left" or mirrored else "hardpoints.right"
         if not isinstance(points, dict):
             r.fail(key, "expected a mapping of point name to {x, y, z}")
+        for k in points:
+            if any(k in names for names in CENTER.values()):
+                r.fail(f"{key}.{k}", "a point of the anti-roll bar's: it goes in hardpoints.center")
+            if k not in extras and any(k in names for names in SIDE_EXTRAS.values()):
+                r.fail(
+                    f"{key}.{k}",
+                    f"a point of an anti-roll bar or heave link, which this axle does not have "
+                    f"(axle_config.anti_roll.type: {anti_roll}, heave_link.type: {heave})",
+                )
         corner_points = {k: v for k, v in points.items() if k not in extras}
         missing = [k for k in extras if k not in points]
         if missing:

@@ -847,3 +847,18 @@ def test_the_roll_rows_jacobian_is_its_residuals_derivative(tmp_path):
             model.kin.update(q + sign * h * dq)
             values.append(roll.residual(model.kin)[0])
         assert row @ dq == pytest.approx((values[0] - values[1]) / (2 * h), rel=1e-6, abs=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("change", "key", "words"),
+    [
+        (lambda d: d["hardpoints"]["left"].update(arb_u_bar_axis_a={"x": 0, "y": 300, "z": 300}),
+         "hardpoints.left.arb_u_bar_axis_a", "hardpoints.center"),
+        (lambda d: (d["axle_config"].update(anti_roll={"type": "none"}), d["hardpoints"].pop("center")),
+         "hardpoints.left.droplink_rocker", "does not have"),
+    ],
+)  # fmt: skip
+def test_a_bar_point_in_the_wrong_place_says_where_it_goes(tmp_path, change, key, words):
+    with pytest.raises(pin_susp.InputError) as info:
+        load_axle(axle_file(tmp_path, change))
+    assert info.value.key == key and words in str(info.value)
