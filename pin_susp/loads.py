@@ -50,9 +50,19 @@ class LoadCase:
     moment: np.ndarray
 
 
-def load_cases(source) -> list[LoadCase]:
+@dataclass(frozen=True)
+class AxleLoadCase:
+    """An axle's load case: one LoadCase per wheel (a side not given: no load)."""
+
+    name: str
+    left: LoadCase
+    right: LoadCase
+
+
+def load_cases(source, axle: bool = False) -> list:
     """Read a load-case file (spec/loads.md): ``cases:`` a list of {name,
-    contact_patch: {fx, fy, fz}, wheel_center: {…}, moment: {mx, my, mz}}."""
+    contact_patch: {fx, fy, fz}, wheel_center: {…}, moment: {mx, my, mz}}; for an
+    axle (``axle``) each case's loads sit in ``left:`` and ``right:`` blocks."""
     data, name, _ = load_yaml(source)
     r = Reader(name)
     r.mapping(data, "", required=("cases",), optional=("version",))
@@ -63,43 +73,69 @@ def load_cases(source) -> list[LoadCase]:
     for i, case in enumerate(cases):
         key = f"cases[{i}]"
         r.mapping(case, key, required=("name",), optional=(*CASE_KEYS, "left", "right"))
-        for side in ("left", "right"):
-            if side in case:
-                r.fail(f"{key}.{side}", "a side block is for an axle's load cases")
         title = r.text(case["name"], f"{key}.name")
         if title in seen:
             r.fail(f"{key}.name", f"{title!r} names two cases")
         seen.add(title)
-        vectors = {}
-        for part, axes in (("contact_patch", "f"), ("wheel_center", "f"), ("moment", "m")):
-            block = case.get(part, {})
-            names = tuple(f"{axes}{a}" for a in "xyz")
-            block = r.mapping(block, f"{key}.{part}", optional=names)
-            vectors[part] = np.array(
-                [r.number(block.get(n, 0.0), f"{key}.{part}.{n}") for n in names]
-            )
-        out.append(LoadCase(str(title), **vectors))
+        if not axle:
+            for side in ("left", "right"):
+                if side in case:
+                    r.fail(f"{key}.{side}", "a side block is for an axle's load cases")
+            out.append(_wheel_loads(case, key, str(title), r))
+            continue
+        for part in CASE_KEYS:
+            if part in case:
+                r.fail(f"{key}.{part}", "an axle's loads go in left: and right: blocks")
+        if "left" not in case and "right" not in case:
+            r.fail(key, "an axle's case needs a left: or right: block of loads")
+        wheels = [
+            _wheel_loads(r.mapping(case.get(s, {}), f"{key}.{s}", optional=CASE_KEYS), f"{key}.{s}",
+                         str(title), r)
+            for s in ("left", "right")
+        ]  # fmt: skip
+        out.append(AxleLoadCase(str(title), *wheels))
     return out
+
+
+def _wheel_loads(case: dict, key: str, title: str, r: Reader) -> LoadCase:
+    vectors = {}
+    for part, axes in (("contact_patch", "f"), ("wheel_center", "f"), ("moment", "m")):
+        names = tuple(f"{axes}{a}" for a in "xyz")
+        block = r.mapping(case.get(part, {}), f"{key}.{part}", optional=names)
+        vectors[part] = np.array([r.number(block.get(n, 0.0), f"{key}.{part}.{n}") for n in names])
+    return LoadCase(title, **vectors)
 
 
 def member_forces(corner, sweep, cases: list, solutions=None, results=None, progress=None):
     """Every force column at every step of a sweep under every load case (spec/loads.md):
     a Results with one row per step and case — ``step_index``, ``load_case``,
     ``loads_unbounded`` (1 at a toggle: the forces there are blank, not huge), the
-    forces, then the sweep's own columns. ``corner``: a Corner; ``sweep``: a Sweep,
-    path or dict; ``cases``: LoadCases or a load-case file."""
+    forces, then the sweep's own columns. ``corner``: a Corner, or an AxleModel (its
+    columns suffixed _left/_right, the bar's ``torque_arb``); ``sweep``: a Sweep, path
+    or dict; ``cases``: LoadCases (AxleLoadCases) or a load-case file."""
     from .corner import Results
     from .sweep import load_sweep
 
+    axle = hasattr(corner, "geometries")  # an AxleModel
     if not isinstance(sweep, Sweep):
         sweep = load_sweep(sweep)
     if not isinstance(cases, list):
-        cases = load_cases(cases)
+        cases = load_cases(cases, axle=axle)
     statics = Statics(corner)
     if solutions is None:
-        solutions = corner.solve_steps(sweep)
+        if axle:
+            from .axle import solve_axle_sweep
+
+            solutions = solve_axle_sweep(corner, sweep)
+        else:
+            solutions = corner.solve_steps(sweep)
     if results is None:
-        results = Results.from_solutions(corner, solutions, sweep)
+        if axle:
+            from .axle import axle_results
+
+            results = axle_results(corner, sweep, solutions)
+        else:
+            results = Results.from_solutions(corner, solutions, sweep)
     names = statics.names
     W = statics.loads_matrix(cases)
     n, m = len(cases), len(solutions)
@@ -130,38 +166,80 @@ def member_forces(corner, sweep, cases: list, solutions=None, results=None, prog
 
 
 class Statics:
-    """The equilibrium of one corner (a Linkage) at its poses, every load case at once.
+    """The equilibrium of a corner (a Linkage) or an axle (an AxleModel) at its poses,
+    every load case at once.
 
-    Per pose: the held rows' Jacobian J from the solver's batch, one LU of Jᵀ for all
-    cases, λ = −J⁻ᵀ·G·W with G = [J_cp; J_wc; J_ω]ᵀ and W the cases' loads (a column
-    each). A tree joint's force (the parent's on its subtree) is minus the sum of the
+    Per pose: the held rows' Jacobian J from the solver's batch — the closures, then
+    each spring, an axle's anti-roll bar, the rack — and λ from Jᵀλ = −G·W, with
+    G = [J_cp; J_wc; J_ω]ᵀ per wheel and W the cases' loads (a column each). With as
+    many rows as freedoms that is one LU for all cases. An axle whose bar (or rigid
+    bar) shares the load with the springs has one row more than freedoms: statically
+    indeterminate, it shares by stiffness — the λ of least complementary energy
+    Σ λ_e²/k_e over the springs and the bar (Menabrea), i.e. the one whose elastic
+    deflections are compatible.
+
+    A tree joint's force (the parent's on its subtree) is minus the sum of the
     external forces on the subtree — the applied loads and the closures' multipliers
     at their ends, which bodies carry them being fixed by the tree — so no inverse
     dynamics runs per case (the tests check it against Pinocchio's ``rnea``).
     """
 
-    def __init__(self, corner):
-        g = corner.geometry
-        self.corner, self.model = corner, corner.model
-        if g.spring == "none":
-            raise PinSuspError(
-                f"{g.source}: spring.type: none leaves bump without a load path (no member "
-                "holds the wheel up): give the corner a spring for its loads"
+    def __init__(self, subject):
+        self.subject, self.model = subject, subject.model
+        self.axle = hasattr(subject, "geometries")
+        sides = subject.geometries if self.axle else {"": subject.geometry}
+        self.source = subject.axle.source if self.axle and subject.axle else None
+        held, compliance = [], []
+        for side, g in sides.items():
+            prefix = f"{side}_" if side else ""
+            source = self.source or g.source
+            if g.spring == "none":
+                raise PinSuspError(
+                    f"{source}: spring.type: none leaves bump without a load path (no member "
+                    "holds the wheel up): give the corner a spring for its loads"
+                )
+            if g.spring == "coilover":
+                top, bottom = (subject.points[f"{prefix}strut_{e}"] for e in ("top", "bottom"))
+                held.append(DistanceClosure(f"{prefix}spring", top, bottom, 0.0))
+                stiffness = None if g.spring_rate is None else g.spring_rate * 1e3  # N/m
+            else:  # a torsion bar: the rocker's turn about its axis
+                held.append(_RockerTurn(subject, prefix))
+                stiffness = None if g.spring_rate is None else g.spring_rate * 180 / np.pi
+            compliance.append(stiffness)
+        bar = subject.axle if self.axle else None
+        if bar is not None and bar.anti_roll != "none" and not bar.anti_roll_rigid:
+            joints = (
+                ["left_arb_arm_pivot", "right_arb_arm_pivot"]
+                if bar.anti_roll == "u_bar"
+                else ["t_bar_pivot_b"]
             )
-        if g.spring == "coilover":
-            top, bottom = corner.points["strut_top"], corner.points["strut_bottom"]
-            spring = DistanceClosure("spring", top, bottom, 0.0)
-        else:  # a torsion bar: the rocker's turn about its axis
-            spring = _RockerTurn(corner)
-        held = [JointTarget(self.model, "rack_slide")] if g.steering == "rack" else []
-        self.solver = NewtonSolver(corner.kin, [*corner.closures, spring], held)
+            held.append(_Twist(self.model, joints))
+            k = bar.anti_roll_stiffness
+            compliance.append(None if k is None else k * 180 / np.pi)  # N·m/rad
+        if "rack_slide" in [self.model.names[j] for j in range(self.model.njoints)]:
+            held.append(JointTarget(self.model, "rack_slide"))
+            compliance.append(np.inf)  # held by the steering: rigid
+        self.solver = NewtonSolver(subject.kin, [*subject.closures, *held], [])
         self.rows = self.solver.rows
         self.size = self.solver.nrows
-        if self.size != self.model.nv:
+        source = self.source or subject.geometry.source
+        if self.size < self.model.nv:
             raise PinSuspError(
-                f"{g.source}: the closures, spring and rack hold {self.size} of the "
+                f"{source}: the closures, springs and rack hold {self.size} of the "
                 f"{self.model.nv} freedoms: the loads are not determined"
             )
+        # compliance per row (1/k; 0 for a rigid row): needed where rows outnumber freedoms
+        self.compliance = None
+        if self.size > self.model.nv:
+            if any(k is None for k in compliance):
+                raise PinSuspError(
+                    f"{source}: the anti-roll bar and the springs share the load by their "
+                    "stiffnesses: give each spring's rate (spring.rate) and the bar's "
+                    "(axle_config.anti_roll.stiffness)"
+                )
+            c = np.zeros(self.size)
+            c[self.size - len(held) :] = [1.0 / k for k in compliance]
+            self.compliance = c
         self._plan()
 
     # ---------------------------------------------------------------- the plan
@@ -169,10 +247,11 @@ class Statics:
     def _plan(self) -> None:
         """Which multiplier acts where, which tree joint's subtree holds each end, and
         the column each output comes from (fixed by the tree: worked out once)."""
-        corner, model = self.corner, self.model
+        subject, model = self.subject, self.model
         joint_of = lambda point: model.frames[point.frame_id].parentJoint  # noqa: E731
         self.ends = []  # (first multiplier, size, point, sign, the other end or None)
         self.direct = []  # (name, first multiplier, size, factor): the rows' own outputs
+        self.couples = []  # (multiplier, a torsion bar's rocker turn)
         col = 0
         for row in self.rows:
             if isinstance(row, BallClosure):
@@ -181,26 +260,23 @@ class Statics:
                 self.direct.append((f"load_{name}", col, 3, -1.0))  # outboard on inboard
             elif isinstance(row, DistanceClosure):
                 self.ends += [(col, 1, row.b, 1.0, row.a), (col, 1, row.a, -1.0, row.b)]
-                spring = row.name == "spring"
-                self.direct.append(
-                    (
-                        "force_spring" if spring else f"force_{row.name}",
-                        col,
-                        1,
-                        1.0 if spring else -1.0,
-                    )
-                )
+                spring = row.name.endswith("spring")  # compression +, a link's tension +
+                self.direct.append((f"force_{row.name}", col, 1, 1.0 if spring else -1.0))
             elif isinstance(row, _RockerTurn):
-                self.couple = (col, row)
-                self.direct.append(("torque_spring", col, 1, 1.0))
+                self.couples.append((col, row))
+                self.direct.append((f"torque_{row.prefix}spring", col, 1, 1.0))
+            elif isinstance(row, _Twist):
+                self.direct.append(("torque_arb", col, 1, 1.0))
             else:  # the rack, held by the steering: the trackrods' pull on it is −λ
                 self.direct.append(("force_rack", col, 1, -1.0))
             col += row.size
-        self.couple = getattr(self, "couple", None)
-        self.wc = corner.points["wheel_center"]
-        upright = joint_of(self.wc)
-        self.joints = []  # (body, joint, pinocchio index, ends inside, load inside, rocker inside)
-        for body in corner.tree.bodies:
+        sides = ("left", "right") if self.axle else ("",)
+        self.wheels = [
+            (subject.points[_at(s, "wheel_center")], subject.points[_at(s, "contact_patch_center")])
+            for s in sides
+        ]
+        self.joints = []  # (body, joint, index, ends inside, wheels inside, couples inside)
+        for body in subject.tree.bodies:
             j = body.joint
             if j is None:
                 continue
@@ -208,8 +284,9 @@ class Statics:
             first = model.getJointId(j.name + {"ball": "_z", "universal": "_a"}.get(j.kind, ""))
             inside = lambda joint, first=first: first in model.supports[joint]  # noqa: E731
             ends = [k for k, e in enumerate(self.ends) if inside(joint_of(e[2]))]
-            rocker = self.couple is not None and inside(joint_of(self.couple[1].point))
-            self.joints.append((body, j, index, ends, inside(upright), rocker))
+            wheels = [k for k, (wc, _) in enumerate(self.wheels) if inside(joint_of(wc))]
+            couples = [k for k, (_, t) in enumerate(self.couples) if inside(joint_of(t.point))]
+            self.joints.append((body, j, index, ends, wheels, couples))
         # the ends as arrays: their frames (and the other end's), signs, multipliers
         self.frames = list(dict.fromkeys(e[2].frame_id for e in self.ends))
         place = {f: i for i, f in enumerate(self.frames)}
@@ -225,58 +302,100 @@ class Statics:
         )
         self.specs = [self._joint_spec(body, j) for body, j, *_ in self.joints]
         self.subtree = np.zeros((len(self.joints), len(self.ends)))
-        for k, (*_, ends, _, _) in enumerate(self.joints):
+        for k, (_, _, _, ends, _, _) in enumerate(self.joints):
             self.subtree[k, ends] = 1.0
-        self.names = [
+        names = [
             n for name, _, size, _ in self.direct for n in (_xyz(name) if size == 3 else [name])
         ]
         for body, j, *_ in self.joints:
-            self.names += self._joint_names(body, j)
+            names += self._joint_names(body, j)
+        self.names = [_sided(n) for n in names] if self.axle else names
+
+    def _point(self, body: str, name: str) -> str:
+        """A corner point's name in the subject (an axle's carry the body's side)."""
+        side = body.split("_", 1)[0]
+        return f"{side}_{name}" if self.axle and side in ("left", "right") else name
+
+    def _named(self, body: str, point: str) -> str:
+        """A point's name in the subject: an axle's corner points carry their side."""
+        sided = self._point(body, point)
+        return sided if sided in self.subject.design_positions else point
 
     def _joint_names(self, body, j) -> list[str]:
-        if j.kind == "ball":
-            return _xyz(f"load_{j.name}")
+        if self._bearing(body, j):  # a ball joint by its name; a bar's pivot by its point
+            pivot = j.kind != "ball" and j.defined_by
+            return _xyz(f"load_{j.defined_by[0] if pivot else j.name}")
         if j.kind == "universal":
             return [f"force_{body.name}"]
         if j.kind == "revolute" and len(j.defined_by) == 2:
-            names = _xyz(f"load_{_bushing(j.defined_by[0])}") + _xyz(
-                f"load_{_bushing(j.defined_by[1])}"
-            )
-            return names + list(self._legs(body.name, j.defined_by) or {})
+            names = [f"load_{_bushing(self._point(body.name, n))}" for n in j.defined_by]
+            return _xyz(names[0]) + _xyz(names[1]) + list(self._legs(body.name, j.defined_by) or {})
         return []
+
+    def _bearing(self, body, j) -> bool:
+        """Whether a joint's load is written as one vector: a ball joint, a T-bar's
+        pivot (universal, or revolute when rigid) — not a link or a two-bush pivot."""
+        if j.kind == "ball":
+            return True
+        if j.kind == "universal":
+            return f"{body.name}_inboard" not in self.subject.points
+        return j.kind == "revolute" and len(j.defined_by) != 2
 
     def _legs(self, arm: str, pickups) -> dict | None:
         """A wishbone's legs: name → pickup, when the arm is loaded at its outboard ball
         alone (its legs two-force members); {} with blank columns when not; None for
         an arm that is no wishbone."""
         outboard = f"{arm}_outboard"
-        if not arm.endswith("wishbone") or outboard not in self.corner.points:
+        if not arm.endswith("wishbone") or outboard not in self.subject.points:
             return None
-        names = {f"force_{arm}_{'front' if 'front' in n else 'rear'}": n for n in pickups}
-        others = [n for n, (b, _) in self.corner.tree.points.items() if b == arm and n != outboard]
+        names = {
+            f"force_{arm}_{'front' if 'front' in n else 'rear'}": self._named(arm, n)
+            for n in pickups
+        }
+        others = [n for n, (b, _) in self.subject.tree.points.items() if b == arm and n != outboard]
         return dict.fromkeys(names) if others else names
 
     # ---------------------------------------------------------------- solving
 
-    def loads_matrix(self, cases: list[LoadCase]) -> np.ndarray:
-        """W (9 × cases): each case's contact-patch force, wheel-centre force, moment."""
+    def loads_matrix(self, cases: list) -> np.ndarray:
+        """W (9 per wheel × cases): each wheel's contact-patch force, wheel-centre force
+        and moment, a case a column (an axle's case: its left and right parts)."""
+        parts = [(c,) if not self.axle else (c.left, c.right) for c in cases]
         return np.array(
-            [np.r_[c.contact_patch, c.wheel_center, c.moment] for c in cases], dtype=float
-        ).T
+            [np.concatenate([np.r_[w.contact_patch, w.wheel_center, w.moment] for w in p])
+             for p in parts], dtype=float
+        ).T  # fmt: skip
+
+    def _multipliers(self, W: np.ndarray) -> np.ndarray | None:
+        """λ at the current state (solver evaluated) for the loads W; None at a toggle."""
+        J = self.solver.jacobian
+        G = self._load_map()
+        if self.compliance is None:  # as many rows as freedoms: one LU
+            lu, pivots, info = lapack.dgetrf(J.T)
+            rcond = lapack.dgecon(lu, np.abs(J).sum(axis=1).max())[0] if info == 0 else 0.0
+            if rcond < 1.0 / TOGGLE:
+                return None
+            return lapack.dgetrs(lu, pivots, -(G @ W))[0]
+        # one row more than freedoms: the λ of least Σ c·λ² among the equilibria
+        U, S, Vt = np.linalg.svd(J.T)
+        if S[-1] < S[0] / TOGGLE:
+            return None
+        rank = len(S)
+        particular = Vt[:rank].T @ ((U.T @ -(G @ W)) / S[:, None])
+        free = Vt[rank:].T  # the null space of Jᵀ: self-stresses
+        C = self.compliance[:, None] * free
+        t = np.linalg.solve(free.T @ C, -(C.T @ particular))
+        return particular + free @ t
 
     def solve_matrix(self, q: np.ndarray, W: np.ndarray) -> np.ndarray | None:
         """Every output column (rows: self.names) for each case (columns of W) at the
         pose q; None at a toggle (the held rows singular: a member cannot hold its
         load, the force is unbounded)."""
-        solver, kin = self.solver, self.corner.kin
-        solver.evaluate(q)  # the kinematics (Jacobians too) and the held rows at q
-        J = solver.jacobian
-        lu, pivots, info = lapack.dgetrf(J.T)
-        rcond = lapack.dgecon(lu, np.abs(J).sum(axis=1).max())[0] if info == 0 else 0.0
-        if rcond < 1.0 / TOGGLE:
+        kin = self.subject.kin
+        self.solver.evaluate(q)  # the kinematics (Jacobians too) and the held rows at q
+        lam = self._multipliers(W)
+        if lam is None:
             return None
-        G, cp, wc = self._load_map()
-        lam = lapack.dgetrs(lu, pivots, -(G @ W))[0]
         out = [factor * lam[col : col + size] for _, col, size, factor in self.direct]
         # every closure end's force (ends × 3 × cases), and its moment about the origin
         oMf = kin.data.oMf
@@ -293,52 +412,54 @@ class Statics:
         # a tree joint's force on its subtree: minus the external forces inside it
         through_f = -np.einsum("je,eic->jic", self.subtree, forces)
         through_m = -np.einsum("je,eic->jic", self.subtree, moments)
-        load_f = W[0:3] + W[3:6]
-        load_m = _cross(cp, W[0:3]) + _cross(wc, W[3:6]) + W[6:9]
-        if self.couple is not None:
-            col, turn = self.couple
-            couple = np.outer(turn.axis(kin), lam[col])
-        for k, (*_, loaded, rocker) in enumerate(self.joints):
+        loads = []  # each wheel's applied force and moment about the origin
+        for k, (wc, cp) in enumerate(self.wheels):
+            w = W[9 * k : 9 * k + 9]
+            c, p = cp.position(kin), wc.position(kin)
+            loads.append((w[0:3] + w[3:6], _cross(c, w[0:3]) + _cross(p, w[3:6]) + w[6:9]))
+        couples = [np.outer(turn.axis(kin), lam[col]) for col, turn in self.couples]
+        for k, (_, _, _, _, wheels, inner) in enumerate(self.joints):
             f, m = through_f[k], through_m[k]
-            if loaded:
-                f, m = f - load_f, m - load_m
-            if rocker:
-                m = m - couple
+            for i in wheels:
+                f, m = f - loads[i][0], m - loads[i][1]
+            for i in inner:
+                m = m - couples[i]
             out += self._joint_columns(self.specs[k], f, m)
         return np.vstack(out)
 
-    def _load_map(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """G = [J_cp; J_wc; J_ω]ᵀ (nv × 9) at the current kinematics, with the upright's
-        material point at the contact patch, and the patch and wheel centre."""
-        kin = self.corner.kin
-        Jw = kin.frame_jacobian(self.wc.frame_id)  # linear at WC, angular: the upright's
-        wc = self.wc.position(kin)
-        cp = self.corner.points["contact_patch_center"].position(kin)
-        at_patch = Jw[:3] - _skew(cp - wc) @ Jw[3:]
-        return np.vstack([at_patch, Jw[:3], Jw[3:]]).T, cp, wc
+    def _load_map(self) -> np.ndarray:
+        """G (nv × 9 per wheel) = [J_cp; J_wc; J_ω]ᵀ at the current kinematics, with the
+        upright's material point at the contact patch."""
+        kin = self.subject.kin
+        parts = []
+        for wc, cp in self.wheels:
+            Jw = kin.frame_jacobian(wc.frame_id)  # linear at WC, angular: the upright's
+            at_patch = Jw[:3] - _skew(cp.position(kin) - wc.position(kin)) @ Jw[3:]
+            parts += [at_patch, Jw[:3], Jw[3:]]
+        return np.vstack(parts).T
 
-    def generalized(self, q: np.ndarray, case: LoadCase) -> np.ndarray:
+    def generalized(self, q: np.ndarray, case) -> np.ndarray:
         """Σ J_pᵀ w_p at q: the case's generalised force (its virtual work per dq)."""
-        self.corner.kin.update(q)
-        return self._load_map()[0] @ self.loads_matrix([case])[:, 0]
+        self.subject.kin.update(q)
+        return self._load_map() @ self.loads_matrix([case])[:, 0]
 
     def _joint_spec(self, body, j) -> tuple:
         """What a tree joint writes, with what is fixed about it worked out once."""
-        corner = self.corner
-        if j.kind == "ball":
+        subject = self.subject
+        if self._bearing(body, j):
             return ("ball",)
         if j.kind == "universal":  # a link from a universal joint to a ball: two-force
-            ends = (corner.points[f"{body.name}_inboard"], corner.points[f"{body.name}_outboard"])
+            ends = (subject.points[f"{body.name}_inboard"], subject.points[f"{body.name}_outboard"])
             return ("link", *ends)
         if j.kind != "revolute" or len(j.defined_by) != 2:
             return ("none",)
-        a, b = (corner.design_positions[n] for n in j.defined_by)
+        a, b = (subject.design_positions[self._named(body.name, n)] for n in j.defined_by)
         d = b - a
         legs = self._legs(body.name, j.defined_by)
         pickups = None
         if legs is not None and all(v is not None for v in legs.values()):
-            pickups = np.array([corner.design_positions[n] for n in legs.values()])
-        ball = corner.points.get(f"{body.name}_outboard")
+            pickups = np.array([subject.design_positions[n] for n in legs.values()])
+        ball = subject.points.get(f"{body.name}_outboard")
         blank = 0 if legs is None else len(legs)
         return ("pivot", a, d[:, None], d[:, None] / (d @ d), pickups, ball, blank)
 
@@ -347,8 +468,8 @@ class Statics:
         world origin: a ball joint's load, a link's tension, a pivot's bushings, legs."""
         kind = spec[0]
         if kind == "ball":
-            return [-force]  # outboard on inboard
-        kin = self.corner.kin
+            return [-force]  # outboard on inboard (a pivot's: the bar on the chassis)
+        kin = self.subject.kin
         if kind == "link":
             u = spec[1].position(kin) - spec[2].position(kin)
             return [(u / math.sqrt(u @ u)) @ force]
@@ -398,22 +519,55 @@ class _RockerTurn:
     """A torsion bar's row: the rocker's turn about its axis a→b (rad per dq)."""
 
     size = 1
-    name = "spring"
 
-    def __init__(self, corner):
-        self.corner = corner
-        self.point = corner.points["pushrod_inboard"]  # any frame on the rocker
+    def __init__(self, subject, prefix: str = ""):
+        self.subject, self.prefix = subject, prefix
+        self.name = f"{prefix}spring"
+        self.point = subject.points[f"{prefix}pushrod_inboard"]  # any frame on the rocker
 
     def residual(self, kin) -> np.ndarray:  # a held row: only its Jacobian counts
         return np.zeros(1)
 
     def axis(self, kin) -> np.ndarray:
-        p = self.corner.points
-        a, b = p["rocker_axis_a"].position(kin), p["rocker_axis_b"].position(kin)
+        p, prefix = self.subject.points, self.prefix
+        a, b = p[f"{prefix}rocker_axis_a"].position(kin), p[f"{prefix}rocker_axis_b"].position(kin)
         return (b - a) / np.linalg.norm(b - a)
 
     def jacobian(self, kin) -> np.ndarray:
         return (self.axis(kin) @ kin.frame_jacobian(self.point.frame_id)[3:])[None]
+
+
+class _Twist:
+    """An anti-roll bar's twist row (rad per dq): a U-bar's left arm's turn minus the
+    right's (both about the bar's axis), a T-bar's crossbar turn about its stem."""
+
+    size = 1
+    name = "arb"
+
+    def __init__(self, model, joints: list[str]):
+        self.row = np.zeros((1, model.nv))
+        for sign, joint in zip((1.0, -1.0), joints, strict=False):
+            self.row[0, model.joints[model.getJointId(joint)].idx_v] = sign
+
+    def residual(self, kin) -> np.ndarray:
+        return np.zeros(1)
+
+    def jacobian(self, kin) -> np.ndarray:
+        return self.row
+
+
+def _at(side: str, point: str) -> str:
+    return f"{side}_{point}" if side else point
+
+
+def _sided(name: str) -> str:
+    """An axle's column name with its side last: force_left_trackrod → force_trackrod_left,
+    load_left_lower_ball_joint_x → load_lower_ball_joint_x_left."""
+    head, _, rest = name.partition("_")
+    for side in ("left", "right"):
+        if rest.startswith(side + "_"):
+            return f"{head}_{rest[len(side) + 1 :]}_{side}"
+    return name
 
 
 def _vector(name: str, v) -> dict[str, float]:

@@ -406,3 +406,123 @@ def test_bad_rates_name_their_key(change, key):
     with pytest.raises(InputError) as info:
         load_geometry(data)
     assert info.value.key == key
+
+
+# ---------------------------------------------------------------- an axle
+
+
+def _axle(bar: str):
+    import yaml
+
+    from pin_susp.axle import AxleModel, load_axle
+
+    data = yaml.safe_load((EXAMPLES / "axle_front.yaml").read_text())
+    config = data["axle_config"]
+    config["spring"] = {"type": "coilover", "rate": 175.0, "preload": 2600.0}
+    if bar == "none":
+        config["anti_roll"] = {"type": "none"}
+        data["hardpoints"].pop("center")
+        for k in ("droplink_rocker", "droplink_u_bar"):
+            data["hardpoints"]["left"].pop(k)
+    else:
+        config["anti_roll"]["stiffness"] = 40.0 if bar == "u_bar" else "rigid"
+    return AxleModel(load_axle(data)), data
+
+
+def _axle_case(left, right):
+    from pin_susp.loads import AxleLoadCase
+
+    zero = np.zeros(3)
+    return AxleLoadCase("case", LoadCase("case", np.asarray(left, float), zero, zero),
+                        LoadCase("case", np.asarray(right, float), zero, zero))  # fmt: skip
+
+
+def test_an_axle_without_a_bar_is_its_two_corners_sharing_the_rack():
+    """Each side's forces are its corner's under that wheel's load at the same pose
+    (the right corner the mirrored one); the rack takes both trackrods' pull."""
+    import yaml
+    from conftest import mirrored
+
+    model, data = _axle("none")
+    heights, rack = {"left": 0.012, "right": -0.008}, 0.004
+    z = {s: model.design_positions[f"{s}_wheel_center"][2] + heights[s] for s in heights}
+    q = model.solve(z, rack).q
+    case = _axle_case([-1500.0, -2500.0, 2200.0], [800.0, -900.0, 1100.0])
+    forces = Statics(model).solve(q, case)
+    corner_data = yaml.safe_load((EXAMPLES / "pushrod_rocker.yaml").read_text())
+    rack_total = 0.0
+    for side, drawn in (("left", corner_data), ("right", mirrored(corner_data))):
+        corner = pin_susp.Corner(drawn)
+        targets = [Target("wheel_center", "z", [heights[side] * 1e3]),
+                   Target("trackrod_inboard", "y", [rack * 1e3])]  # fmt: skip
+        (solution,) = corner.solve_steps(Sweep(targets, "x"))
+        own = getattr(case, side)
+        theirs = Statics(corner).solve(solution.q, own)
+        for name, value in theirs.items():
+            if name in ("force_rack", "loads_unbounded"):
+                continue
+            assert forces[f"{name}_{side}"] == pytest.approx(value, rel=1e-8, abs=1e-6), name
+        rack_total += theirs["force_rack"]
+    assert forces["force_rack"] == pytest.approx(rack_total, rel=1e-9)
+
+
+def test_an_axles_bar_and_springs_share_by_stiffness():
+    """Statically indeterminate: the springs' and the bar's deflections (force/rate)
+    must be those of one motion of the axle — written from the sweep's own rates
+    (damper length and bar twist per wheel height), not from the solver."""
+    from pin_susp.axle import axle_results, solve_axle_sweep
+
+    model, _ = _axle("u_bar")
+    sweep = _sweep_of(ROLL)
+    solutions = solve_axle_sweep(model, sweep)
+    results = axle_results(model, sweep, solutions)
+    statics = Statics(model)
+    sides = ("left", "right")
+    cases = (_axle_case([0, -2700, 1800], [0, -900, 600]), _axle_case([0, 0, 2000], [0, 0, 2000]))
+    for i in (0, 3, 6):
+        for case in cases:
+            f = statics.solve(solutions[i].q, case)
+            spring = [-f[f"force_spring_{s}"] / 175.0 for s in sides]  # shortened by F/k, mm
+            twist = -f["torque_arb"] / (40.0 * 180 / np.pi)  # rad
+            motion = [results[f"deriv_damper_length_wrt_hub_z_{s}"][i] for s in sides]
+            rate = [np.radians(results[f"deriv_arb_twist_wrt_hub_z_{s}"][i]) for s in sides]
+            span = np.array([[motion[0], 0.0, rate[0]], [0.0, motion[1], rate[1]]]).T
+            deflection = np.array([*spring, twist])
+            fit = span @ np.linalg.lstsq(span, deflection, rcond=None)[0]
+            np.testing.assert_allclose(fit, deflection, rtol=1e-7, atol=1e-12)
+        assert abs(statics.solve(solutions[i].q, cases[0])["torque_arb"]) > 1.0  # it works
+
+
+def test_a_rigid_bar_compresses_both_springs_alike():
+    """A locked bar on a mirrored axle in heave: the wheels move as one, so both
+    springs deflect alike — the same force on each side, whichever wheel is loaded."""
+    from pin_susp.axle import solve_axle_sweep
+
+    model, _ = _axle("rigid")
+    solutions = solve_axle_sweep(model, _sweep_of(HEAVE))
+    statics = Statics(model)
+    for solution in solutions:
+        f = statics.solve(solution.q, _axle_case([0, -2700, 1800], [0, -900, 600]))
+        assert f["force_spring_left"] == pytest.approx(f["force_spring_right"], rel=1e-9)
+
+
+RACK_HELD = {"point": "trackrod_inboard", "side": "left", "direction": {"axis": "y"}, "start": 0,
+             "stop": 0}  # fmt: skip
+ROLL = [{"quantity": "roll", "start": -2, "stop": 2}, {"quantity": "heave", "start": 5, "stop": 5}]
+HEAVE = [{"quantity": "heave", "start": -15, "stop": 15}]
+
+
+def _sweep_of(targets):
+    from pin_susp.sweep import load_sweep
+
+    return load_sweep({"steps": 7, "targets": [*targets, RACK_HELD]})
+
+
+def test_a_bar_without_rates_says_what_it_needs():
+    import yaml
+
+    from pin_susp.axle import AxleModel, load_axle
+
+    data = yaml.safe_load((EXAMPLES / "axle_front.yaml").read_text())
+    with pytest.raises(PinSuspError, match="share the load by their stiffnesses"):
+        Statics(AxleModel(load_axle(data)))
