@@ -994,6 +994,36 @@ def _roll_rates(model: AxleModel, points: dict, sides: dict) -> dict:
             ends = [points[f"{s}_droplink_t_bar"][side] for s in SIDES]
             rate = np.degrees(_t_bar_twist(model, *ends).der[0]) * 1e-3
         out[f"deriv_arb_twist_wrt_hub_z_{side}"] = (rate, "deg/mm")
+    return out | _roll_stiffness(model, sides, out, per_rad)
+
+
+def _roll_stiffness(model: AxleModel, sides: dict, rates: dict, per_rad: dict) -> dict:
+    """Where the springs' rates (and a bar's stiffness) are given: ``roll_stiffness``
+    (N·m/deg) = Σ springs' k·(dℓ/dφ)² + the bar's k·(dθ/dφ)², and ``arb_wheel_rate``
+    (N/mm), the bar's rate at each wheel in roll (one up, the other down): ½·k·(dθ/dh)²."""
+    axle = model.axle
+    if any(model.geometries[s].spring_rate is None for s in SIDES):
+        return {}
+    if axle is not None and axle.anti_roll != "none":
+        if axle.anti_roll_rigid or axle.anti_roll_stiffness is None:
+            return {}  # a locked bar does not roll; without its stiffness: unknown
+    total, out = 0.0, {}
+    for side in SIDES:
+        g = model.geometries[side]
+        if g.spring == "torsion_bar":  # wind-up rate deg/mm → rad/m, k N·m/deg → N·m/rad
+            turn = np.radians(sides[side]["deriv_torsion_bar_twist_wrt_hub_z"][0]) * 1e3
+            k = g.spring_rate * 180.0 / np.pi
+        else:  # length rate mm/mm, k N/mm → N/m
+            turn, k = sides[side]["deriv_damper_length_wrt_hub_z"][0], g.spring_rate * 1e3
+        total = total + k * (turn * per_rad[side]) ** 2
+    if axle is not None and axle.anti_roll != "none":
+        k = axle.anti_roll_stiffness * 180.0 / np.pi  # N·m/rad
+        twist = {s: np.radians(rates[f"deriv_arb_twist_wrt_hub_z_{s}"][0]) * 1e3 for s in SIDES}
+        total = (
+            total + k * (twist["left"] * per_rad["left"] + twist["right"] * per_rad["right"]) ** 2
+        )
+        out["arb_wheel_rate"] = (0.5 * k * (twist["left"] - twist["right"]) ** 2 * 1e-3, "N/mm")
+    out["roll_stiffness"] = (total * np.pi / 180.0, "N·m/deg")
     return out
 
 

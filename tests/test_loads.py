@@ -526,3 +526,38 @@ def test_a_bar_without_rates_says_what_it_needs():
     data = yaml.safe_load((EXAMPLES / "axle_front.yaml").read_text())
     with pytest.raises(PinSuspError, match="share the load by their stiffnesses"):
         Statics(AxleModel(load_axle(data)))
+
+
+def test_roll_stiffness_is_the_second_derivative_of_the_stored_energy():
+    """At design (no preload), roll_stiffness = d²E/dφ² with E = Σ ½k·Δℓ² + ½k_bar·θ²
+    read from a fine roll sweep's damper lengths and bar twist (central differences);
+    arb_wheel_rate is the bar's share at each wheel: ½·k_bar·(dθ/dh)²."""
+    import yaml
+
+    from pin_susp.axle import AxleModel, axle_results, load_axle, solve_axle_sweep
+    from pin_susp.sweep import load_sweep
+
+    data = yaml.safe_load((EXAMPLES / "axle_front.yaml").read_text())
+    data["axle_config"]["spring"] = {"type": "coilover", "rate": 175.0}
+    data["axle_config"]["anti_roll"]["stiffness"] = 40.0
+    model = AxleModel(load_axle(data))
+    h = 0.02  # deg
+    sweep = load_sweep({"targets": [
+        {"quantity": "roll", "values": [-h, 0.0, h]},
+        {"quantity": "heave", "values": [0.0, 0.0, 0.0]},
+        {k: v for k, v in RACK_HELD.items() if k not in ("start", "stop")} | {"values": [0, 0, 0]},
+    ]})  # fmt: skip
+    r = axle_results(model, sweep, solve_axle_sweep(model, sweep))
+    energy = 0.5 * 40.0 * 180 / np.pi * np.radians(r["arb_twist"]) ** 2  # N·m
+    for s in ("left", "right"):
+        energy += 0.5 * 175e3 * ((r[f"damper_length_{s}"] - r[f"damper_length_{s}"][1]) * 1e-3) ** 2
+    # the moment is dE/dφ per radian: N·m/deg = d²E/dφ_deg² · 180/π
+    second = (energy[0] - 2 * energy[1] + energy[2]) / h**2 * 180 / np.pi
+    assert r["roll_stiffness"][1] == pytest.approx(second, rel=1e-5)
+    # the bar's share per wheel, from the sweep's twist rates: ½ k (dθ/dz_L − dθ/dz_R)²
+    rate = np.radians(
+        r["deriv_arb_twist_wrt_hub_z_left"][1] - r["deriv_arb_twist_wrt_hub_z_right"][1]
+    )
+    assert r["arb_wheel_rate"][1] == pytest.approx(
+        0.5 * 40.0 * 180 / np.pi * rate**2 * 1e3, rel=1e-9
+    )
