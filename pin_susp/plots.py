@@ -28,10 +28,18 @@ the mean steer angle when the rack moved. ``axle_drawing_figure`` draws the
 axle in front view at design or at a pose (``axle_pose``: a step of its
 results), with each side's FVIC construction and the roll centre where the
 two contact-patch lines cross.
+
+A forces CSV (``pin-susp loads``: a ``load_case`` column, a row per step and
+case) gives the force report (``force_figure``): a panel per member (the
+two-force members, the spring, the rack) and per joint (the magnitude of its
+load vector) on the same grid, a line per load case; a step at a toggle
+(``loads_unbounded`` = 1, its forces blank) is a gap, marked by a dotted line
+and noted under the panels. Forces and a sweep's results are refused together.
 """
 
 from __future__ import annotations
 
+import csv
 import json
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -68,6 +76,7 @@ EXTRA = (
     "motion_ratio",
 )
 DERIVED = ("camber", "roadwheel_angle")  # their derivative columns get panels
+TEXT = ("load_case",)  # columns of names, not numbers
 
 
 class ResultsFile:
@@ -98,12 +107,19 @@ class ResultsFile:
             text = None
         if text is None or "\x00" in text:
             raise InputError(source, "", "is not a text file: not a pin_susp results CSV")
-        comments, rows = [], []
-        for number, line in enumerate(text.splitlines(), start=1):
+        comments, lines, numbers = [], [], []
+        for number, line in enumerate(text.splitlines(keepends=True), start=1):
             if line.startswith("#"):
-                comments.append(line)
+                comments.append(line.rstrip("\r\n"))
             elif line.strip():
-                rows.append((number, line.split(",")))
+                lines.append(line)
+                numbers.append(number)
+        # the csv module: a load case's name is quoted when it holds a comma
+        reader = csv.reader(lines)
+        try:
+            rows = [(numbers[reader.line_num - 1], row) for row in reader]
+        except csv.Error as exc:
+            raise InputError(source, f"line {numbers[reader.line_num - 1]}", str(exc)) from None
         if not rows or "step_index" not in rows[0][1]:
             raise InputError(source, "", "not a pin_susp results CSV (no step_index column)")
         (_, header), body = rows[0], rows[1:]
@@ -127,17 +143,23 @@ class ResultsFile:
                 self.units = _units(source, line.removeprefix("# units:"))
         self.columns = {}
         for j, name in enumerate(header):
+            if name in TEXT:
+                self.columns[name] = np.array([row[j] for _, row in body], dtype=object)
+                continue
             try:
                 self.columns[name] = np.array([_cell(row[j]) for _, row in body])
             except ValueError:
                 raise InputError(source, name, "has a cell that is not a number") from None
+        # forces (pin-susp loads): a row per step and load case, the sweep's columns after
+        self.forces = "load_case" in self.columns
         # an axle's results: every corner column per side, and the axle's own
         self.axle = "camber_left" in self.columns
         travel, shape = ("heave", "roll") if self.axle else ("wheel_travel", "camber")
         for needed in (travel, shape):
             if needed not in self.columns:
                 raise InputError(source, needed, "missing column: not a sweep results CSV")
-        if not any(np.any(np.isfinite(c)) for c in self.columns.values()):
+        values = [c for n, c in self.columns.items() if n not in TEXT]
+        if not any(np.any(np.isfinite(c)) for c in values):
             raise InputError(source, "", "no numbers in it: every data cell is empty")
         if not np.any(np.isfinite(self.columns[travel])):
             converged = self.columns.get("solver_converged")
@@ -253,14 +275,9 @@ def report_figure(results: list[ResultsFile]):
     an axle's results: the axle report (``axle_panels``)."""
     if not results:
         raise PinSuspError("no results file to plot")
-    axle = next((r for r in results if r.axle), None)
-    corner = next((r for r in results if not r.axle), None)
-    if axle is not None and corner is not None:
-        raise InputError(
-            corner.source,
-            "",
-            f"a corner's results, but {axle.source} is an axle's: plot them separately",
-        )
+    if _all_of(results, "forces", "a sweep's results", "holds forces (pin-susp loads)"):
+        return force_figure(results)
+    axle = _all_of(results, "axle", "a corner's results", "is an axle's")
     xname, xlabel = x_axis(results)
     for r in results[1:]:
         if xname not in r.columns or not np.any(np.isfinite(r[xname])):
@@ -270,7 +287,7 @@ def report_figure(results: list[ResultsFile]):
                 f"no values, but {results[0].label} is plotted against it: "
                 "plot results of the same kind of sweep together",
             )
-    if axle is not None:
+    if axle:
         drawn = axle_panels(results, xname, xlabel)
         title = "pin_susp axle kinematics: "
     else:
@@ -280,22 +297,36 @@ def report_figure(results: list[ResultsFile]):
         files = ", ".join(r.source for r in results)
         raise InputError(files, "", "no metric column has a value to plot")
     fig = _grid(drawn)
-    if axle is None and len(results) > 1:
+    if not axle and len(results) > 1:
         fig.axes[0].legend(fontsize=8)
     fig.suptitle(title + ", ".join(r.label for r in results), fontsize=12)
     fig.tight_layout()
     return fig
 
 
+def _all_of(results: list[ResultsFile], kind: str, other: str, which: str) -> bool:
+    """Whether the files are of a kind (their attribute ``kind``: an axle's, forces); an
+    InputError naming one that is not when another is: two kinds are plotted apart."""
+    first = next((r for r in results if getattr(r, kind)), None)
+    odd = next((r for r in results if not getattr(r, kind)), None)
+    if first is not None and odd is not None:
+        raise InputError(
+            odd.source, "", f"{other}, but {first.source} {which}: plot them separately"
+        )
+    return first is not None
+
+
 @dataclass
 class Panel:
-    """One panel of a report: its lines (x, y, legend label, line style, colour, marker)."""
+    """One panel of a report: its lines (x, y, legend label, line style, colour, marker);
+    ``marks``: x values to mark with a vertical line (a force report's toggles)."""
 
     title: str
     ylabel: str
     xlabel: str
     lines: list = field(default_factory=list)
     legend: bool = False
+    marks: list = field(default_factory=list)
 
 
 def _corner_panel(results: list[ResultsFile], name: str, xname: str, xlabel: str) -> Panel:
@@ -323,6 +354,8 @@ def _grid(drawn: list[Panel]):
         ax.tick_params(labelsize=8)
         if panel.legend:
             ax.legend(fontsize=7)
+        for x in panel.marks:
+            ax.axvline(x, color="0.4", ls=":", lw=1.0, gid="toggle")
     for ax in list(axes.flat)[len(drawn) :]:
         ax.set_visible(False)
     return fig
@@ -390,9 +423,153 @@ def _axle_panel(results, title: str, names: tuple, xlabel: str, x) -> Panel:
 
 
 def _marker(r: ResultsFile, name: str) -> str | None:
-    finite = np.isfinite(r[name])
+    return _lone(r[name])
+
+
+def _lone(y: np.ndarray) -> str | None:
+    """A dot marker when some value has no finite neighbour (a line would not show it)."""
+    finite = np.isfinite(y)
     lone = finite & ~np.r_[False, finite[:-1]] & ~np.r_[finite[1:], False]
     return "o" if np.any(lone) else None
+
+
+# ---------------------------------------------------------------- the force report
+
+STYLES = ("-", "--", ":", "-.")  # several forces files: one line style each
+
+
+def force_figure(results: list[ResultsFile]):
+    """The force report of forces CSVs (``pin-susp loads``): ``force_panels`` on the
+    report's grid, a legend of the load cases, and a note of the steps at a toggle."""
+    xname, xlabel = x_axis(results)
+    drawn = force_panels(results, xname, xlabel)
+    fig = _grid(drawn)
+    handles = {}
+    for ax in fig.axes:
+        for line in ax.get_lines():
+            if not line.get_label().startswith("_"):
+                handles.setdefault(line.get_label(), line)
+    height = fig.get_figheight()  # inches: the legend and the note get their room
+    ncol = min(len(handles), 6) or 1
+    fig.legend(
+        handles.values(),
+        handles.keys(),
+        loc="upper center",
+        bbox_to_anchor=(0.5, 1.0 - 0.42 / height),
+        ncol=ncol,
+        fontsize=9,
+    )
+    notes = [n for n in (toggle_note(r, xname) for r in results) if n]
+    if notes:
+        fig.text(0.01, 0.01, "\n".join(notes), fontsize=8, va="bottom", gid="toggle_note")
+    sign = "members: tension +, spring: compression +, joints: magnitude of the load"
+    fig.suptitle(f"pin_susp forces ({sign}): " + ", ".join(r.label for r in results), fontsize=12)
+    top = 1.0 - (0.5 + 0.25 * -(-len(handles) // ncol)) / height
+    fig.tight_layout(rect=(0, (0.16 * len(notes) + 0.1) / height if notes else 0, 1, top))
+    return fig
+
+
+def force_panels(results: list[ResultsFile], xname: str, xlabel: str) -> list[Panel]:
+    """One panel per member (``force_<member>``, the spring, the rack) and per joint (the
+    magnitude of ``load_<joint>_{x,y,z}``), a line per load case (per file and case for
+    several files: a colour per case, a line style per file). A member or joint with no
+    value anywhere has no panel; a toggle's rows (blank forces) are gaps, marked."""
+    members, joints = force_columns(results)
+    cases = list(dict.fromkeys(c for r in results for c in r["load_case"]))
+    marks = sorted({x for r in results for x in toggles(r, xname)[1]})
+    out = []
+    for name in members + joints:
+        column = f"load_{name}_x" if name in joints else name
+        unit = next((r.units.get(column, "N") for r in results if column in r.columns), "N")
+        if name in joints:
+            title = f"{name.replace('_', ' ').capitalize()} load (magnitude)"
+            ylabel = f"|load_{name}| [{unit}]"
+        else:
+            title, ylabel = _member_title(name), f"{name} [{unit}]" if unit else name
+        panel = Panel(title, ylabel, xlabel, marks=marks)
+        for k, r in enumerate(results):
+            y_all = joint_load(r, name) if name in joints else r.columns.get(name)
+            if y_all is None:
+                continue
+            for case in dict.fromkeys(r["load_case"]):
+                rows = r["load_case"] == case
+                who = f"{r.label}: {case}" if len(results) > 1 else str(case)
+                colour = f"C{cases.index(case) % 10}"
+                y = y_all[rows]
+                style = STYLES[k % len(STYLES)]
+                panel.lines.append((r[xname][rows], y, who, style, colour, _lone(y)))
+        if any(np.any(np.isfinite(line[1])) for line in panel.lines):
+            out.append(panel)
+    if not out:  # every step at a toggle or failed: the members' panels, empty, and the note
+        out = [Panel(_member_title(n), n, xlabel, marks=marks) for n in members]
+    return out
+
+
+def force_columns(results: list[ResultsFile]) -> tuple[list[str], list[str]]:
+    """The members (the two-force members in the files' order, then the spring and the
+    rack) and the joints (``load_<joint>_{x,y,z}`` → ``<joint>``) of forces files."""
+    names = list(dict.fromkeys(n for r in results for n in r.columns))
+    members = [n for n in names if n.startswith(("force_", "torque_"))]
+    last = ("force_spring", "torque_spring", "force_rack")
+    members = [n for n in members if n not in last] + [n for n in last if n in members]
+    joints = [n[5:-2] for n in names if n.startswith("load_") and n.endswith("_x")]
+    joints = [j for j in joints if all(f"load_{j}_{a}" in names for a in "yz")]
+    return members, joints
+
+
+def joint_load(r: ResultsFile, joint: str) -> np.ndarray | None:
+    """|load_<joint>_{x,y,z}| at each row (N), or None when the file has no such joint."""
+    names = [f"load_{joint}_{a}" for a in "xyz"]
+    if not all(n in r.columns for n in names):
+        return None
+    return np.linalg.norm(np.column_stack([r[n] for n in names]), axis=1)
+
+
+def _member_title(name: str) -> str:
+    side = next((f" {s}" for s in ("left", "right") if name.endswith(f"_{s}")), "")
+    base = name.removesuffix(side.replace(" ", "_"))
+    if base == "force_spring":
+        return f"Spring{side} (compression +)"
+    if base == "torque_spring":
+        return f"Torsion bar{side} torque"
+    if base == "torque_arb":
+        return "Anti-roll bar torque"
+    if base == "force_rack":
+        return "Rack (the trackrods' pull, + left)"
+    return f"{base.removeprefix('force_').replace('_', ' ').capitalize()}{side} (tension +)"
+
+
+def toggles(r: ResultsFile, xname: str) -> tuple[list[int], list[float]]:
+    """The steps at a toggle (``loads_unbounded`` = 1: forces unbounded, blank) and their
+    x values."""
+    flag = r.columns.get("loads_unbounded")
+    if flag is None:
+        return [], []
+    rows = np.flatnonzero(flag == 1.0)
+    steps = dict.fromkeys(int(s) for s in r["step_index"][rows])
+    xs = dict.fromkeys(float(x) for x in r[xname][rows] if np.isfinite(x))
+    return list(steps), list(xs)
+
+
+def toggle_note(r: ResultsFile, xname: str) -> str:
+    """What the report says of a file's toggles and failed steps ('' when none)."""
+    steps, xs = toggles(r, xname)
+    parts = []
+    if steps:
+        at = ", ".join(f"{x:.4g}" for x in xs[:8]) + (" ..." if len(xs) > 8 else "")
+        parts.append(
+            f"forces unbounded (a toggle) at step(s) {_steps(steps)} "
+            f"({xname.replace('_', ' ')} {at}): gaps, marked by dotted lines"
+        )
+    converged = r.columns.get("solver_converged")
+    if converged is not None and np.any(converged != 1.0):
+        failed = dict.fromkeys(int(s) for s in r["step_index"][converged != 1.0])
+        parts.append(f"step(s) {_steps(list(failed))} did not converge: gaps")
+    return f"{r.label}: " + "; ".join(parts) if parts else ""
+
+
+def _steps(steps: list[int]) -> str:
+    return ", ".join(map(str, steps[:10])) + (" ..." if len(steps) > 10 else "")
 
 
 FRONT, SIDE = (1, 2), (0, 2)  # the world axes each view shows, in mm
@@ -894,7 +1071,8 @@ def _roll_centre_construction(ax, model, q, sides) -> tuple[bool, list[np.ndarra
             ax.annotate(
                 "RC", rc, xytext=(6, 5), textcoords="offset points", fontsize=8, color=CONSTRUCTION
             )
-            notes.insert(0, f"RC: y = {rc[0]:.0f} mm, z = {rc[1]:.0f} mm")
+            y, z = np.round(rc) + 0.0  # a centre a hair left of the centreline: 0, not -0
+            notes.insert(0, f"RC: y = {y:.0f} mm, z = {z:.0f} mm")
     else:
         missing = [s for s in sides if s not in lines]
         notes.append("RC: no front-view instant centre on " + " and ".join(missing))

@@ -25,6 +25,19 @@ rocker. The roll centre is a marker, placed from an axle's results columns
 (``roll_center_y``, ``roll_center_z``, in the front-view plane midway between
 the contact patches) and hidden where they are blank. It is seen from the
 left side, and the ground is widened to the axle's track.
+
+Under a load case (``pin-susp view GEOMETRY SWEEP --cases LOADS --case NAME``)
+the members are coloured by their force at each frame: the links drawn
+between their ends and the coilover (its compression is the spring's
+``force_spring``), and the URDF's rods that are two-force members (a
+wishbone's legs, a multilink's tree link). The colour is matplotlib's
+``coolwarm`` at 0.5 + 0.5·tension/scale: red in tension, blue in
+compression, grey at zero, the scale being the largest |force| of any
+coloured member over the sweep under that case; near-black at a toggle,
+where the force is unbounded. One replay shows one case: meshcat's
+animation is one clip of poses and colours, and a selector would need
+either a copy of every member per case or code reaching into meshcat's
+player.
 """
 
 from __future__ import annotations
@@ -52,6 +65,8 @@ GROUND_COLOUR, GROUND_OPACITY = 0xB4B4A8, 0.3
 GROUND_SIZE, GROUND_THICKNESS = 1.5, 0.002  # m: a square under the corner, its top at the CP
 GROUND_SPAN = 1.2  # ... or this times the width of what is drawn, if wider (an axle)
 MARKERS = {"roll_centre": (0x00D8F0, 0.025)}  # name: colour, radius (m)
+FORCE_MAP = "coolwarm"  # matplotlib's: blue (compression) → grey (0) → red (tension)
+UNBOUNDED = (0.1, 0.1, 0.1)  # a member at a toggle: its force has no bound
 VIEW = np.array([1.6, 0.35, 0.7])  # camera direction: front, outboard (y by side), above
 FOV = 75.0  # degrees, vertical: meshcat's default camera (three.js PerspectiveCamera)
 FILL = 0.8  # the corner's share of the view's height, or of its width ...
@@ -389,12 +404,13 @@ class Scene:
         grid[2, 3] = ground - target[2] - 0.5 * GROUND_THICKNESS
         self.viewer["/Grid"].set_transform(grid)
 
-    def show(self, q: np.ndarray | None = None, viewer=None, markers=None) -> None:
+    def show(self, q: np.ndarray | None = None, viewer=None, markers=None, colours=None) -> None:
         """Display the model at q (default: its design state), drawn on ``viewer``.
 
         ``markers``: {name: position (m)} of the markers (an axle's
         ``roll_centre``); a marker not given, or NaN, is hidden. By default
-        at the design state, where the design results put them."""
+        at the design state, where the design results put them. ``colours``:
+        {node: rgb (0 to 1)} of members coloured by their force."""
         if q is None:
             q = self.model.q_design
             markers = self.design_markers if markers is None else markers
@@ -421,13 +437,21 @@ class Scene:
                 place[:3, 3] = p
                 target[f"{ROOT}/{name}"].set_transform(place)
             _set_visible(target[f"{ROOT}/{name}"], visible)
+        for node, rgb in (colours or {}).items():
+            _set_colour(target[node], rgb)
 
     def animate(
-        self, qs: list[np.ndarray], fps: float = 10.0, play: bool = True, markers=None
+        self,
+        qs: list[np.ndarray],
+        fps: float = 10.0,
+        play: bool = True,
+        markers=None,
+        colours=None,
     ) -> int:
         """Record the poses as a meshcat animation; returns the number of frames.
 
-        ``markers``: {name: positions (m, one row per pose, NaN where hidden)}."""
+        ``markers``: {name: positions (m, one row per pose, NaN where hidden)};
+        ``colours``: {node: rgb (one row per pose)}, from ``force_colours``."""
         from meshcat.animation import Animation
 
         animation = Animation(default_framerate=fps)
@@ -436,16 +460,87 @@ class Scene:
             if q is None:  # a step that did not converge: no pose to show
                 continue
             at = {name: rows[i] for name, rows in (markers or {}).items()}
+            paint = {node: rows[i] for node, rows in (colours or {}).items()}
             with animation.at_frame(self.viewer, frames) as frame:
-                self.show(q, viewer=frame, markers=at)
+                self.show(q, viewer=frame, markers=at, colours=paint)
             frames += 1
-        self.viewer.set_animation(animation, play=play, repetitions=0)
+        self.viewer.window.send(_LastAnimation(animation, play=play, repetitions=0))
         self.frames = frames
         return frames
 
-    def html(self) -> str:
-        """The scene (and animation) as one self-contained HTML page."""
-        return self.viewer.static_html()
+    def html(self, caption: str = "") -> str:
+        """The scene (and animation) as one self-contained HTML page; ``caption``: an
+        HTML block laid over its top left corner (a force colouring's key)."""
+        page = self.viewer.static_html()
+        if caption:
+            page = page.replace("</body>", caption + "</body>", 1)
+        return page
+
+    def members(self, columns) -> dict[str, str]:
+        """Force column → the node drawing that member (``pin-susp loads``' names): a link
+        drawn between its ends (``force_trackrod``, a multilink's links; the coilover for
+        ``force_spring``), else the as-set model's rod between the member's ends (a
+        wishbone's legs ``force_<arm>_front``/``_rear``, a multilink's tree link)."""
+        model, viz = self.robots[-1]
+        drawn = segments(model, model.design_positions)
+        data = model.model.createData()
+        placed = viz.visual_model.createData()
+        pin.updateGeometryPlacements(model.model, data, viz.visual_model, placed, model.q_design)
+        middles = [
+            (o, placed.oMg[i].translation) for i, o in enumerate(viz.visual_model.geometryObjects)
+        ]
+        p = model.design_positions
+        out = {}
+        for column in columns:
+            name = column.removeprefix("force_")
+            link = "coilover" if name == "spring" else name
+            if not column.startswith("force_") or name == "rack":
+                continue
+            if link in drawn:
+                out[column] = f"{ROOT}/links/{link}"
+                continue
+            arm, _, end = name.rpartition("_")
+            for a, b in (
+                (f"{name}_inboard", f"{name}_outboard"),
+                (f"{arm}_inboard_{end}", f"{arm}_outboard"),
+            ):
+                if a in p and b in p:
+                    middle = 0.5 * (p[a] + p[b])
+                    rod = next((o for o, m in middles if np.linalg.norm(m - middle) < 1e-9), None)
+                    if rod is not None:
+                        out[column] = viz.getViewerNodeName(rod, pin.GeometryType.VISUAL)
+        return out
+
+    def force_colours(self, forces, case: str) -> tuple[dict[str, np.ndarray], float]:
+        """Each member's colour at each step of ``forces`` (a Results or ResultsFile of
+        ``pin-susp loads``) under the load case ``case``: {node: rgb rows}, and the scale
+        (N): the largest |force| of a coloured member over the sweep. Tension red,
+        compression blue, grey at zero (``FORCE_MAP``); UNBOUNDED where the force is
+        blank (a toggle). A member whose column is blank at every other step (a leg of
+        an arm that carries more than its ball joint) is not coloured."""
+        import matplotlib
+
+        rows = np.asarray(forces["load_case"]) == case
+        bounded = np.asarray(forces["loads_unbounded"], dtype=float)[rows] == 0.0
+        sign = {"force_spring": -1.0}  # the spring's column is its compression
+        tension = {
+            node: sign.get(column, 1.0) * np.asarray(forces[column], dtype=float)[rows]
+            for column, node in self.members(forces.columns).items()
+        }
+        # a leg blank wherever the forces are bounded is no two-force member (its arm
+        # carries the pushrod): it keeps its own colour
+        tension = {n: t for n, t in tension.items() if np.isfinite(t).any() or not bounded.any()}
+        scale = max(
+            (float(np.nanmax(np.abs(t), initial=0.0)) for t in tension.values()), default=0.0
+        )
+        ramp = matplotlib.colormaps[FORCE_MAP]
+        out = {}
+        for node, t in tension.items():
+            share = t / scale if scale > 0.0 else np.zeros_like(t)
+            rgb = ramp(0.5 + 0.5 * np.nan_to_num(share))[:, :3]
+            rgb[~np.isfinite(t)] = UNBOUNDED
+            out[node] = rgb
+        return out, scale
 
     def close(self) -> None:
         """Stop the meshcat server this scene started.
@@ -469,6 +564,69 @@ class Scene:
 
 
 CornerScene = Scene  # its name from before axles
+
+
+class _LastAnimation:
+    """meshcat's set_animation command, kept by its server after the scene's objects.
+
+    The server keeps each command at its path and sends a new page (and the static
+    HTML) its tree in that order; an animation kept at the root, meshcat's default,
+    comes before the objects, and a colour track would bind to a placeholder where
+    the member's mesh is not loaded yet. Kept at a path after ROOT's, it comes last
+    (the page reads no path from this command)."""
+
+    def __init__(self, animation, play: bool, repetitions: int):
+        from meshcat.commands import SetAnimation
+
+        self.command = SetAnimation(animation, play=play, repetitions=repetitions).lower()
+        self.command["path"] = f"/meshcat/{ROOT}_animation"
+
+    def lower(self) -> dict:
+        return self.command
+
+
+def _set_colour(node, rgb) -> None:
+    """A member's colour (rgb, 0 to 1): of the node's mesh, or of an animation frame (a
+    colour track on the mesh's material)."""
+    from meshcat.animation import AnimationFrameVisualizer
+
+    rgb = [float(c) for c in rgb]
+    if isinstance(node, AnimationFrameVisualizer):
+        node["<object>"].set_property("material.color", "color", rgb)
+    else:
+        node.set_property("color", [*rgb, 1.0])
+
+
+def force_key(case: str, scale: float, note: str = "") -> str:
+    """The colours' key, one line of text: the case, the scale, what red and blue are."""
+    return (
+        f"members coloured by force under {case!r}{f' ({note})' if note else ''}: "
+        f"red tension, blue compression, grey 0, full colour at {scale:.0f} N "
+        "(the largest |force| over the sweep); near-black: unbounded (a toggle)"
+    )
+
+
+def force_caption(case: str, scale: float, source: str = "") -> str:
+    """The key as an HTML block over the replay: a colour bar from −scale to +scale."""
+    import html
+
+    import matplotlib
+
+    ramp = matplotlib.colormaps[FORCE_MAP]
+    stops = ", ".join(matplotlib.colors.to_hex(ramp(t)) for t in np.linspace(0.0, 1.0, 9))
+    black = matplotlib.colors.to_hex(UNBOUNDED)
+    return (
+        '<div id="force_key" style="position:fixed;left:8px;top:8px;z-index:10;'
+        "font:12px sans-serif;background:rgba(255,255,255,0.85);padding:6px 8px;"
+        f'border-radius:4px">Load case <b>{html.escape(case)}</b>'
+        f"{html.escape(f' ({source})') if source else ''}<br>"
+        f'<div style="width:220px;height:10px;margin:4px 0;background:linear-gradient('
+        f'to right, {stops})"></div>'
+        f'<div style="display:flex;justify-content:space-between;width:220px">'
+        f"<span>−{scale:.0f} N</span><span>0</span><span>+{scale:.0f} N</span></div>"
+        f"compression ← → tension; "
+        f'<span style="color:{black}">■</span> unbounded (toggle)</div>'
+    )
 
 
 def _set_visible(node, visible: bool) -> None:
