@@ -271,43 +271,90 @@ def _loads_command(sub) -> None:
     )
     lo.add_argument("-o", "--output", required=True, metavar="OUT.csv", help="forces CSV")
     lo.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
+    lo.add_argument(
+        "--plot",
+        metavar="OUT.png",
+        help="also draw the force report: each member's force and each joint's load "
+        "against wheel travel (or rack), a line per load case",
+    )
     lo.set_defaults(run=_loads)
 
 
 def _loads(args) -> int:
-    from .loads import Statics, load_cases, member_forces
-
-    _check_outputs(args, args.output)
-    if _is_axle(args.geometry):
-        raise PinSuspError(
-            f"{args.geometry}: loads: an axle's loads are not built yet (corners are)"
-        )
-    corner = Corner(load_geometry(args.geometry))
-    sweep = load_sweep(args.sweep)
-    cases = load_cases(args.cases)
-    corner.solver_for(sweep.targets, sweep.source)  # target errors before any work
-    Statics(corner)  # a corner without a load path: said before any work
-    tangents = []
-    solutions = corner.solve_steps(
-        sweep, progress=_progress_bar(sweep.steps, args.quiet), tangents=tangents
-    )
-    results = Results.from_solutions(corner, solutions, sweep, tangents or None)
-    forces = member_forces(corner, sweep, cases, solutions, results)
-    write_text(csv_text(forces), args.output)
+    _check_outputs(args, args.output, args.plot)
+    if args.plot is not None:
+        _check_image(args.plot)
+    corner, sweep, cases = _load_inputs(args.geometry, args.sweep, args.cases)
+    results, forces = _solve_forces(corner, sweep, cases, args.quiet)
+    plot = _write_results(args, forces)
     if not args.quiet:
         unbounded = int(np.nansum(forces["loads_unbounded"]))
         print(
-            f"wrote {args.output}: {len(solutions)} steps x {len(cases)} load cases"
+            f"wrote {args.output}: {len(results)} steps x {len(cases)} load cases"
             + (f"; {unbounded} row(s) at a toggle (forces unbounded: blank)" if unbounded else "")
         )
         _force_summary(forces)
+        if plot:
+            print(f"wrote {args.plot}")
     return _report_failures(results)
+
+
+def _load_inputs(geometry, sweep, cases, option: str = "loads"):
+    """A corner, its sweep and load cases, every input error said before any work."""
+    from .loads import Statics, load_cases
+
+    if _is_axle(geometry):
+        if option != "loads":
+            raise PinSuspError(f"{geometry}: {option}: an axle's members are not coloured yet")
+        from .axle import axle_rows
+
+        model = _axle_model(geometry)
+        sweep = load_sweep(sweep)
+        cases = load_cases(cases, axle=True)
+        axle_rows(model, sweep.targets, sweep.source)  # target errors before any work
+        Statics(model)  # no load path, or a bar without its stiffness
+        return model, sweep, cases
+    corner = Corner(load_geometry(geometry))
+    sweep = load_sweep(sweep)
+    cases = load_cases(cases)
+    corner.solver_for(sweep.targets, sweep.source)  # target errors before any work
+    Statics(corner)  # a corner without a load path
+    return corner, sweep, cases
+
+
+def _solve_forces(corner, sweep, cases, quiet: bool):
+    """The sweep's results and, at every step and load case, the forces."""
+    from .loads import member_forces
+
+    if not isinstance(corner, Corner):  # an axle
+        from .axle import axle_results, solve_axle_sweep
+
+        solutions = solve_axle_sweep(corner, sweep, progress=_progress_bar(sweep.steps, quiet))
+        results = axle_results(corner, sweep, solutions)
+        return results, member_forces(corner, sweep, cases, solutions, results)
+    tangents = []
+    solutions = corner.solve_steps(
+        sweep, progress=_progress_bar(sweep.steps, quiet), tangents=tangents
+    )
+    results = Results.from_solutions(corner, solutions, sweep, tangents or None)
+    return results, member_forces(corner, sweep, cases, solutions, results)
+
+
+def _chosen_case(path, cases, name: str | None) -> str:
+    """The load case to show: the one named (it must be in the file), else the first."""
+    from .errors import InputError
+
+    names = [c.name for c in cases]
+    if name is not None and name not in names:
+        listed = ", ".join(repr(n) for n in names)
+        raise InputError(str(path), "cases", f"no load case named {name!r} (it has {listed})")
+    return names[0] if name is None else name
 
 
 def _force_summary(forces) -> None:
     """The largest tension and compression of each member over the sweep, per case."""
     names = [n for n in forces.columns if n.startswith(("force_", "torque_"))]
-    print(f"  {'member':28s} {'case':18s} {'min':>12s} {'max':>12s}")
+    print(f"  {'member':36s} {'case':18s} {'min':>12s} {'max':>12s}")
     for case in dict.fromkeys(forces["load_case"]):
         rows = forces["load_case"] == case
         for name in names:
@@ -316,7 +363,7 @@ def _force_summary(forces) -> None:
                 continue
             unit = forces.units.get(name, "N")
             print(
-                f"  {name:28s} {str(case)[:18]:18s} {np.nanmin(values):12.1f} "
+                f"  {name:36s} {str(case)[:18]:18s} {np.nanmin(values):12.1f} "
                 f"{np.nanmax(values):12.1f} {unit}"
             )
 
@@ -382,6 +429,8 @@ AXLE_SUMMARY = (
     "arb_twist",
     "heave_link_length",
     "ackermann",
+    "roll_stiffness",
+    "arb_wheel_rate",
 )
 
 
@@ -791,7 +840,7 @@ def _check_image(path) -> None:
 
 def _check_outputs(args, *paths) -> None:
     """Before any work: every output writable, each its own file, none of them an input."""
-    inputs = [getattr(args, name, None) for name in ("geometry", "sweep", "mjcf")]
+    inputs = [getattr(args, name, None) for name in ("geometry", "sweep", "mjcf", "cases")]
     inputs += list(getattr(args, "results", None) or ())
     at = getattr(args, "at", None)
     if at:
@@ -1323,9 +1372,13 @@ def _plot_command(sub) -> None:
         "(of the same kind of sweep: a bump and a steer sweep cannot share one figure). An "
         "axle's CSV gives the axle report: camber (to the chassis and to the ground), toe, "
         "steer angle, roll centre height and lateral position, bar twist, per side, against "
-        "roll (else heave, else rack), and Ackermann against the mean steer angle.",
+        "roll (else heave, else rack), and Ackermann against the mean steer angle. A forces "
+        "CSV (pin-susp loads) gives the force report: each member's force and each joint's "
+        "load, a line per load case, a toggle's steps left as gaps.",
     )
-    pl.add_argument("results", nargs="+", metavar="RESULTS.csv", help="pin-susp sweep output")
+    pl.add_argument(
+        "results", nargs="+", metavar="RESULTS.csv", help="pin-susp sweep (or loads) output"
+    )
     pl.add_argument(
         "-o", "--output", required=True, metavar="OUT.png", help="image (png, pdf, svg)"
     )
@@ -1402,12 +1455,19 @@ def _view_command(sub) -> None:
         description="Open GEOMETRY in a meshcat scene served locally (works offline) and print "
         "its URL; with SWEEP, play the solved motion as an animation. --html writes the scene "
         "and animation as one HTML file that opens in a browser with no server. An axle file "
-        "shows both corners, the anti-roll bar and the roll centre (hidden where it is blank).",
+        "shows both corners, the anti-roll bar and the roll centre (hidden where it is blank). "
+        "With --cases (and SWEEP), the members are coloured by their force under one load "
+        "case at every frame: red tension, blue compression, grey zero, full colour at the "
+        "largest |force| over the sweep; one replay per case (--case).",
     )
     _geometry_argument(v)
     v.add_argument("sweep", metavar="SWEEP", nargs="?", help="sweep YAML to animate")
     v.add_argument("--html", metavar="OUT.html", help="write a self-contained replay and exit")
     v.add_argument("--fps", type=_positive, default=10.0, help="animation frames per second")
+    v.add_argument(
+        "--cases", metavar="LOADS.yaml", help="load cases: colour the members by their force"
+    )
+    v.add_argument("--case", metavar="NAME", help="the load case to colour by (default: the first)")
     v.set_defaults(run=_view)
 
 
@@ -1416,13 +1476,23 @@ def _view(args) -> int:
     import io
     import time
 
-    from .viz import Scene, roll_centres
+    from .viz import Scene, force_caption, force_key, roll_centres
 
     _check_outputs(args, args.html)
-    axle = _is_axle(args.geometry)
-    model = _axle_model(args.geometry) if axle else Corner(load_geometry(args.geometry))
-    qs, results, markers = None, None, None
-    if args.sweep is not None:
+    if args.case is not None and args.cases is None:
+        raise PinSuspError(f"--case {args.case}: needs --cases LOADS.yaml, the cases it names")
+    if args.cases is not None and args.sweep is None:
+        raise PinSuspError(f"--cases {args.cases}: needs a SWEEP, whose steps the forces are of")
+    qs, results, markers, forces = None, None, None, None
+    if args.cases is not None:  # a corner, its sweep and its forces under every case
+        model, sweep, cases = _load_inputs(args.geometry, args.sweep, args.cases, "view --cases")
+        case = _chosen_case(args.cases, cases, args.case)
+        results, forces = _solve_forces(model, sweep, cases, quiet=False)
+        _warn_transmission(results)
+    else:
+        axle = _is_axle(args.geometry)
+        model = _axle_model(args.geometry) if axle else Corner(load_geometry(args.geometry))
+    if args.sweep is not None and forces is None:
         sweep = load_sweep(args.sweep)
         progress = _progress_bar(sweep.steps, False)
         if axle:  # both corners, the bar, and the roll centre from the results' columns
@@ -1434,6 +1504,7 @@ def _view(args) -> int:
             model.solver_for(sweep.targets, sweep.source)
             results = model.run_sweep(sweep, progress=progress)
             _warn_transmission(results)
+    if results is not None:
         qs = [
             q if ok else None
             for q, ok in zip(results.meta["q"], results["solver_converged"], strict=True)
@@ -1442,9 +1513,21 @@ def _view(args) -> int:
     with contextlib.redirect_stdout(quiet):  # meshcat announces its server on stdout
         scene = Scene(model)
     try:
-        frames = scene.animate(qs, fps=args.fps, markers=markers) if qs is not None else 0
+        colours, caption = None, ""
+        if forces is not None:
+            colours, scale = scene.force_colours(forces, case)
+            others = f"the first of {len(cases)}: --case NAME for another" * (
+                args.case is None and len(cases) > 1
+            )
+            print(force_key(case, scale, others))
+            caption = force_caption(case, scale, Path(args.cases).name)
+        frames = (
+            scene.animate(qs, fps=args.fps, markers=markers, colours=colours)
+            if qs is not None
+            else 0
+        )
         if args.html is not None:
-            write_text(scene.html(), args.html)
+            write_text(scene.html(caption), args.html)
             print(f"wrote {args.html}" + (f" ({frames} frames)" if frames else ""))
             return 0 if results is None else _report_failures(results, "are not in the replay")
         print(

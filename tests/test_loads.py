@@ -561,3 +561,34 @@ def test_roll_stiffness_is_the_second_derivative_of_the_stored_energy():
     assert r["arb_wheel_rate"][1] == pytest.approx(
         0.5 * 40.0 * 180 / np.pi * rate**2 * 1e3, rel=1e-9
     )
+
+
+def test_loads_of_an_axle_through_the_cli(tmp_path, capsys):
+    import yaml
+
+    from pin_susp.cli import main
+
+    data = yaml.safe_load((EXAMPLES / "axle_front.yaml").read_text())
+    geometry = tmp_path / "axle.yaml"
+    cases = tmp_path / "cases.yaml"
+    cases.write_text(
+        "cases:\n  - name: turn\n    left: {contact_patch: {fy: -2700, fz: 1800}}\n"
+        "    right: {contact_patch: {fy: -900, fz: 600}}\n"
+    )
+    out = tmp_path / "forces.csv"
+    args = ["loads", str(geometry), str(EXAMPLES / "heave_roll.yaml"), "--cases", str(cases)]
+    geometry.write_text(yaml.safe_dump(data))  # a bar without its stiffness: refused
+    assert main([*args, "-o", str(out)]) == 2
+    assert "stiffnesses" in capsys.readouterr().err and not out.exists()
+    data["axle_config"]["spring"] = {"type": "coilover", "rate": 175.0}
+    data["axle_config"]["anti_roll"]["stiffness"] = 40.0
+    geometry.write_text(yaml.safe_dump(data))
+    assert main([*args, "-o", str(out), "-q"]) == 0
+    header, rows = _read(out)
+    for name in ("force_spring_left", "force_spring_right", "torque_arb", "force_droplink_left",
+                 "force_rack", "load_lower_ball_joint_x_right", "roll_stiffness"):  # fmt: skip
+        assert name in header, name
+    assert len(rows) == 31
+    cases.write_text("cases: [{name: flat, contact_patch: {fz: 1}}]\n")  # no side blocks
+    assert main([*args, "-o", str(out)]) == 2
+    assert "left: and right:" in capsys.readouterr().err
