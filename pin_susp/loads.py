@@ -370,12 +370,12 @@ class Statics:
         """λ at the current state (solver evaluated) for the loads W; None at a toggle."""
         J = self.solver.jacobian
         G = self._load_map()
-        if self.compliance is None:  # as many rows as freedoms: one LU
-            lu, pivots, info = lapack.dgetrf(J.T)
+        if self.compliance is None:  # as many rows as freedoms: one LU for every case
+            # (dgesv: factor and solve in one call — dgetrs with several right-hand sides
+            # was measured 10-40x slower here, BLAS threading on tiny systems)
+            lu, _, lam, info = lapack.dgesv(J.T, -(G @ W))
             rcond = lapack.dgecon(lu, np.abs(J).sum(axis=1).max())[0] if info == 0 else 0.0
-            if rcond < 1.0 / TOGGLE:
-                return None
-            return lapack.dgetrs(lu, pivots, -(G @ W))[0]
+            return None if rcond < 1.0 / TOGGLE else lam
         # one row more than freedoms: the λ of least Σ c·λ² among the equilibria
         U, S, Vt = np.linalg.svd(J.T)
         if S[-1] < S[0] / TOGGLE:
