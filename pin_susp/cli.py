@@ -258,7 +258,7 @@ def _loads_command(sub) -> None:
         "loads",
         help="member and joint forces at every step under load cases",
         description="Solve SWEEP on the corner GEOMETRY and, at every step, the quasi-static "
-        "forces under each load case of CASES (spec/loads.md): the tension in every "
+        "forces under each load case of CASES (README, Loads and rates): the tension in every "
         "two-force member (wishbone legs, trackrod or toe link, pushrod, links), the "
         "spring's force, the rack's, and the load at every ball joint and pivot bushing. "
         "One CSV row per step and case, then the sweep's own columns. Exit code 1 if a "

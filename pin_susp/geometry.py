@@ -457,6 +457,8 @@ def _spring_rate(spring_map: dict, spring: str, strut, r: Reader) -> tuple:
     MacPherson strut, config.strut; (None, 0) without a rate."""
     if strut is not None:
         strut = _strut(strut, r)
+        if "preload" in strut and "rate" not in strut:
+            r.fail("config.strut.preload", "a preload needs the strut's rate (config.strut.rate)")
         return strut.get("rate"), strut.get("preload", 0.0)
     given = [k for k in ("rate", "preload") if k in spring_map]
     if given and spring == "none":

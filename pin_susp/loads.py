@@ -66,22 +66,28 @@ def load_cases(source, axle: bool = False) -> list:
     data, name, _ = load_yaml(source)
     r = Reader(name)
     r.mapping(data, "", required=("cases",), optional=("version",))
+    if "version" in data and data["version"] != 1:
+        r.fail("version", f"expected 1 (this file format's version), got {data['version']!r}")
     cases = data["cases"]
     if not isinstance(cases, list) or not cases:
         r.fail("cases", "expected a list of load cases")
     out, seen = [], set()
     for i, case in enumerate(cases):
         key = f"cases[{i}]"
-        r.mapping(case, key, required=("name",), optional=(*CASE_KEYS, "left", "right"))
-        title = r.text(case["name"], f"{key}.name")
+        if not axle and isinstance(case, dict):
+            for side in ("left", "right"):
+                if side in case:
+                    r.fail(f"{key}.{side}", "a side block is for an axle's load cases")
+        sides = ("left", "right") if axle else ()
+        r.mapping(case, key, required=("name",), optional=(*CASE_KEYS, *sides))
+        title = str(r.text(case["name"], f"{key}.name")).strip()
+        if not title:
+            r.fail(f"{key}.name", "empty: name the case")
         if title in seen:
             r.fail(f"{key}.name", f"{title!r} names two cases")
         seen.add(title)
         if not axle:
-            for side in ("left", "right"):
-                if side in case:
-                    r.fail(f"{key}.{side}", "a side block is for an axle's load cases")
-            out.append(_wheel_loads(case, key, str(title), r))
+            out.append(_wheel_loads(case, key, title, r))
             continue
         for part in CASE_KEYS:
             if part in case:
@@ -102,8 +108,18 @@ def _wheel_loads(case: dict, key: str, title: str, r: Reader) -> LoadCase:
     for part, axes in (("contact_patch", "f"), ("wheel_center", "f"), ("moment", "m")):
         names = tuple(f"{axes}{a}" for a in "xyz")
         block = r.mapping(case.get(part, {}), f"{key}.{part}", optional=names)
-        vectors[part] = np.array([r.number(block.get(n, 0.0), f"{key}.{part}.{n}") for n in names])
+        vectors[part] = np.array([_load(block.get(n, 0.0), f"{key}.{part}.{n}", r) for n in names])
     return LoadCase(title, **vectors)
+
+
+MAX_LOAD = 1e7  # N and N·m: far beyond any wheel's (a unit mistake, or a typo)
+
+
+def _load(value, key: str, r: Reader) -> float:
+    x = r.number(value, key)
+    if abs(x) > MAX_LOAD:
+        r.fail(key, f"{x:g} is beyond {MAX_LOAD:g} (N, N·m): no wheel carries that")
+    return x
 
 
 def member_forces(corner, sweep, cases: list, solutions=None, results=None, progress=None):
@@ -121,6 +137,8 @@ def member_forces(corner, sweep, cases: list, solutions=None, results=None, prog
         sweep = load_sweep(sweep)
     if not isinstance(cases, list):
         cases = load_cases(cases, axle=axle)
+    if not cases:
+        raise PinSuspError("member_forces: no load cases given")
     statics = Statics(corner)
     if solutions is None:
         if axle:
@@ -203,7 +221,12 @@ class Statics:
                 held.append(DistanceClosure(f"{prefix}spring", top, bottom, 0.0))
                 stiffness = None if g.spring_rate is None else g.spring_rate * 1e3  # N/m
             else:  # a torsion bar: the rocker's turn about its axis
-                held.append(_RockerTurn(subject, prefix))
+                turn = _RockerTurn(subject, prefix)
+                # + resisting bump, as the sweep's spring_torque: bump turns the rocker
+                # about a→b in the sense s·spring_sense (motion_ratio > 0 at design)
+                sense = subject.spring_sense[side] if self.axle else subject.spring_sense
+                turn.resisting = -g.sign * sense
+                held.append(turn)
                 stiffness = None if g.spring_rate is None else g.spring_rate * 180 / np.pi
             compliance.append(stiffness)
         bar = subject.axle if self.axle else None
@@ -264,7 +287,7 @@ class Statics:
                 self.direct.append((f"force_{row.name}", col, 1, 1.0 if spring else -1.0))
             elif isinstance(row, _RockerTurn):
                 self.couples.append((col, row))
-                self.direct.append((f"torque_{row.prefix}spring", col, 1, 1.0))
+                self.direct.append((f"torque_{row.prefix}spring", col, 1, row.resisting))
             elif isinstance(row, _Twist):
                 self.direct.append(("torque_arb", col, 1, 1.0))
             else:  # the rack, held by the steering: the trackrods' pull on it is −λ
@@ -476,15 +499,16 @@ class Statics:
         if kind == "none":
             return []
         _, a, d, d_scaled, pickups, ball, blank = spec
+        if pickups is not None:  # two two-force legs: each bush takes its leg's pull
+            U = (ball.position(kin) - pickups).T
+            U = U / np.sqrt((U * U).sum(axis=0))
+            # the chassis holds the arm through its legs: force = −Σ tension · (pickup → ball)ˆ
+            t = np.linalg.solve(U.T @ U, U.T @ -force)  # exact: the force is in their plane
+            return [U[:, :1] * t[0], U[:, 1:] * t[1], t]  # on the chassis: tension · û
         at_a = moment - _cross(a, force)
         on_b = _cross(at_a, d) / (d.T @ d) + d_scaled * (0.5 * (d.T @ force))
-        out = [on_b - force, -on_b]  # the bushings' loads on the chassis
-        if pickups is None:
-            return out if not blank else [*out, np.full((blank, force.shape[1]), np.nan)]
-        U = (ball.position(kin) - pickups).T
-        U = U / np.sqrt((U * U).sum(axis=0))
-        # the chassis holds the arm through its legs: force = −Σ tension · (pickup → ball)ˆ
-        return [*out, np.linalg.solve(U.T @ U, U.T @ -force)]  # exact: force in their plane
+        out = [on_b - force, -on_b]  # the bushings' loads on the chassis (axial: halves)
+        return out if not blank else [*out, np.full((blank, force.shape[1]), np.nan)]
 
     def solve_cases(self, q: np.ndarray, cases: list[LoadCase]) -> list[dict[str, float]]:
         """The columns under each case at q, as dicts; at a toggle every force is NaN and

@@ -193,6 +193,9 @@ def test_a_corner_without_a_spring_has_no_load_path():
         ("cases: [{name: a}, {name: a}]", "cases[1].name"),
         ("cases: []", "cases"),
         ("cases: [{name: a, torque: 3}]", "cases[0].torque"),
+        ("cases: [{name: a, contact_patch: {fz: 1e300}}]", "cases[0].contact_patch.fz"),
+        ("cases: [{name: ' '}]", "cases[0].name"),
+        ("version: 2\ncases: [{name: a}]", "version"),
     ],
 )
 def test_bad_load_case_names_its_key(tmp_path, text, key):
@@ -592,3 +595,37 @@ def test_loads_of_an_axle_through_the_cli(tmp_path, capsys):
     cases.write_text("cases: [{name: flat, contact_patch: {fz: 1}}]\n")  # no side blocks
     assert main([*args, "-o", str(out)]) == 2
     assert "left: and right:" in capsys.readouterr().err
+
+
+def test_a_plain_wishbones_bushings_take_their_legs_pull(rocker):
+    """An arm loaded at its ball joint alone: each bush carries its leg's tension along
+    the leg (pickup → ball), the leg forces and the bush loads in one row agreeing."""
+    corner, statics, qs = rocker
+    f = statics.solve(qs[0], CASES[0])
+    corner.kin.update_positions(qs[0])
+    for arm in ("lower_wishbone", "upper_wishbone"):
+        ball = corner.points[f"{arm}_outboard"].position(corner.kin)
+        for end in ("front", "rear"):
+            pickup = corner.design_positions[f"{arm}_inboard_{end}"]
+            u = (ball - pickup) / np.linalg.norm(ball - pickup)
+            load = np.array([f[f"load_{arm}_{end}_bushing_{a}"] for a in "xyz"])
+            np.testing.assert_allclose(load, f[f"force_{arm}_{end}"] * u, atol=1e-9 * 5000)
+
+
+def test_a_torsion_bars_torque_resists_bump_whichever_way_its_axis_is_written():
+    import yaml
+
+    data = yaml.safe_load((EXAMPLES / "pushrod_rocker.yaml").read_text())
+    data["spring"] = {"type": "torsion_bar", "rate": 20.0, "preload": 150.0}
+    for k in ("strut_top", "strut_bottom"):
+        data["hardpoints"].pop(k)
+    bump = LoadCase("bump", np.array([0.0, 0.0, 2100.0]), np.zeros(3), np.zeros(3))
+    torques = []
+    for swap in (False, True):
+        if swap:
+            hp = data["hardpoints"]
+            hp["rocker_axis_a"], hp["rocker_axis_b"] = hp["rocker_axis_b"], hp["rocker_axis_a"]
+        corner = pin_susp.Corner(data)
+        torques.append(Statics(corner).solve(corner.q_design, bump)["torque_spring"])
+    assert torques[0] > 0.0  # a bump load winds the bar: it resists, + as the sweep's
+    assert torques[1] == pytest.approx(torques[0], rel=1e-9)
