@@ -857,6 +857,8 @@ def axle_results(model: AxleModel, sweep, solutions: list) -> AxleResults:
     for name, (values, column_unit) in axle_metric_columns(model, points).items():
         columns[name], units[name] = values, column_unit
     plain = {k: v["left"].val for k, v in points.items()}
+    for name, (values, column_unit) in _side_rates(model, plain, qs).items():
+        columns[name], units[name] = values, column_unit
     for name in model.output_points:
         for i, axis in enumerate("xyz"):
             columns[f"{name}_{axis}"] = plain[name][:, i] * 1e3
@@ -864,6 +866,39 @@ def axle_results(model: AxleModel, sweep, solutions: list) -> AxleResults:
     source = model.axle.source if model.axle is not None else "<geometries>"
     sha = model.axle.sha256 if model.axle is not None else None
     return AxleResults(columns, units, AxleResults.solver_meta(solutions, (source, sha), sweep))
+
+
+def _side_rates(model: AxleModel, plain: dict, qs: list) -> dict:
+    """Each side's spring force and wheel and ride rates where its rate is given (the
+    corner's, loads.SpringRates, along its own hub z with the rack held: its corner
+    posed at the side's wheel-centre height and the rack's travel at each step)."""
+    from .loads import rate_columns
+
+    out = {}
+    rack = model.model.existJointName("rack_slide")
+    index = model.model.joints[model.model.getJointId("rack_slide")].idx_q if rack else None
+    for side, g in model.geometries.items():
+        if g.spring_rate is None or g.spring == "none":
+            continue
+        corner = Linkage(g)
+        targets = [PointTarget(corner.points["wheel_center"], Z)]
+        if rack:
+            targets.append(JointTarget(corner.model, "rack_slide"))
+        solver = NewtonSolver(corner.kin, corner.closures, targets, corner.branches)
+        poses, q = [], corner.q_design
+        for i, at in enumerate(qs):
+            if at is None:
+                poses.append(None)
+                continue
+            goal = [plain[f"{side}_wheel_center"][i, 2]] + ([at[index]] if rack else [])
+            corner.kin.update_positions(q)
+            start = np.array([t.residual(corner.kin)[0] + t.value for t in targets])
+            solution = solver.solve(q, start, np.array(goal))
+            q = solution.q if solution.converged else q
+            poses.append(solution.q if solution.converged else None)
+        for name, (values, unit_) in rate_columns(corner, poses).items():
+            out[f"{name}_{side}"] = (values, unit_)
+    return out
 
 
 def axle_metric_columns(model: AxleModel, points: dict) -> dict:

@@ -629,3 +629,30 @@ def test_a_torsion_bars_torque_resists_bump_whichever_way_its_axis_is_written():
         torques.append(Statics(corner).solve(corner.q_design, bump)["torque_spring"])
     assert torques[0] > 0.0  # a bump load winds the bar: it resists, + as the sweep's
     assert torques[1] == pytest.approx(torques[0], rel=1e-9)
+
+
+def test_each_side_of_an_axle_has_its_corners_rates():
+    """An axle with rated springs writes each side's spring force and wheel and ride
+    rates: its corner's, at that side's wheel height and the rack (the corner's own
+    rates are checked against central differences above)."""
+    import yaml
+    from conftest import mirrored
+
+    from pin_susp.axle import AxleModel, axle_results, load_axle, solve_axle_sweep
+
+    data = yaml.safe_load((EXAMPLES / "axle_front.yaml").read_text())
+    data["axle_config"]["spring"] = {"type": "coilover", "rate": 175.0, "preload": 2600.0}
+    data["axle_config"]["wheel"]["tyre"] = {"rate": 120.0}
+    data["axle_config"]["anti_roll"]["stiffness"] = 40.0
+    model = AxleModel(load_axle(data))
+    sweep = _sweep_of(ROLL)
+    r = axle_results(model, sweep, solve_axle_sweep(model, sweep))
+    corner_data = yaml.safe_load((EXAMPLES / "pushrod_rocker.yaml").read_text())
+    for side, drawn in (("left", corner_data), ("right", mirrored(corner_data))):
+        corner = pin_susp.Corner(drawn)
+        design = corner.design_positions["wheel_center"][2] * 1e3
+        heights = r[f"{side}_wheel_center_z"] - design
+        targets = [Target("wheel_center", "z", heights), Target("trackrod_inboard", "y", [0] * 7)]
+        own = corner.run_sweep(Sweep(targets, "x"))
+        for name in ("spring_force", "wheel_rate", "ride_rate"):
+            np.testing.assert_allclose(r[f"{name}_{side}"], own[name], rtol=1e-9, err_msg=name)
