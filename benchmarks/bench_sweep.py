@@ -227,16 +227,22 @@ def loads_overhead(rounds: int, steps: int = 101) -> dict:
         return member_forces(corner, sweep, cases, solutions, results)
 
     jobs = {"sweep": lambda: corner.run_sweep(sweep), "sweep + forces": with_forces}
+    us = alternating(jobs, rounds, steps)
+    return {"us_per_step": us, "added": us["sweep + forces"] / us["sweep"] - 1.0, "cases": 3}
+
+
+def alternating(jobs: dict, rounds: int, steps: int) -> dict[str, float]:
+    """Median µs per step of each job, the jobs run in turn round after round (after a
+    warm-up), so that the machine's drift falls on all of them alike."""
     times = {name: [] for name in jobs}
     for job in jobs.values():
-        job()
+        job()  # warm-up
     for _ in range(rounds):
         for name, job in jobs.items():
             started = time.perf_counter()
             job()
             times[name].append((time.perf_counter() - started) / steps * 1e6)
-    us = {name: float(np.median(t)) for name, t in times.items()}
-    return {"us_per_step": us, "added": us["sweep + forces"] / us["sweep"] - 1.0, "cases": 3}
+    return {name: float(np.median(t)) for name, t in times.items()}
 
 
 def axle_sweeps(steps: int) -> dict[str, Sweep]:
@@ -290,15 +296,7 @@ def axle_vs_corner(rounds: int, steps: int = 101) -> dict:
         jobs[f"axle {kind} whole"] = lambda sweep=sweep: axle_results(
             model, sweep, solve_axle_sweep(model, sweep)
         )
-    times = {name: [] for name in jobs}
-    for job in jobs.values():
-        job()  # warm-up
-    for _ in range(rounds):
-        for name, job in jobs.items():
-            started = time.perf_counter()
-            job()
-            times[name].append((time.perf_counter() - started) / steps * 1e6)
-    us = {name: float(np.median(t)) for name, t in times.items()}
+    us = alternating(jobs, rounds, steps)
     out = {"us_per_step": us, "ratio": {}}
     for name, t in us.items():
         if name.startswith("axle"):

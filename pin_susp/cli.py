@@ -205,17 +205,26 @@ def _sweep_command(sub) -> None:
         "side, and its roll, roll centre, bar twist, ...) and every point to CSV. "
         "Exit code 1 if any step did not converge (its row is flagged).",
     )
-    _geometry_argument(s)
-    s.add_argument("sweep", metavar="SWEEP", help="sweep YAML (targets per step)")
-    s.add_argument("-o", "--output", required=True, metavar="OUT.csv", help="results CSV")
-    s.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
-    s.add_argument(
-        "--plot",
-        metavar="OUT.png",
-        help="also draw the standard kinematics report (an axle's: camber, toe, steer, roll "
+    _run_arguments(
+        s,
+        "results CSV",
+        "also draw the standard kinematics report (an axle's: camber, toe, steer, roll "
         "centre, bar twist, ... against roll, heave or rack)",
     )
     s.set_defaults(run=_sweep)
+
+
+def _run_arguments(parser, output: str, plot: str, cases: bool = False) -> None:
+    """GEOMETRY SWEEP [--cases] -o OUT.csv [-q] [--plot OUT.png]: a sweep's, a loads run's."""
+    _geometry_argument(parser)
+    parser.add_argument("sweep", metavar="SWEEP", help="sweep YAML (targets per step)")
+    if cases:
+        parser.add_argument(
+            "--cases", required=True, metavar="LOADS.yaml", help="load cases (N, N·m, world axes)"
+        )
+    parser.add_argument("-o", "--output", required=True, metavar="OUT.csv", help=output)
+    parser.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
+    parser.add_argument("--plot", metavar="OUT.png", help=plot)
 
 
 def _sweep(args) -> int:
@@ -257,25 +266,20 @@ def _loads_command(sub) -> None:
     lo = sub.add_parser(
         "loads",
         help="member and joint forces at every step under load cases",
-        description="Solve SWEEP on the corner GEOMETRY and, at every step, the quasi-static "
+        description="Solve SWEEP on GEOMETRY (a corner or an axle) and, at every step, the "
+        "quasi-static "
         "forces under each load case of CASES (README, Loads and rates): the tension in every "
         "two-force member (wishbone legs, trackrod or toe link, pushrod, links), the "
         "spring's force, the rack's, and the load at every ball joint and pivot bushing. "
         "One CSV row per step and case, then the sweep's own columns. Exit code 1 if a "
         "step did not converge.",
     )
-    _geometry_argument(lo)
-    lo.add_argument("sweep", metavar="SWEEP", help="sweep YAML (targets per step)")
-    lo.add_argument(
-        "--cases", required=True, metavar="LOADS.yaml", help="load cases (N, N·m, world axes)"
-    )
-    lo.add_argument("-o", "--output", required=True, metavar="OUT.csv", help="forces CSV")
-    lo.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
-    lo.add_argument(
-        "--plot",
-        metavar="OUT.png",
-        help="also draw the force report: each member's force and each joint's load "
+    _run_arguments(
+        lo,
+        "forces CSV",
+        "also draw the force report: each member's force and each joint's load "
         "against wheel travel (or rack), a line per load case",
+        cases=True,
     )
     lo.set_defaults(run=_loads)
 
