@@ -175,7 +175,22 @@ def _sum(x, axis=None, keepdims=False):
 def _cross(a, b):
     av, ad = _split(a)
     bv, bd = _split(b)
-    return Dual(np.cross(av, bv), np.cross(ad, bv) + np.cross(av, bd))
+    der = 0.0  # a plain factor's derivative is the scalar 0: no term
+    if not isinstance(ad, float):
+        der = der + cross(ad, bv)
+    if not isinstance(bd, float):
+        der = der + cross(av, bd)
+    return Dual(cross(av, bv), der)
+
+
+def cross(a, b) -> np.ndarray:
+    """a × b over the last axis (length 3), broadcast as np.cross — written out by
+    component: np.cross's axis handling costs more than the product on small arrays."""
+    if isinstance(a, Dual) or isinstance(b, Dual):  # nested jets (sensitivities)
+        return _cross(a, b)
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
 
 
 def _norm(x, axis=None, keepdims=False):

@@ -28,7 +28,7 @@ from .closures import (
 )
 from .errors import InputError
 from .geometry import DERIVED_POINTS, Geometry, contact_patch, unit
-from .jet import Dual
+from .jet import Dual, cross
 from .metrics import HUB_Z, RACK, TOE_LINK, metric_columns
 from .solver import NewtonSolver
 from .urdf import read_closures, tree_to_urdf
@@ -129,7 +129,7 @@ class FrameMotion:
             pos[:, index] = arms + origin[g][:, None]
             v = np.moveaxis(twist[g, :, :3], -1, 0)  # (k, n, 3)
             w = np.moveaxis(twist[g, :, 3:], -1, 0)
-            rates[:, :, index] = v[:, :, None] + np.cross(w[:, :, None], arms[None])
+            rates[:, :, index] = v[:, :, None] + cross(w[:, :, None], arms[None])
         unsolved = np.array([q is None for q in qs])
         pos[unsolved] = np.nan
         rates[:, unsolved] = np.nan
