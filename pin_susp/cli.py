@@ -303,13 +303,12 @@ def _loads(args) -> int:
     return _report_failures(results)
 
 
-def _load_inputs(geometry, sweep, cases, option: str = "loads"):
-    """A corner, its sweep and load cases, every input error said before any work."""
+def _load_inputs(geometry, sweep, cases):
+    """A corner or an axle, its sweep and load cases, every input error said before any
+    work."""
     from .loads import Statics, load_cases
 
     if _is_axle(geometry):
-        if option != "loads":
-            raise PinSuspError(f"{geometry}: {option}: an axle's members are not coloured yet")
         from .axle import axle_rows
 
         model = _axle_model(geometry)
@@ -778,11 +777,21 @@ def _summary(results: Results, path) -> None:
 
 def _warn_transmission(results: Results) -> None:
     """Name the steps where a rocker transmission angle leaves its band (an axle's
-    per side)."""
+    per side), and where a rated spring's force goes below zero (it would unseat)."""
     for suffix, side in (("", ""), ("_left", "left "), ("_right", "right ")):
         angle = results.columns.get(f"rocker_transmission_angle{suffix}")
         if angle is not None:
             _warn_band(angle, side)
+        force = results.columns.get(f"spring_force{suffix}")
+        if force is not None and np.nanmin(force) < 0.0:
+            steps = np.flatnonzero(force < 0.0)
+            warnings.warn(
+                f"{side}spring force below zero at steps {_list([int(i) for i in steps])} "
+                f"(least {np.nanmin(force):.0f} N): the spring would unseat there — more "
+                "preload, or less droop",
+                PlausibilityWarning,
+                stacklevel=2,
+            )
 
 
 def _warn_band(angle: np.ndarray, side: str) -> None:
@@ -1489,21 +1498,21 @@ def _view(args) -> int:
         raise PinSuspError(f"--cases {args.cases}: needs a SWEEP, whose steps the forces are of")
     qs, results, markers, forces = None, None, None, None
     if args.cases is not None:  # a corner, its sweep and its forces under every case
-        model, sweep, cases = _load_inputs(args.geometry, args.sweep, args.cases, "view --cases")
+        model, sweep, cases = _load_inputs(args.geometry, args.sweep, args.cases)
         case = _chosen_case(args.cases, cases, args.case)
         results, forces = _solve_forces(model, sweep, cases, quiet=False)
         _warn_transmission(results)
+        axle = not isinstance(model, Corner)
     else:
         axle = _is_axle(args.geometry)
         model = _axle_model(args.geometry) if axle else Corner(load_geometry(args.geometry))
     if args.sweep is not None and forces is None:
         sweep = load_sweep(args.sweep)
         progress = _progress_bar(sweep.steps, False)
-        if axle:  # both corners, the bar, and the roll centre from the results' columns
+        if axle:  # both corners and the bar
             from .axle import axle_results, solve_axle_sweep
 
             results = axle_results(model, sweep, solve_axle_sweep(model, sweep, progress=progress))
-            markers = {"roll_centre": roll_centres(results)}
         else:
             model.solver_for(sweep.targets, sweep.source)
             results = model.run_sweep(sweep, progress=progress)
@@ -1513,6 +1522,8 @@ def _view(args) -> int:
             q if ok else None
             for q, ok in zip(results.meta["q"], results["solver_converged"], strict=True)
         ]
+        if axle:  # the roll centre, from the results' columns
+            markers = {"roll_centre": roll_centres(results)}
     quiet = io.StringIO()
     with contextlib.redirect_stdout(quiet):  # meshcat announces its server on stdout
         scene = Scene(model)

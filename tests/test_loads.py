@@ -656,3 +656,23 @@ def test_each_side_of_an_axle_has_its_corners_rates():
         own = corner.run_sweep(Sweep(targets, "x"))
         for name in ("spring_force", "wheel_rate", "ride_rate"):
             np.testing.assert_allclose(r[f"{name}_{side}"], own[name], rtol=1e-9, err_msg=name)
+
+
+def test_a_spring_below_zero_force_is_warned_of(tmp_path, capsys):
+    """With too little preload for the droop, the rated spring's force goes negative:
+    the sweep says at which steps (a coilover would unseat there)."""
+    import yaml
+
+    from pin_susp.cli import main
+
+    data = yaml.safe_load((EXAMPLES / "pushrod_rocker.yaml").read_text())
+    data["spring"]["preload"] = 1000.0
+    geometry = tmp_path / "corner.yaml"
+    geometry.write_text(yaml.safe_dump(data))
+    out = tmp_path / "out.csv"
+    assert main(["sweep", str(geometry), str(EXAMPLES / "bump_steer.yaml"), "-o", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert "spring force below zero at steps 0," in err
+    header, rows = _read(out)
+    force = [float(r[header.index("spring_force")]) for r in rows]
+    assert force[0] < 0.0 < force[-1]
