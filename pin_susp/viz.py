@@ -34,7 +34,9 @@ wishbone's legs, a multilink's tree link). The colour is matplotlib's
 ``coolwarm`` at 0.5 + 0.5·tension/scale: red in tension, blue in
 compression, grey at zero, the scale being the largest |force| of any
 coloured member over the sweep under that case; near-black at a toggle,
-where the force is unbounded. One replay shows one case: meshcat's
+where the force is unbounded. An axle's are both corners' and its droplinks,
+under one scale; the bar's torque (``torque_arb``, N·m) is no force on that
+scale, and the bar keeps its own colour. One replay shows one case: meshcat's
 animation is one clip of poses and colours, and a selector would need
 either a copy of every member per case or code reaching into meshcat's
 player.
@@ -480,7 +482,9 @@ class Scene:
         """Force column → the node drawing that member (``pin-susp loads``' names): a link
         drawn between its ends (``force_trackrod``, a multilink's links; the coilover for
         ``force_spring``), else the as-set model's rod between the member's ends (a
-        wishbone's legs ``force_<arm>_front``/``_rear``, a multilink's tree link)."""
+        wishbone's legs ``force_<arm>_front``/``_rear``, a multilink's tree link). An
+        axle's columns end with their side (``force_trackrod_left``: the link
+        ``left_trackrod``; ``force_droplink_right``: ``right_droplink``)."""
         model, viz = self.robots[-1]
         drawn = segments(model, model.design_positions)
         data = model.model.createData()
@@ -493,7 +497,11 @@ class Scene:
         out = {}
         for column in columns:
             name = column.removeprefix("force_")
-            link = "coilover" if name == "spring" else name
+            bare, _, side = name.rpartition("_")
+            prefix = f"{side}_" if side in ("left", "right") and len(sides(model)) == 2 else ""
+            if prefix:  # an axle's: force_<member>_<side> is its side's <side>_<member>
+                name = prefix + bare
+            link = prefix + "coilover" if name == prefix + "spring" else name
             if not column.startswith("force_") or name == "rack":
                 continue
             if link in drawn:
@@ -522,7 +530,8 @@ class Scene:
 
         rows = np.asarray(forces["load_case"]) == case
         bounded = np.asarray(forces["loads_unbounded"], dtype=float)[rows] == 0.0
-        sign = {"force_spring": -1.0}  # the spring's column is its compression
+        # a spring's column (an axle's: each side's) is its compression
+        sign = dict.fromkeys(["force_spring", "force_spring_left", "force_spring_right"], -1.0)
         tension = {
             node: sign.get(column, 1.0) * np.asarray(forces[column], dtype=float)[rows]
             for column, node in self.members(forces.columns).items()

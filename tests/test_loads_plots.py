@@ -225,19 +225,28 @@ def test_members_are_coloured_by_the_sign_and_size_of_their_csv_force(replay):
     t = tensions(columns, "2g cornering")
     scale = max(np.abs(v).max() for v in t.values())
     assert scale == pytest.approx(np.abs(t["force_pushrod"]).max())  # its 4194 N
+    assert_coloured_by(tracks, nodes, t, scale)
+    ramp = matplotlib.colormaps["coolwarm"]
+    strongest = np.argmax(np.abs(t["force_pushrod"]))  # in compression: the ramp's end
+    np.testing.assert_allclose(tracks[nodes["force_pushrod"]][strongest], ramp(0.0)[:3])
+
+
+def assert_coloured_by(tracks, nodes, t, scale) -> None:
+    """Each member's colour at every frame (one per step) is red where its tension ``t``
+    is positive, blue where negative, further from grey as |t| grows in either:
+    coolwarm's 0.5 + 0.5·t/scale."""
     ramp = matplotlib.colormaps["coolwarm"]
     grey = np.array(ramp(0.5)[:3])
     for column, node in nodes.items():
-        rgb = np.array([tracks[node][k] for k in range(41)])  # a frame per step
         force = t[column]
+        rgb = np.array([tracks[node][k] for k in range(len(force))])  # a frame per step
         red, blue = rgb[:, 0] - rgb[:, 2], rgb[:, 2] - rgb[:, 0]
         assert np.all((red > 0) == (force > 0)) and np.all((blue > 0) == (force < 0)), column
-        away = np.linalg.norm(rgb - grey, axis=1)  # from grey (zero) as |force| grows
-        order = np.argsort(np.abs(force))
-        assert np.all(np.diff(away[order]) >= -1e-12), column
+        away = np.linalg.norm(rgb - grey, axis=1)  # from grey (zero) as |force| grows,
+        for same in (force >= 0, force < 0):  # on each side of it (coolwarm's sides differ)
+            order = np.argsort(np.abs(force[same]))
+            assert np.all(np.diff(away[same][order]) >= -1e-12), column
         np.testing.assert_allclose(rgb, ramp(0.5 + 0.5 * force / scale)[:, :3], atol=1e-12)
-    strongest = np.argmax(np.abs(t["force_pushrod"]))  # in compression: the ramp's end
-    np.testing.assert_allclose(tracks[nodes["force_pushrod"]][strongest], ramp(0.0)[:3])
 
 
 def test_at_a_toggle_the_members_are_near_black_in_the_replay(toggle, tmp_path):
@@ -311,6 +320,97 @@ def _probe(page, tmp_path) -> list:
     found = re.search(r"<title>probe:(.*?)</title>", dom)
     assert found, "the page left no probe in its title"
     return json.loads(found.group(1))
+
+
+# --- an axle: both corners' members and the droplinks ------------------------------------------
+
+AXLE_SWEEP = str(EXAMPLES / "heave_roll.yaml")  # roll ±3° at 10 mm of heave, 31 steps
+AXLE_CASES = (  # cornering to the right: the left (outer) wheel loaded three times the right
+    "version: 1\ncases:\n"
+    "  - {name: turn, left: {contact_patch: {fy: -2700, fz: 1800}},\n"
+    "     right: {contact_patch: {fy: -900, fz: 600}}}\n"
+)
+
+
+@pytest.fixture(scope="module")
+def axle_replay(tmp_path_factory):
+    """examples/axle_front.yaml with spring and bar rates (the bar shares the load by
+    stiffness): its forces CSV and its replay under 'turn', with the files."""
+    tmp = tmp_path_factory.mktemp("axle")
+    data = example("axle_front.yaml")
+    data["axle_config"]["spring"] = {"type": "coilover", "rate": 175, "preload": 2600}
+    data["axle_config"]["anti_roll"]["stiffness"] = 40
+    geometry, cases = tmp / "axle.yaml", tmp / "cases.yaml"
+    geometry.write_text(yaml.safe_dump(data))
+    cases.write_text(AXLE_CASES)
+    out, html = tmp / "forces.csv", tmp / "axle.html"
+    argv = [str(geometry), AXLE_SWEEP, "--cases", str(cases)]
+    assert main(["loads", *argv, "-o", str(out), "-q"]) == 0
+    assert main(["view", *argv, "--html", str(html)]) == 0
+    return geometry, cases, _commands(html.read_text()), read_csv(out)
+
+
+def axle_nodes(commands) -> dict[str, str]:
+    """Each side's members: the links by their side's prefix, the wishbones' legs the
+    URDF rods whose middles are their ends' (the right corner the left mirrored)."""
+    hp = example("axle_front.yaml")["hardpoints"]["left"]
+    left = {k: np.array([v[a] for a in "xyz"]) * 1e-3 for k, v in hp.items()}
+    point = {
+        **{f"left_{k}": p for k, p in left.items()},
+        **{f"right_{k}": p * [1.0, -1.0, 1.0] for k, p in left.items()},
+    }
+    placed = {
+        c["path"]: np.array(c["matrix"]).reshape(4, 4).T[:3, 3]
+        for c in commands
+        if c["type"] == "set_transform" and c["path"].startswith(VISUALS)
+    }
+    out = {}
+    for side in ("left", "right"):
+        for member in ("trackrod", "pushrod", "droplink"):
+            out[f"force_{member}_{side}"] = f"/meshcat/pin_susp/links/{side}_{member}"
+        out[f"force_spring_{side}"] = f"/meshcat/pin_susp/links/{side}_coilover"
+        for column, (a, b) in LEGS.items():
+            middle = 0.5 * (point[f"{side}_{a}"] + point[f"{side}_{b}"])
+            (node,) = [n for n, p in placed.items() if np.linalg.norm(p - middle) < 1e-9]
+            out[f"{column}_{side}"] = node
+    return out
+
+
+def test_an_axles_members_are_coloured_by_their_sided_csv_forces(axle_replay):
+    _, _, commands, columns = axle_replay
+    tracks = colour_tracks(commands)
+    nodes = axle_nodes(commands)
+    assert len(set(nodes.values())) == 16  # each side's 4 links and 4 legs, no other
+    assert set(tracks) == set(nodes.values())  # the bar (torque_arb, N·m) keeps its colour
+    rows = case_rows(columns, "turn")
+    assert rows.sum() == 31
+    t = {
+        c: (-1.0 if c.startswith("force_spring") else 1.0) * numbers(columns[c])[rows]
+        for c in nodes
+    }
+    assert np.all(np.isfinite(np.concatenate(list(t.values()))))
+    # the outer (left) side's droplink pushes, the inner's pulls: a side swapped would fail
+    assert np.all(t["force_droplink_left"] < 0) and np.all(t["force_droplink_right"] > 0)
+    scale = max(np.abs(v).max() for v in t.values())
+    assert scale == pytest.approx(np.abs(t["force_pushrod_left"]).max())  # the outer pushrod
+    assert_coloured_by(tracks, nodes, t, scale)
+
+
+def test_an_axles_replay_bad_input_writes_nothing(axle_replay, tmp_path, capsys):
+    geometry, cases, _, _ = axle_replay
+    html = tmp_path / "out.html"
+    argv = ["view", str(geometry), AXLE_SWEEP, "--html", str(html)]
+    err = one_error_line(capsys, [*argv, "--cases", str(cases), "--case", "brake"])
+    assert err == f"pin-susp: error: {cases}: cases: no load case named 'brake' (it has 'turn')\n"
+    err = one_error_line(capsys, [*argv, "--cases", CASES])  # a corner's cases
+    assert err == (
+        f"pin-susp: error: {CASES}: cases[0].contact_patch: an axle's loads go in left: and "
+        "right: blocks\n"
+    )
+    unrated = str(EXAMPLES / "axle_front.yaml")  # the bar's share needs the rates
+    err = one_error_line(capsys, ["view", unrated, *argv[2:], "--cases", str(cases)])
+    assert "give each spring's rate (spring.rate) and the bar's" in err
+    assert not html.exists()
 
 
 # --- bad input: one line, exit 2, nothing written ---------------------------------------------
