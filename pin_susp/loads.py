@@ -22,11 +22,11 @@ load is its outboard ball joint is a pair of two-force legs.
 from __future__ import annotations
 
 import math
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
-from scipy.linalg import lapack
 
 from .closures import BallClosure, DistanceClosure, JointTarget
 from .errors import PinSuspError
@@ -139,7 +139,7 @@ def member_forces(corner, sweep, cases: list, solutions=None, results=None, prog
         cases = load_cases(cases, axle=axle)
     if not cases:
         raise PinSuspError("member_forces: no load cases given")
-    statics = Statics(corner)
+    statics = _STATICS.get(corner) or _STATICS.setdefault(corner, Statics(corner))
     if solutions is None:
         if axle:
             from .axle import solve_axle_sweep
@@ -157,16 +157,16 @@ def member_forces(corner, sweep, cases: list, solutions=None, results=None, prog
     names = statics.names
     W = statics.loads_matrix(cases)
     n, m = len(cases), len(solutions)
-    values = np.full((len(names), m * n), np.nan)
-    unbounded = np.full(m * n, np.nan)
-    for i, solution in enumerate(solutions):
-        if solution.converged:
-            at = statics.solve_matrix(solution.q, W)
-            unbounded[i * n : (i + 1) * n] = at is None
-            if at is not None:
-                values[:, i * n : (i + 1) * n] = at
-        if progress is not None:
-            progress(i + 1, m)
+    values = np.full((m, len(names), n), np.nan)
+    unbounded = np.full((m, n), np.nan)
+    done = [i for i, solution in enumerate(solutions) if solution.converged]
+    if done:  # every converged step at once
+        at, toggles = statics.solve_poses([solutions[i].q for i in done], W)
+        values[done], unbounded[done] = at, toggles[:, None]
+    if progress is not None:
+        progress(m, m)
+    values = values.transpose(1, 0, 2).reshape(len(names), m * n)  # rows: step, then case
+    unbounded = unbounded.reshape(m * n)
     columns = {
         "step_index": np.repeat(results["step_index"], n),
         "load_case": np.array([c.name for c in cases] * m, dtype=object),
@@ -181,6 +181,9 @@ def member_forces(corner, sweep, cases: list, solutions=None, results=None, prog
             columns[name] = np.repeat(values, n)
             units[name] = results.units.get(name, "")
     return Results(columns, units, results.meta)
+
+
+_STATICS = weakref.WeakKeyDictionary()  # a subject's plan, made once (it is fixed by its tree)
 
 
 class Statics:
@@ -298,6 +301,12 @@ class Statics:
             (subject.points[_at(s, "wheel_center")], subject.points[_at(s, "contact_patch_center")])
             for s in sides
         ]
+        kin = subject.kin
+        kin.update_positions(subject.q_design)
+        self.spin = []  # each spin axis AI → AO in its wheel centre's frame
+        for wc, cp in self.wheels:
+            a = cp.axle_out.position(kin) - cp.axle_in.position(kin)
+            self.spin.append(kin.data.oMf[wc.frame_id].rotation.T @ (a / np.linalg.norm(a)))
         self.joints = []  # (body, joint, index, ends inside, wheels inside, couples inside)
         for body in subject.tree.bodies:
             j = body.joint
@@ -324,6 +333,20 @@ class Statics:
             [np.eye(3) if e[1] == 3 else np.zeros((3, 3)) for e in self.ends]
         )
         self.specs = [self._joint_spec(body, j) for body, j, *_ in self.joints]
+        self.wheel_joints = [
+            [k for k, joint in enumerate(self.joints) if w in joint[4]]
+            for w in range(len(self.wheels))
+        ]
+        self.couple_joints = [
+            [k for k, joint in enumerate(self.joints) if c in joint[5]]
+            for c in range(len(self.couples))
+        ]
+        self.extra_points = {}  # the points a joint's columns read at each pose
+        for spec in self.specs:
+            if spec[0] == "link":
+                self.extra_points |= {spec[1].name: spec[1], spec[2].name: spec[2]}
+            elif spec[0] == "pivot" and spec[4] is not None:
+                self.extra_points[spec[5].name] = spec[5]
         self.subtree = np.zeros((len(self.joints), len(self.ends)))
         for k, (_, _, _, ends, _, _) in enumerate(self.joints):
             self.subtree[k, ends] = 1.0
@@ -389,77 +412,132 @@ class Statics:
              for p in parts], dtype=float
         ).T  # fmt: skip
 
-    def _multipliers(self, W: np.ndarray) -> np.ndarray | None:
-        """λ at the current state (solver evaluated) for the loads W; None at a toggle."""
-        J = self.solver.jacobian
-        G = self._load_map()
-        if self.compliance is None:  # as many rows as freedoms: one LU for every case
-            # (dgesv: factor and solve in one call — dgetrs with several right-hand sides
-            # was measured 10-40x slower here, BLAS threading on tiny systems)
-            lu, _, lam, info = lapack.dgesv(J.T, -(G @ W))
-            rcond = lapack.dgecon(lu, np.abs(J).sum(axis=1).max())[0] if info == 0 else 0.0
-            return None if rcond < 1.0 / TOGGLE else lam
-        # one row more than freedoms: the λ of least Σ c·λ² among the equilibria
-        U, S, Vt = np.linalg.svd(J.T)
-        if S[-1] < S[0] / TOGGLE:
-            return None
-        rank = len(S)
-        particular = Vt[:rank].T @ ((U.T @ -(G @ W)) / S[:, None])
-        free = Vt[rank:].T  # the null space of Jᵀ: self-stresses
-        C = self.compliance[:, None] * free
-        t = np.linalg.solve(free.T @ C, -(C.T @ particular))
-        return particular + free @ t
-
     def solve_matrix(self, q: np.ndarray, W: np.ndarray) -> np.ndarray | None:
         """Every output column (rows: self.names) for each case (columns of W) at the
         pose q; None at a toggle (the held rows singular: a member cannot hold its
         load, the force is unbounded)."""
-        kin = self.subject.kin
-        self.solver.evaluate(q)  # the kinematics (Jacobians too) and the held rows at q
-        lam = self._multipliers(W)
-        if lam is None:
-            return None
-        out = [factor * lam[col : col + size] for _, col, size, factor in self.direct]
-        # every closure end's force (ends × 3 × cases), and its moment about the origin
-        oMf = kin.data.oMf
-        P = np.array([oMf[f].translation for f in self.frames])
-        at, other = P[self.end_at], P[self.end_other]
-        u = self.end_sign[:, None] * (at - other)  # a distance's (b − a) at either end
-        lengths = np.linalg.norm(u[self.distance_ends], axis=1)
-        directions = self.directions.copy()  # I for a ball's ends, û in column 0 else
-        directions[self.distance_ends, :, 0] = u[self.distance_ends] / lengths[:, None]
-        forces = self.end_sign[:, None, None] * np.einsum(
-            "eij,ejc->eic", directions, lam[self.end_rows]
-        )
-        moments = _cross(at.T[:, :, None], forces.transpose(1, 0, 2)).transpose(1, 0, 2)
-        # a tree joint's force on its subtree: minus the external forces inside it
-        through_f = -np.einsum("je,eic->jic", self.subtree, forces)
-        through_m = -np.einsum("je,eic->jic", self.subtree, moments)
-        loads = []  # each wheel's applied force and moment about the origin
-        for k, (wc, cp) in enumerate(self.wheels):
-            w = W[9 * k : 9 * k + 9]
-            c, p = cp.position(kin), wc.position(kin)
-            loads.append((w[0:3] + w[3:6], _cross(c, w[0:3]) + _cross(p, w[3:6]) + w[6:9]))
-        couples = [np.outer(turn.axis(kin), lam[col]) for col, turn in self.couples]
-        for k, (_, _, _, _, wheels, inner) in enumerate(self.joints):
-            f, m = through_f[k], through_m[k]
-            for i in wheels:
-                f, m = f - loads[i][0], m - loads[i][1]
-            for i in inner:
-                m = m - couples[i]
-            out += self._joint_columns(self.specs[k], f, m)
-        return np.vstack(out)
+        values, unbounded = self.solve_poses([q], W)
+        return None if unbounded[0] else values[0]
 
-    def _load_map(self) -> np.ndarray:
+    def solve_poses(self, qs: list, W: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(values (poses × self.names × cases), unbounded (poses)): every pose's
+        kinematics read in turn, then the statics of all poses at once, as stacked
+        arrays (a handful of numpy calls whatever the number of steps)."""
+        kin, model = self.subject.kin, self.model
+        n = len(qs)
+        Js = np.empty((n, self.size, model.nv))
+        Gs = np.empty((n, model.nv, W.shape[0]))
+        P = np.empty((n, len(self.frames), 3))
+        wheels = np.empty((n, len(self.wheels), 2, 3))  # (wheel centre, contact patch)
+        axes = np.empty((n, len(self.couples), 3))
+        extra = {k: np.empty((n, 3)) for k in self.extra_points}
+        for i, q in enumerate(qs):
+            self.solver.evaluate(q)  # the kinematics (Jacobians too) and the held rows at q
+            Js[i] = self.solver.jacobian
+            self._load_map(wheels[i], Gs[i])
+            oMf = kin.data.oMf
+            P[i] = [oMf[f].translation for f in self.frames]
+            for k, (_, turn) in enumerate(self.couples):
+                axes[i, k] = turn.axis(kin)
+            for name, point in self.extra_points.items():
+                extra[name][i] = point.position(kin)
+        lam, unbounded = self._multipliers(Js, Gs @ W)
+        out = [factor * lam[:, col : col + size] for _, col, size, factor in self.direct]
+        # every closure end's force (poses × ends × 3 × cases) and its moment
+        at, other = P[:, self.end_at], P[:, self.end_other]
+        u = self.end_sign[None, :, None] * (at - other)  # a distance's (b − a) at either end
+        dist = u[:, self.distance_ends]
+        directions = np.broadcast_to(self.directions, (n, *self.directions.shape)).copy()
+        column = directions[..., 0]  # a view: û in column 0 of a distance end's
+        column[:, self.distance_ends] = dist / np.linalg.norm(dist, axis=2)[..., None]
+        forces = self.end_sign[None, :, None, None] * np.einsum(
+            "seij,sejc->seic", directions, lam[:, self.end_rows]
+        )
+        moments = np.cross(at[..., None], forces, axisa=2, axisb=2, axisc=2)
+        through_f = -np.einsum("je,seic->sjic", self.subtree, forces)
+        through_m = -np.einsum("je,seic->sjic", self.subtree, moments)
+        for k in range(len(self.wheels)):
+            w = W[9 * k : 9 * k + 9]
+            load_f = (w[0:3] + w[3:6])[None]
+            load_m = (
+                np.cross(wheels[:, k, 1][..., None], w[0:3][None], axisa=1, axisb=1, axisc=1)
+                + np.cross(wheels[:, k, 0][..., None], w[3:6][None], axisa=1, axisb=1, axisc=1)
+                + w[6:9][None]
+            )
+            for j in self.wheel_joints[k]:
+                through_f[:, j] -= load_f
+                through_m[:, j] -= load_m
+        for k, (col, _) in enumerate(self.couples):
+            couple = axes[:, k, :, None] * lam[:, col][:, None, :]
+            for j in self.couple_joints[k]:
+                through_m[:, j] -= couple
+        for j, spec in enumerate(self.specs):
+            out += self._joint_columns(spec, through_f[:, j], through_m[:, j], extra)
+        values = np.concatenate(out, axis=1)
+        values[unbounded] = np.nan
+        return values, unbounded
+
+    def _multipliers(self, Js: np.ndarray, GW: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """λ per pose (poses × rows × cases) from Jᵀλ = −G·W, and which poses are at a
+        toggle (the held rows singular there)."""
+        if self.compliance is None:
+            # square: singular where the Hadamard ratio |det J| / Π‖row‖ ∈ (0, 1] is tiny
+            # (rows dependent), or where a row all but vanishes against the others (a
+            # member square to its motion); an SVD per pose costs ten times more
+            sign, logdet = np.linalg.slogdet(Js)
+            norms = np.linalg.norm(Js, axis=2)
+            with np.errstate(divide="ignore", invalid="ignore"):  # a zero row: singular
+                ratio = logdet - np.log(norms).sum(axis=1)
+            small = norms.min(axis=1) < norms.max(axis=1) / TOGGLE
+            unbounded = (sign == 0) | small | ~(ratio >= -np.log(TOGGLE))  # NaN: too
+        else:
+            s = np.linalg.svd(Js, compute_uv=False)
+            unbounded = s[:, -1] < s[:, 0] / TOGGLE
+        Jt = Js.transpose(0, 2, 1)
+        if unbounded.any():
+            Jt = Jt.copy()
+            Jt[unbounded] = np.eye(*Jt.shape[1:])  # any solvable stand-in: blanked later
+        if self.compliance is None:  # as many rows as freedoms
+            return np.linalg.solve(Jt, -GW), unbounded
+        # one row more than freedoms: the λ of least Σ c·λ² among the equilibria
+        U, S, Vt = np.linalg.svd(Jt)
+        rank = S.shape[1]
+        particular = Vt[:, :rank].transpose(0, 2, 1) @ (
+            (U.transpose(0, 2, 1) @ -GW) / S[:, :, None]
+        )
+        free = Vt[:, rank:].transpose(0, 2, 1)  # the null space of Jᵀ: self-stresses
+        C = self.compliance[None, :, None] * free
+        t = np.linalg.solve(free.transpose(0, 2, 1) @ C, -(C.transpose(0, 2, 1) @ particular))
+        return particular + free @ t, unbounded
+
+    def _load_map(self, places: np.ndarray | None = None, out: np.ndarray | None = None):
         """G (nv × 9 per wheel) = [J_cp; J_wc; J_ω]ᵀ at the current kinematics, with the
-        upright's material point at the contact patch."""
+        upright's material point at the contact patch (into ``out`` if given);
+        ``places`` (wheels × 2 × 3) receives each wheel's centre and contact patch.
+
+        The patch CP = WC + R·d̂, d̂ = unit(a_z·â − Ẑ), with the spin axis â turning with
+        the wheel centre's frame (its direction there fixed at design)."""
         kin = self.subject.kin
-        parts = []
-        for wc, cp in self.wheels:
+        G = np.empty((self.model.nv, 9 * len(self.wheels))) if out is None else out
+        for k, (wc, cp) in enumerate(self.wheels):
             Jw = kin.frame_jacobian(wc.frame_id)  # linear at WC, angular: the upright's
-            at_patch = Jw[:3] - _skew(cp.position(kin) - wc.position(kin)) @ Jw[3:]
-            parts += [at_patch, Jw[:3], Jw[3:]]
-        return np.vstack(parts).T
+            M = kin.data.oMf[wc.frame_id]
+            ax, ay, az = (M.rotation @ self.spin[k]).tolist()
+            norm = math.sqrt(1.0 - az * az)
+            r = (
+                az * ax * cp.radius / norm,
+                az * ay * cp.radius / norm,
+                (az * az - 1.0) * cp.radius / norm,
+            )
+            center = M.translation
+            if places is not None:
+                places[k, 0], places[k, 1] = center, center + r
+            w = Jw[3:]
+            G[:, 9 * k : 9 * k + 3] = (Jw[:3] - np.array(
+                [[0.0, -r[2], r[1]], [r[2], 0.0, -r[0]], [-r[1], r[0], 0.0]]) @ w).T  # fmt: skip
+            G[:, 9 * k + 3 : 9 * k + 6] = Jw[:3].T
+            G[:, 9 * k + 6 : 9 * k + 9] = w.T
+        return G
 
     def generalized(self, q: np.ndarray, case) -> np.ndarray:
         """Σ J_pᵀ w_p at q: the case's generalised force (its virtual work per dq)."""
@@ -486,29 +564,36 @@ class Statics:
         blank = 0 if legs is None else len(legs)
         return ("pivot", a, d[:, None], d[:, None] / (d @ d), pickups, ball, blank)
 
-    def _joint_columns(self, spec, force, moment) -> list[np.ndarray]:
-        """From the parent's force on a subtree (3 × cases) and its moment about the
-        world origin: a ball joint's load, a link's tension, a pivot's bushings, legs."""
+    def _joint_columns(self, spec, force, moment, extra) -> list[np.ndarray]:
+        """From the parent's force on a subtree (poses × 3 × cases) and its moment about
+        the world origin: a ball joint's load, a link's tension, a pivot's bushings and
+        legs (each poses × rows × cases)."""
         kind = spec[0]
         if kind == "ball":
             return [-force]  # outboard on inboard (a pivot's: the bar on the chassis)
-        kin = self.subject.kin
         if kind == "link":
-            u = spec[1].position(kin) - spec[2].position(kin)
-            return [(u / math.sqrt(u @ u)) @ force]
+            u = extra[spec[1].name] - extra[spec[2].name]
+            u = u / np.linalg.norm(u, axis=1)[:, None]
+            return [np.einsum("si,sic->sc", u, force)[:, None]]
         if kind == "none":
             return []
         _, a, d, d_scaled, pickups, ball, blank = spec
         if pickups is not None:  # two two-force legs: each bush takes its leg's pull
-            U = (ball.position(kin) - pickups).T
-            U = U / np.sqrt((U * U).sum(axis=0))
+            U = (extra[ball.name][:, None, :] - pickups[None]).transpose(0, 2, 1)  # s × 3 × 2
+            U = U / np.linalg.norm(U, axis=1)[:, None, :]
+            Ut = U.transpose(0, 2, 1)
             # the chassis holds the arm through its legs: force = −Σ tension · (pickup → ball)ˆ
-            t = np.linalg.solve(U.T @ U, U.T @ -force)  # exact: the force is in their plane
-            return [U[:, :1] * t[0], U[:, 1:] * t[1], t]  # on the chassis: tension · û
-        at_a = moment - _cross(a, force)
-        on_b = _cross(at_a, d) / (d.T @ d) + d_scaled * (0.5 * (d.T @ force))
+            t = np.linalg.solve(Ut @ U, Ut @ -force)  # exact: the force is in their plane
+            return [U[:, :, :1] * t[:, 0:1], U[:, :, 1:] * t[:, 1:2], t]  # tension · û
+        at_a = moment - np.cross(a[None, :, None], force, axisa=1, axisb=1, axisc=1)
+        dd = float((d.T @ d)[0, 0])
+        on_b = np.cross(at_a, d[None], axisa=1, axisb=1, axisc=1) / dd + d_scaled[None] * (
+            0.5 * np.einsum("i,sic->sc", d[:, 0], force)[:, None]
+        )
         out = [on_b - force, -on_b]  # the bushings' loads on the chassis (axial: halves)
-        return out if not blank else [*out, np.full((blank, force.shape[1]), np.nan)]
+        if blank:
+            out.append(np.full((force.shape[0], blank, force.shape[2]), np.nan))
+        return out
 
     def solve_cases(self, q: np.ndarray, cases: list[LoadCase]) -> list[dict[str, float]]:
         """The columns under each case at q, as dicts; at a toggle every force is NaN and
