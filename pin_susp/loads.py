@@ -104,10 +104,14 @@ def load_cases(source, axle: bool = False) -> list:
 
 
 def _wheel_loads(case: dict, key: str, title: str, r: Reader) -> LoadCase:
+    """One wheel's loads: each block given in full (a block left out: no such load)."""
     vectors = {}
     for part, axes in (("contact_patch", "f"), ("wheel_center", "f"), ("moment", "m")):
         names = tuple(f"{axes}{a}" for a in "xyz")
-        block = r.mapping(case.get(part, {}), f"{key}.{part}", optional=names)
+        given = part in case
+        block = r.mapping(
+            case.get(part, {}), f"{key}.{part}", required=names if given else (), optional=names
+        )
         vectors[part] = np.array([_load(block.get(n, 0.0), f"{key}.{part}.{n}", r) for n in names])
     return LoadCase(title, **vectors)
 

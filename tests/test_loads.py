@@ -186,14 +186,21 @@ def test_a_corner_without_a_spring_has_no_load_path():
 @pytest.mark.parametrize(
     ("text", "key"),
     [
-        ("cases: [{name: a, contact_patch: {fx: lots}}]", "cases[0].contact_patch.fx"),
+        (
+            "cases: [{name: a, contact_patch: {fx: lots, fy: 0, fz: 0}}]",
+            "cases[0].contact_patch.fx",
+        ),
         ("cases: [{contact_patch: {fx: 1}}]", "cases[0].name"),
         ("cases: [{name: a, contact_patch: {fw: 1}}]", "cases[0].contact_patch.fw"),
         ("cases: [{name: a, left: {contact_patch: {fx: 1}}}]", "cases[0].left"),
         ("cases: [{name: a}, {name: a}]", "cases[1].name"),
         ("cases: []", "cases"),
         ("cases: [{name: a, torque: 3}]", "cases[0].torque"),
-        ("cases: [{name: a, contact_patch: {fz: 1e300}}]", "cases[0].contact_patch.fz"),
+        (
+            "cases: [{name: a, contact_patch: {fx: 0, fy: 0, fz: 1e300}}]",
+            "cases[0].contact_patch.fz",
+        ),
+        ("cases: [{name: a, contact_patch: {fx: 0, fy: 0}}]", "cases[0].contact_patch.fz"),
         ("cases: [{name: ' '}]", "cases[0].name"),
         ("version: 2\ncases: [{name: a}]", "version"),
     ],
@@ -208,7 +215,9 @@ def test_bad_load_case_names_its_key(tmp_path, text, key):
 
 def test_load_cases_read_with_defaults(tmp_path):
     path = tmp_path / "loads.yaml"
-    path.write_text("version: 1\ncases:\n  - name: bump\n    contact_patch: {fz: 5000}\n")
+    path.write_text(
+        "version: 1\ncases:\n  - name: bump\n    contact_patch: {fx: 0, fy: 0, fz: 5000}\n"
+    )
     (case,) = load_cases(path)
     assert case.name == "bump"
     np.testing.assert_array_equal(case.contact_patch, [0.0, 0.0, 5000.0])
@@ -226,8 +235,8 @@ def test_loads_through_the_cli_a_row_per_step_and_case(tmp_path, capsys):
 
     cases = tmp_path / "loads.yaml"
     cases.write_text(
-        "version: 1\ncases:\n  - name: braking\n    contact_patch: {fx: -3000, fz: 2500}\n"
-        "  - name: bump\n    contact_patch: {fz: 6000}\n"
+        "version: 1\ncases:\n  - name: braking\n    contact_patch: {fx: -3000, fy: 0, fz: 2500}\n"
+        "  - name: bump\n    contact_patch: {fx: 0, fy: 0, fz: 6000}\n"
     )
     out = tmp_path / "forces.csv"
     code = main(["loads", str(EXAMPLES / "pushrod_rocker.yaml"), str(EXAMPLES / "bump_steer.yaml"),
@@ -247,7 +256,7 @@ def test_loads_through_the_cli_a_row_per_step_and_case(tmp_path, capsys):
     [
         (
             "pushrod_rocker.yaml",
-            "cases: [{name: a, contact_patch: {fx: lots}}]",
+            "cases: [{name: a, contact_patch: {fx: lots, fy: 0, fz: 0}}]",
             "cases[0].contact_patch.fx",
         ),
         ("pushrod_rocker.yaml", "cases: [{name: a, left: {}}]", "cases[0].left"),
@@ -575,8 +584,8 @@ def test_loads_of_an_axle_through_the_cli(tmp_path, capsys):
     geometry = tmp_path / "axle.yaml"
     cases = tmp_path / "cases.yaml"
     cases.write_text(
-        "cases:\n  - name: turn\n    left: {contact_patch: {fy: -2700, fz: 1800}}\n"
-        "    right: {contact_patch: {fy: -900, fz: 600}}\n"
+        "cases:\n  - name: turn\n    left: {contact_patch: {fx: 0, fy: -2700, fz: 1800}}\n"
+        "    right: {contact_patch: {fx: 0, fy: -900, fz: 600}}\n"
     )
     out = tmp_path / "forces.csv"
     args = ["loads", str(geometry), str(EXAMPLES / "heave_roll.yaml"), "--cases", str(cases)]
@@ -592,7 +601,9 @@ def test_loads_of_an_axle_through_the_cli(tmp_path, capsys):
                  "force_rack", "load_lower_ball_joint_x_right", "roll_stiffness"):  # fmt: skip
         assert name in header, name
     assert len(rows) == 31
-    cases.write_text("cases: [{name: flat, contact_patch: {fz: 1}}]\n")  # no side blocks
+    cases.write_text(
+        "cases: [{name: flat, contact_patch: {fx: 0, fy: 0, fz: 1}}]\n"
+    )  # no side blocks
     assert main([*args, "-o", str(out)]) == 2
     assert "left: and right:" in capsys.readouterr().err
 

@@ -327,8 +327,8 @@ def _probe(page, tmp_path) -> list:
 AXLE_SWEEP = str(EXAMPLES / "heave_roll.yaml")  # roll ±3° at 10 mm of heave, 31 steps
 AXLE_CASES = (  # cornering to the right: the left (outer) wheel loaded three times the right
     "version: 1\ncases:\n"
-    "  - {name: turn, left: {contact_patch: {fy: -2700, fz: 1800}},\n"
-    "     right: {contact_patch: {fy: -900, fz: 600}}}\n"
+    "  - {name: turn, left: {contact_patch: {fx: 0, fy: -2700, fz: 1800}},\n"
+    "     right: {contact_patch: {fx: 0, fy: -900, fz: 600}}}\n"
 )
 
 
