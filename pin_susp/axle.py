@@ -21,7 +21,7 @@ from .closures import ContactPatchPoint, JointTarget, PointTarget
 from .corner import Results
 from .errors import InputError
 from .geometry import DERIVED_POINTS, MM, Geometry, unit
-from .linkage import Built, FrameMotion, Linkage
+from .linkage import Built, FrameMotion, Linkage, closure_row
 from .mechanisms import axis_foot, xml_name
 from .solver import NewtonSolver, march
 from .urdf import Body, Closure, Joint, Tree, Visual
@@ -933,7 +933,7 @@ def _motion(model: AxleModel, qs: list, solutions: list | None = None) -> dict:
     for c, (side, g) in enumerate(model.geometries.items()):
         columns[side] = [c, 2] if rack else [c]
         if g.steering == "none" and g.steering_points:
-            row = _closure_row(model.closures, f"{side}_toe_link")
+            row = closure_row(model.closures, f"{side}_toe_link")
             toe = np.zeros((solver.nrows, 1))
             toe[row] = 1.0
             columns[side].append(rhs.shape[1])
@@ -963,16 +963,6 @@ def _motion(model: AxleModel, qs: list, solutions: list | None = None) -> dict:
             for s in SIDES
         }
     return out
-
-
-def _closure_row(closures: list, name: str) -> int:
-    """The first row of the named closure in a solver's stacked rows."""
-    row = 0
-    for c in closures:
-        if c.name == name:
-            return row
-        row += c.size
-    raise KeyError(name)
 
 
 def _roll_rates(model: AxleModel, points: dict, sides: dict) -> dict:

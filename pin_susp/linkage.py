@@ -75,6 +75,16 @@ class Built:
         return FramePoint(name, self.model.addFrame(frame), link)
 
 
+def closure_row(closures: list, name: str) -> int:
+    """The first row of the named closure among a solver's stacked rows."""
+    row = 0
+    for c in closures:
+        if c.name == name:
+            return row
+        row += c.size
+    raise KeyError(name)
+
+
 class FrameMotion:
     """Points fixed to bodies, at many configurations, with their rates along a
     tangent of the solution manifold: each point grouped by the joint that carries
@@ -177,13 +187,8 @@ class Linkage:
         self.drive_rhs = self._drive._unit_rhs
         if geometry.steering == "none" and geometry.steering_points:
             self.drivers = (HUB_Z, TOE_LINK)
-            row = 0
-            for c in self.closures:
-                if c.name == "toe_link":
-                    break
-                row += c.size
             toe = np.zeros((self._drive.nrows, 1))
-            toe[row] = 1.0
+            toe[closure_row(self.closures, "toe_link")] = 1.0
             self.drive_rhs = np.hstack([self._drive._unit_rhs, toe])
         frames = [name for name in self.point_names if name != "contact_patch_center"]
         self._frame_motion = FrameMotion(self.kin, frames, self.points, self.design_positions)

@@ -197,8 +197,9 @@ class Statics:
     Per pose: the held rows' Jacobian J from the solver's batch — the closures, then
     each spring, an axle's anti-roll bar, the rack — and λ from Jᵀλ = −G·W, with
     G = [J_cp; J_wc; J_ω]ᵀ per wheel and W the cases' loads (a column each). With as
-    many rows as freedoms that is one LU for all cases. An axle whose bar (or rigid
-    bar) shares the load with the springs has one row more than freedoms: statically
+    many rows as freedoms that is one solve per pose for all cases, every pose at once
+    (``solve_poses``). An axle whose bar (or rigid bar) shares the load with the
+    springs has one row more than freedoms: statically
     indeterminate, it shares by stiffness — the λ of least complementary energy
     Σ λ_e²/k_e over the springs and the bar (Menabrea), i.e. the one whose elastic
     deflections are compatible.
@@ -416,13 +417,6 @@ class Statics:
              for p in parts], dtype=float
         ).T  # fmt: skip
 
-    def solve_matrix(self, q: np.ndarray, W: np.ndarray) -> np.ndarray | None:
-        """Every output column (rows: self.names) for each case (columns of W) at the
-        pose q; None at a toggle (the held rows singular: a member cannot hold its
-        load, the force is unbounded)."""
-        values, unbounded = self.solve_poses([q], W)
-        return None if unbounded[0] else values[0]
-
     def solve_poses(self, qs: list, W: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(values (poses × self.names × cases), unbounded (poses)): every pose's
         kinematics read in turn, then the statics of all poses at once, as stacked
@@ -537,8 +531,7 @@ class Statics:
             if places is not None:
                 places[k, 0], places[k, 1] = center, center + r
             w = Jw[3:]
-            G[:, 9 * k : 9 * k + 3] = (Jw[:3] - np.array(
-                [[0.0, -r[2], r[1]], [r[2], 0.0, -r[0]], [-r[1], r[0], 0.0]]) @ w).T  # fmt: skip
+            G[:, 9 * k : 9 * k + 3] = (Jw[:3] - _skew(r) @ w).T
             G[:, 9 * k + 3 : 9 * k + 6] = Jw[:3].T
             G[:, 9 * k + 6 : 9 * k + 9] = w.T
         return G
@@ -602,11 +595,10 @@ class Statics:
     def solve_cases(self, q: np.ndarray, cases: list[LoadCase]) -> list[dict[str, float]]:
         """The columns under each case at q, as dicts; at a toggle every force is NaN and
         ``loads_unbounded`` is 1."""
-        values = self.solve_matrix(q, self.loads_matrix(cases))
-        if values is None:
-            return [dict.fromkeys(self.names, np.nan) | {"loads_unbounded": 1.0} for _ in cases]
+        (values,), (unbounded,) = self.solve_poses([q], self.loads_matrix(cases))
+        flag = float(unbounded)  # at a toggle the values are NaN already
         return [
-            dict(zip(self.names, values[:, k].tolist(), strict=True)) | {"loads_unbounded": 0.0}
+            dict(zip(self.names, values[:, k].tolist(), strict=True)) | {"loads_unbounded": flag}
             for k in range(len(cases))
         ]
 
@@ -617,15 +609,6 @@ class Statics:
 
 def _xyz(name: str) -> list[str]:
     return [f"{name}_{a}" for a in "xyz"]
-
-
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """a × b for (3,) or (3, n) arrays, component by component (np.cross is slow here)."""
-    if a.ndim == 1:
-        a = a[:, None]
-    return np.array(
-        [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-    )
 
 
 class _RockerTurn:
@@ -681,10 +664,6 @@ def _sided(name: str) -> str:
         if rest.startswith(side + "_"):
             return f"{head}_{rest[len(side) + 1 :]}_{side}"
     return name
-
-
-def _vector(name: str, v) -> dict[str, float]:
-    return {f"{name}_{a}": float(v[i]) for i, a in enumerate("xyz")}
 
 
 def _bushing(point: str) -> str:
