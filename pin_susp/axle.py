@@ -17,7 +17,7 @@ import numpy as np
 import pinocchio as pin
 
 from . import __version__
-from .closures import ContactPatchPoint, JointTarget, PointTarget
+from .closures import WORLD, ContactPatchPoint, JointTarget, PointTarget
 from .corner import Results
 from .errors import InputError
 from .geometry import DERIVED_POINTS, MM, Geometry, unit
@@ -682,27 +682,28 @@ class RollTarget(_FrameRow):
         Ẑ), its y row), and â turning with the upright, dâ = ω × â, so
         dCP_y = dWC_y + R·((a_z/s)·da_y + (a_y/s³)·da_z): a fixed combination of the
         wheel-centre frame's Jacobian rows, and so is the row's."""
-        y, rows = [0.0, 0.0], []
-        for k in (0, 1):
+        y, z, c = [0.0, 0.0], [0.0, 0.0], [None, None]
+        for k in (0, 1):  # Python floats: numpy's scalars cost more than the arithmetic
             ax, ay, az = (M[k].rotation @ self.spin[k]).tolist()
+            _, wy, z[k] = M[k].translation.tolist()
             s = math.sqrt(1.0 - az * az)
             R = self.radii[k]
-            y[k] = M[k].translation[1] + R * az * ay / s
+            y[k] = wy + R * az * ay / s
             # dCP_y = row 1 + R·(c_x ω_x + c_y ω_y + c_z ω_z), da = ω × â
-            c_x = R * (ay * ay / s**3 - az * az / s)
-            c_y = -R * ax * ay / s**3
-            c_z = R * az * ax / s
-            rows.append(np.array([0.0, 1.0, 0.0, c_x, c_y, c_z]))
-        a = M[0].translation[2] - M[1].translation[2] - self.design
+            c[k] = (R * (ay * ay / s**3 - az * az / s), -R * ax * ay / s**3, R * az * ax / s)
+        a = z[0] - z[1] - self.design
         b = y[0] - y[1]
         r = np.array([math.atan2(a, b) - self.value])
         if J is None:
             return r, None
-        scale = 1.0 / (a * a + b * b)  # d atan2(a, b) = (b·da − a·db)/(a² + b²)
-        rise = np.array([0.0, 0.0, b * scale, 0.0, 0.0, 0.0])
-        left = rise - a * scale * rows[0]
-        right = -rise + a * scale * rows[1]
-        return r, (left @ J[0] + right @ J[1])[None]
+        # d atan2(a, b) = (b·da − a·db)/(a² + b²): one row of weights per wheel centre
+        scale = 1.0 / (a * a + b * b)
+        rise, k = b * scale, a * scale
+        (lx, ly, lz), (rx, ry, rz) = c
+        w = np.array(
+            [[0.0, -k, rise, -k * lx, -k * ly, -k * lz], [0.0, k, -rise, k * rx, k * ry, k * rz]]
+        )
+        return r, (w[0] @ J[0] + w[1] @ J[1])[None]
 
 
 def axle_rows(model: AxleModel, targets, source: str = "<targets>") -> list:
@@ -815,17 +816,34 @@ def solve_axle_sweep(model: AxleModel, sweep, source: str | None = None, progres
     drive = _drive_rows(model)
     found = []
 
-    def per_driver(tangent: np.ndarray) -> np.ndarray | None:
-        """dq per driver from dq per target, T·(J_drive·T)⁻¹, at the solution (a rigid
-        bar has fewer freedoms than drivers: its per-side rates stay blank)."""
+    data, frames = model.kin.data, [model.points[f"{s}_wheel_center"].frame_id for s in SIDES]
+    rack = (
+        model.model.joints[model.model.getJointId("rack_slide")].idx_v if len(drive) > 2 else None
+    )
+
+    def per_driver(tangent: np.ndarray) -> tuple | None:
+        """The drivers' rows times the tangent at the solution, J_drive·T (each wheel
+        centre's z and the rack; the inverse is taken for all steps at once below). A
+        rigid bar has fewer freedoms than drivers: its per-side rates stay blank."""
         if tangent.shape[1] != len(drive):
             return None
-        across = np.vstack([row.jacobian(model.kin) for row in drive]) @ tangent
-        return tangent @ np.linalg.inv(across)
+        rows = [pin.getFrameJacobian(model.model, data, f, WORLD)[2] @ tangent for f in frames]
+        if rack is not None:
+            rows.append(tangent[rack])
+        return tangent, np.array(rows)
 
     solutions = march(
         solver, values, model.q_design, previous, progress, tangents=found, keep=per_driver
     )
+    # dq per driver from dq per target, T·(J_drive·T)⁻¹, every step's in one call
+    kept = [i for i, f in enumerate(found) if f is not None]
+    if kept:
+        across = np.array([found[i][1] for i in kept])
+        ok = np.abs(np.linalg.det(across)) > 0.0
+        inverse = np.full_like(across, np.nan)
+        inverse[ok] = np.linalg.inv(across[ok])
+        for i, inv in zip(kept, inverse, strict=True):
+            found[i] = found[i][0] @ inv
     for solution, tangent in zip(solutions, found, strict=True):
         solution.drive_tangent = tangent
     return solutions
