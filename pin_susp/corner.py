@@ -29,13 +29,22 @@ class Corner(Linkage):
     >>> pose.metrics["camber"]  # deg
     """
 
-    def __init__(self, geometry: Geometry | str | dict, apply_setup: bool = True):
+    def __init__(
+        self,
+        geometry: Geometry | str | dict,
+        apply_setup: bool = True,
+        warn: bool = True,
+        visuals: bool = True,
+    ):
+        """``warn``: a PlausibilityWarning for each implausible design metric (a study's
+        variants skip it: their design's was shown); ``visuals``: the URDF's shapes."""
         if not isinstance(geometry, Geometry):
             geometry = load_geometry(geometry)
         if apply_setup:  # shims and adjusters: the as-set state is the design state
             geometry = setup.apply_setup(geometry)
-        super().__init__(geometry)
-        self._warn_implausible()
+        super().__init__(geometry, visuals)
+        if warn:
+            self._warn_implausible()
 
     def _warn_implausible(self) -> None:
         """A PlausibilityWarning for each design metric outside its plausible range."""
@@ -216,23 +225,26 @@ class Results:
 
     @classmethod
     def from_solutions(
-        cls, corner: Corner, solutions: list[Solution], sweep: Sweep, tangents=None
+        cls, corner: Corner, solutions: list[Solution], sweep: Sweep, tangents=None, only=None
     ) -> Results:
+        """``only``: the set of columns wanted (a study's summary), else every column."""
         columns, units = cls.solver_columns(solutions)
         # A step that did not converge has no trustworthy pose: its cells stay empty.
         points = corner.motion([s.q if s.converged else None for s in solutions], tangents)
         design = {k: v[None] for k, v in corner.design_positions.items()}
-        metrics = metric_columns(corner.geometry, points, design, corner.spring_sense)
+        metrics = metric_columns(corner.geometry, points, design, corner.spring_sense, only)
         for name, (values, column_unit) in metrics.items():
             columns[name], units[name] = values, column_unit
-        from .loads import rate_columns
+        from .loads import RATE_COLUMNS, rate_columns
 
         qs = [s.q if s.converged else None for s in solutions]
-        for name, (values, column_unit) in rate_columns(corner, qs).items():
-            columns[name], units[name] = values, column_unit
+        if only is None or RATE_COLUMNS & set(only):
+            for name, (values, column_unit) in rate_columns(corner, qs).items():
+                columns[name], units[name] = values, column_unit
         positions = {name: p.val for name, p in points.items()}
         for name, (values, column_unit) in point_columns(corner.point_names, positions).items():
-            columns[name], units[name] = values, column_unit
+            if only is None or name in only:
+                columns[name], units[name] = values, column_unit
         geometry = (corner.geometry.source, corner.geometry.sha256)
         return cls(columns, units, cls.solver_meta(solutions, geometry, sweep))
 
@@ -266,6 +278,13 @@ class Results:
     @property
     def failed_steps(self) -> np.ndarray:
         return np.flatnonzero(~self.columns["solver_converged"])
+
+    def to_pandas(self):
+        """The columns as a pandas DataFrame, one row per step; the units (mm, deg, ...)
+        in ``.attrs["units"]``; an undefined value (a blank CSV cell) is NaN."""
+        from .study import results_frame
+
+        return results_frame(self)
 
     def to_csv(self, path) -> None:
         from .export import write_csv

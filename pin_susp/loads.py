@@ -804,6 +804,9 @@ def _turned(corner, q: np.ndarray) -> float:
     return float(np.arctan2(u @ np.cross(arm0, arm), arm0 @ arm))
 
 
+RATE_COLUMNS = {"spring_force", "spring_torque", "wheel_rate", "ride_rate"}
+
+
 def rate_columns(corner, qs: list) -> dict:
     """The spring's force and the wheel and ride rates, where the geometry gives the
     spring's rate (else nothing)."""

@@ -571,7 +571,7 @@ def derivative_columns(g: Geometry) -> list[Derivative]:
 
 
 def metric_columns(
-    geometry: Geometry, points: dict, design: dict, spring_sense: float = 1.0
+    geometry: Geometry, points: dict, design: dict, spring_sense: float = 1.0, only=None
 ) -> dict:
     """Metric, derivative and motion-ratio columns in output units: name → (values, unit).
 
@@ -585,28 +585,44 @@ def metric_columns(
     (``spring_sense``·d twist/d hub z, deg/mm, where ``spring_sense`` = ±1 is the
     sign of d twist/d hub z at design, so the rocker axis's a→b order does not
     matter). A sign change through a sweep means the rocker went over centre.
+
+    ``only``: a set of column names to compute (and what they need), the rest left
+    out; None for every column.
     """
     ps = PointSet(points, design, geometry)
     n = np.shape(value(points["wheel_center"]))[:-1]
+    derivatives = derivative_columns(geometry)
+    if only is not None:  # what the wanted columns need: their metrics, the spring's rate
+        only = set(only)
+        if "motion_ratio" in only:
+            only |= {"deriv_damper_length_wrt_hub_z", "deriv_torsion_bar_twist_wrt_hub_z"}
+        derivatives = [d for d in derivatives if d.name in only]
+        needed = only | {d.metric.name for d in derivatives}
     with np.errstate(invalid="ignore", divide="ignore"):  # undefined → NaN → empty cell
-        values = {m.name: m.function(ps) * m.scale for m in METRICS if m.applies(geometry)}
+        values = {
+            m.name: m.function(ps) * m.scale
+            for m in METRICS
+            if m.applies(geometry) and (only is None or m.name in needed)
+        }
     out = {}
     for m in METRICS:
         if m.name in values and m.written:
             out[m.name] = (value(values[m.name]), m.unit)
-        elif m.always_written:
+        elif m.always_written and (only is None or m.name in only):
             out[m.name] = (np.full(n, np.nan), m.unit)
     if not isinstance(points["wheel_center"], Dual):
         return out
     drivers = (HUB_Z, RACK) if geometry.steering == "rack" else (HUB_Z,)
-    for d in derivative_columns(geometry):
+    for d in derivatives:
         rates = values[d.metric.name].der[drivers.index(d.driver)]
         out[d.name] = (rates * 1e-3, d.unit)
-    if geometry.spring == "coilover":
-        out["motion_ratio"] = (-out["deriv_damper_length_wrt_hub_z"][0], "mm/mm")
-    elif geometry.spring == "torsion_bar":
-        twist_rate = out["deriv_torsion_bar_twist_wrt_hub_z"][0]
-        out["motion_ratio"] = (spring_sense * twist_rate, "deg/mm")
+    spring = {"coilover": "deriv_damper_length_wrt_hub_z"}.get(geometry.spring)
+    if geometry.spring == "torsion_bar":
+        spring = "deriv_torsion_bar_twist_wrt_hub_z"
+    if spring in out:
+        coilover = geometry.spring == "coilover"  # its compression; a bar's wind-up
+        sense = -1.0 if coilover else spring_sense
+        out["motion_ratio"] = (sense * out[spring][0], "mm/mm" if coilover else "deg/mm")
     return out
 
 

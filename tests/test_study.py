@@ -1,0 +1,460 @@
+"""Studies (spec/studies.md): variants, their rows against direct sweeps, Monte Carlo
+against the first-order prediction, the bump-steer optimisation, bad input."""
+
+from __future__ import annotations
+
+import io
+import math
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pyarrow.parquet as pq
+import pytest
+import yaml
+
+from pin_susp import Corner, Target, load_sweep
+from pin_susp.cli import main
+from pin_susp.study import Variable, load_study, run_study, variant_data, variant_table
+
+EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+BUMP = EXAMPLES / "bump_rack_held.yaml"
+
+
+def write_study(folder: Path, body: dict, name: str = "study.yaml") -> Path:
+    """A study file in ``folder`` whose geometry and sweep are the examples (absolute)."""
+    data = {"version": 1, "geometry": str(EXAMPLES / "double_wishbone.yaml"), "sweep": str(BUMP)}
+    data.update(body)
+    path = folder / name
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return path
+
+
+def run_cli(args: list[str], capsys) -> tuple[int, str, str]:
+    code = main([str(a) for a in args])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def read_csv(path: Path) -> pd.DataFrame:
+    return pd.read_csv(path, comment="#")
+
+
+LHS = {
+    "variables": [
+        {"point": "trackrod_inboard", "axis": "z", "range": [-15, 15]},
+        {"point": "upper_wishbone_outboard", "axis": "z", "range": [-10, 10]},
+        {"point": "lower_wishbone_inboard_front", "axis": "y", "range": [-5, 5]},
+    ],
+    "kind": "doe",
+    "doe": {"method": "latin_hypercube", "samples": 6, "seed": 3},
+    "summary": ["camber", "roadwheel_angle", "deriv_roadwheel_angle_wrt_hub_z", "anti_dive"],
+    "batch_size": 4,
+}
+
+
+# ---------------------------------------------------------------- the variants
+
+
+def test_variants_of_each_method_fill_their_boxes(tmp_path):
+    three = LHS["variables"]
+    ff = load_study(
+        write_study(
+            tmp_path,
+            {"variables": three, "kind": "doe", "doe": {"method": "full_factorial", "levels": 3}},
+        )
+    )
+    table = variant_table(ff)
+    assert table.shape == (27, 3)
+    for j, v in enumerate(three):
+        assert sorted(set(table[:, j])) == pytest.approx(list(np.linspace(*v["range"], 3)))
+    assert len({tuple(r) for r in table}) == 27  # every combination once
+
+    lhs = load_study(
+        write_study(tmp_path, LHS | {"doe": {"method": "latin_hypercube", "samples": 50}})
+    )
+    table = variant_table(lhs)
+    for j, v in enumerate(three):  # one sample in each of the 50 strata of every variable
+        low, high = v["range"]
+        strata = np.floor((table[:, j] - low) / (high - low) * 50).astype(int)
+        assert sorted(strata) == list(range(50))
+    assert np.array_equal(table, variant_table(lhs))  # the seed fixes them
+
+    sobol = load_study(write_study(tmp_path, LHS | {"doe": {"method": "sobol", "samples": 64}}))
+    table = variant_table(sobol)
+    assert table.shape == (64, 3)
+    assert (table >= [-15, -10, -5]).all() and (table <= [15, 10, 5]).all()
+
+    mc = load_study(
+        write_study(
+            tmp_path,
+            {
+                "variables": three,
+                "kind": "monte_carlo",
+                "monte_carlo": {"samples": 20000, "seed": 7},
+            },
+        )
+    )
+    table = variant_table(mc)  # normal, range = ±3σ about its middle
+    assert table.mean(axis=0) == pytest.approx([0, 0, 0], abs=0.05)
+    assert table.std(axis=0) == pytest.approx([5, 10 / 3, 5 / 3], rel=0.02)
+
+
+def test_all_hardpoints_varies_every_coordinate(tmp_path):
+    study = load_study(
+        write_study(
+            tmp_path,
+            {
+                "variables": {"all_hardpoints": {"tolerance": 0.5}},
+                "kind": "monte_carlo",
+                "monte_carlo": {"samples": 10},
+            },
+        )
+    )
+    corner = Corner(EXAMPLES / "double_wishbone.yaml")
+    assert len(study.variables) == 3 * len(corner.geometry.hardpoints)
+    assert {(v.low, v.high) for v in study.variables} == {(-0.5, 0.5)}
+
+
+def test_variant_data_moves_only_its_coordinates():
+    base = yaml.safe_load((EXAMPLES / "double_wishbone.yaml").read_text())
+    moved = variant_data(
+        base, [Variable("trackrod_inboard", "z", -1, 1), Variable("axle_outboard", "x", -1, 1)],
+        [2.5, -1.25], axle=False,
+    )  # fmt: skip
+    assert moved["hardpoints"]["trackrod_inboard"] == {"x": 50, "y": 200, "z": 252.5}
+    assert moved["hardpoints"]["axle_outboard"]["x"] == -21.25
+    assert base["hardpoints"]["trackrod_inboard"]["z"] == 250  # the design is untouched
+    rest = {
+        k: v
+        for k, v in moved["hardpoints"].items()
+        if k not in ("trackrod_inboard", "axle_outboard")
+    }
+    assert all(rest[k] == base["hardpoints"][k] for k in rest)
+
+
+# ------------------------------------------------ rows against direct sweeps
+
+
+def test_each_variant_equals_a_direct_sweep_of_its_geometry(tmp_path, capsys):
+    """variants.parquet and steps.parquet against `pin-susp sweep` on each variant's
+    geometry file, written out here; the static column against a one-step sweep at design."""
+    study_path = write_study(tmp_path, LHS)
+    out = tmp_path / "out"
+    code, text, err = run_cli(
+        ["study", study_path, "-o", out, "--scheduler", "none", "--steps"], capsys
+    )
+    assert code == 0, err
+    variants = pd.read_parquet(out / "variants.parquet")
+    steps = pd.read_parquet(out / "steps.parquet")
+    assert list(variants["variant_id"]) == list(range(6))
+    assert len(steps) == 6 * 21
+    study = load_study(study_path)
+    design_sweep = tmp_path / "design.yaml"
+    sweep = yaml.safe_load(BUMP.read_text())
+    sweep["steps"] = 1
+    for t in sweep["targets"]:
+        t["start"] = t["stop"] = 0
+    design_sweep.write_text(yaml.safe_dump(sweep))
+    for vid in (0, 5):
+        row = variants.iloc[vid]
+        deltas = [row[v.name] for v in study.variables]
+        geometry = tmp_path / f"variant{vid}.yaml"
+        geometry.write_text(
+            yaml.safe_dump(variant_data(study.geometry_data, study.variables, deltas, False))
+        )
+        csv = tmp_path / f"variant{vid}.csv"
+        assert run_cli(["sweep", geometry, BUMP, "-o", csv, "-q"], capsys)[0] == 0
+        direct = read_csv(csv)
+        mine = steps[steps["variant_id"] == vid].reset_index(drop=True)
+        assert list(mine.columns) == ["variant_id", *direct.columns]
+        for c in direct.columns:
+            a, b = direct[c].to_numpy(), mine[c].to_numpy()
+            if a.dtype.kind == "f" or b.dtype.kind == "f":
+                a, b = a.astype(float), b.astype(float)
+                assert np.array_equal(np.isnan(a), np.isnan(b)), c
+                assert np.allclose(a, b, rtol=0, atol=1e-9, equal_nan=True), c
+            else:
+                assert (a == b).all(), c
+        static_csv = tmp_path / f"static{vid}.csv"
+        assert run_cli(["sweep", geometry, design_sweep, "-o", static_csv, "-q"], capsys)[0] == 0
+        static = read_csv(static_csv)
+        for m in ("camber", "roadwheel_angle", "deriv_roadwheel_angle_wrt_hub_z"):
+            assert row[f"{m}_static"] == pytest.approx(static[m][0], abs=1e-9)
+            assert row[f"{m}_min"] == pytest.approx(direct[m].min(), abs=1e-9)
+            assert row[f"{m}_max"] == pytest.approx(direct[m].max(), abs=1e-9)
+        assert row["converged"] and row["steps_failed"] == 0 and row["error"] == ""
+
+
+def test_parquet_outputs_read_everywhere_with_nulls_and_units(tmp_path):
+    import dask.dataframe as dd
+    import pyarrow.dataset as ds
+
+    out = tmp_path / "out"
+    outcome = run_study(load_study(write_study(tmp_path, LHS)), out, scheduler=None, steps=True)
+    assert outcome.computed == outcome.batches == 2
+    steps_pandas = pd.read_parquet(out / "steps.parquet")
+    steps_arrow = ds.dataset(out / "steps.parquet", format="parquet").to_table()
+    steps_dask = dd.read_parquet(out / "steps.parquet").compute()
+    assert len(steps_pandas) == steps_arrow.num_rows == len(steps_dask) == 6 * 21
+    # anti_dive is blank in this corner's CSV (no brake bias): a null in Parquet, not NaN
+    column = steps_arrow.column("anti_dive")
+    assert column.null_count == len(column)
+    assert pq.read_table(out / "variants.parquet").column("anti_dive_static").null_count == 6
+    units = pq.read_schema(next((out / "steps.parquet").iterdir())).metadata[b"units"]
+    assert b'"camber": "deg"' in units
+    assert not (out / ".parts").exists()
+
+
+def test_results_convert_to_pandas():
+    corner = Corner(EXAMPLES / "double_wishbone.yaml")
+    results = corner.run_sweep(BUMP)
+    frame = results.to_pandas()
+    assert list(frame.columns) == list(results.columns)
+    assert np.array_equal(frame["camber"].to_numpy(), results["camber"])
+    assert frame.attrs["units"]["camber"] == "deg"
+    assert frame["solver_converged"].dtype == bool
+
+
+def test_a_local_cluster_gives_the_serial_numbers(tmp_path):
+    study = load_study(write_study(tmp_path, LHS))
+    serial = run_study(study, tmp_path / "serial", scheduler=None).variants
+    local = run_study(study, tmp_path / "local", scheduler="local", workers=2).variants
+    pd.testing.assert_frame_equal(serial, local, check_exact=True)
+
+
+def test_an_axle_study_moves_one_side_and_equals_its_direct_sweep(tmp_path, capsys):
+    body = {
+        "geometry": str(EXAMPLES / "axle_front.yaml"),
+        "sweep": str(EXAMPLES / "roll.yaml"),
+        "variables": [
+            {"point": "trackrod_outboard", "axis": "z", "side": "left", "range": [-5, 5]},
+        ],
+        "kind": "doe",
+        "doe": {"method": "full_factorial", "levels": 2},
+        "summary": ["roadwheel_angle_left", "roadwheel_angle_right", "roll_center_z"],
+    }
+    study_path = write_study(tmp_path, body)
+    out = tmp_path / "out"
+    code, _, err = run_cli(["study", study_path, "-o", out, "--scheduler", "none"], capsys)
+    assert code == 0, err
+    variants = pd.read_parquet(out / "variants.parquet")
+    assert list(variants["d_left_trackrod_outboard_z"]) == [-5.0, 5.0]
+    study = load_study(study_path)
+    for vid in (0, 1):
+        data = variant_data(study.geometry_data, study.variables, [variants.iloc[vid, 1]], True)
+        assert (
+            data["hardpoints"]["right"]["trackrod_outboard"]["z"]
+            != (data["hardpoints"]["left"]["trackrod_outboard"]["z"])
+        )
+        geometry = tmp_path / f"axle{vid}.yaml"
+        geometry.write_text(yaml.safe_dump(data))
+        csv = tmp_path / f"axle{vid}.csv"
+        assert run_cli(["sweep", geometry, EXAMPLES / "roll.yaml", "-o", csv, "-q"], capsys)[0] == 0
+        direct = read_csv(csv)
+        for m in body["summary"]:
+            assert variants.iloc[vid][f"{m}_min"] == pytest.approx(direct[m].min(), abs=1e-9)
+            assert variants.iloc[vid][f"{m}_max"] == pytest.approx(direct[m].max(), abs=1e-9)
+    # the design pose is as drawn (a moved trackrod end changes the rod's length, not the
+    # static toe); in roll the left side's toe moves with it, the right one's does not
+    left = variants["roadwheel_angle_left_min"]
+    right = variants["roadwheel_angle_right_min"]
+    assert abs(left[0] - left[1]) > 0.05
+    # the right side moves only through the roll target's contact patches (the left
+    # wheel's camber moves its patch): a hundredth of the left's change at most
+    assert abs(right[0] - right[1]) < 0.01 * abs(left[0] - left[1])
+    assert variants["roadwheel_angle_left_static"][0] == variants["roadwheel_angle_left_static"][1]
+
+
+# ------------------------------------------------ Monte Carlo and its prediction
+
+
+def _monte_carlo(tmp_path, tolerance: float, samples: int = 24) -> tuple:
+    body = {
+        "variables": {"all_hardpoints": {"tolerance": tolerance}},
+        "kind": "monte_carlo",
+        "monte_carlo": {"samples": samples, "seed": 2},
+        "summary": ["camber", "roadwheel_angle", "deriv_roadwheel_angle_wrt_hub_z"],
+    }
+    folder = tmp_path / f"mc{tolerance}"
+    folder.mkdir()
+    outcome = run_study(load_study(write_study(folder, body)), folder / "out", scheduler=None)
+    return outcome, pq.read_table(folder / "out" / "variants.parquet").to_pandas()
+
+
+def test_tiny_tolerances_match_the_linear_prediction(tmp_path):
+    outcome, variants = _monte_carlo(tmp_path, 1e-3)
+    for name in ("camber_static", "roadwheel_angle_max", "deriv_roadwheel_angle_wrt_hub_z_min"):
+        sampled = variants[name].to_numpy()
+        linear = variants[f"{name}_linear"].to_numpy()
+        change = np.abs(sampled - sampled.mean()).max()
+        assert change > 1e-7  # the tolerances move it
+        # second order in 1e-3 mm: the prediction agrees to far below the change
+        assert np.abs(sampled - linear).max() < 1e-3 * change
+
+
+def test_large_tolerances_report_the_difference(tmp_path):
+    from pin_susp.study import summary_lines
+
+    outcome, variants = _monte_carlo(tmp_path, 5.0, samples=16)
+    diff = np.abs(variants["roadwheel_angle_max"] - variants["roadwheel_angle_max_linear"]).max()
+    assert diff > 1e-3  # nonlinear at ±5 mm
+    lines = summary_lines(outcome.study, variants, outcome.linear)
+    assert "max |diff|" in lines[1]
+    row = next(line for line in lines if line.strip().startswith("roadwheel_angle_max"))
+    assert float(row.split()[-1]) == pytest.approx(diff, rel=1e-2)
+
+
+# ------------------------------------------------ the optimisation
+
+
+def test_bump_steer_optimisation_flattens_toe_and_best_yaml_reproduces_it(tmp_path, capsys):
+    """examples/study_bump_steer.yaml: ≤ 0.01° of toe change over ±30 mm, checked by a
+    direct sweep of best.yaml; the objective re-computed from that sweep."""
+    folder = tmp_path / "ex"
+    folder.mkdir()
+    for name in ("study_bump_steer.yaml", "macpherson.yaml", "bump_rack_held.yaml"):
+        shutil.copy(EXAMPLES / name, folder / name)
+    data = yaml.safe_load((folder / "study_bump_steer.yaml").read_text())
+    data["optimise"]["starts"] = 2  # the example's 4, halved for the suite's time
+    (folder / "study_bump_steer.yaml").write_text(yaml.safe_dump(data))
+    out = tmp_path / "out"
+    code, text, err = run_cli(
+        ["study", folder / "study_bump_steer.yaml", "-o", out, "--scheduler", "none"], capsys
+    )
+    assert code == 0, err
+    variants = pd.read_parquet(out / "variants.parquet")
+    best = variants.sort_values("objective").iloc[0]
+    assert (variants["objective"] <= variants["start_objective"]).all()
+    csv = tmp_path / "best.csv"
+    assert run_cli(["sweep", out / "best.yaml", BUMP, "-o", csv, "-q"], capsys)[0] == 0
+    direct = read_csv(csv)
+    design = Corner(out / "best.yaml").solve_pose(
+        [Target("wheel_center", "z", 0.0), Target("trackrod_inboard", "y", 0.0)]
+    )
+    toe_change = direct["roadwheel_angle"] - design.metrics["roadwheel_angle"]
+    assert np.abs(toe_change).max() <= 0.01
+    rms = math.sqrt(np.mean(toe_change**2))
+    assert best["objective"] == pytest.approx(rms, rel=1e-9, abs=1e-12)
+    assert f"{best['objective']:.4g}" in text
+    # the design's bump steer was far from flat: the optimiser did the work
+    assert best["start_objective"] > 20 * best["objective"]
+
+
+def test_objective_jacobian_is_the_derivative_of_the_residuals(tmp_path):
+    from pin_susp.study import Variant, objective_jacobian
+
+    body = {
+        "variables": [
+            {"point": "trackrod_inboard", "axis": "z", "range": [-20, 20]},
+            {"point": "trackrod_outboard", "axis": "x", "range": [-20, 20]},
+        ],
+        "kind": "optimise",
+        "optimise": {
+            "objective": [
+                {"metric": "roadwheel_angle", "relative": True, "target": 0.0},
+                {"metric": "camber", "curve": {"x": "wheel_travel", "points": [[-30, -1.5], [30, -2.5]]}, "weight": 2},
+            ]
+        },
+    }  # fmt: skip
+    study = load_study(write_study(tmp_path, body))
+    job = study.job()
+    sweep = load_sweep(BUMP)
+    x = np.array([3.0, -2.0])
+    exact = objective_jacobian(Variant(job, x, sweep), sweep)
+    h = 1e-4
+    central = np.stack(
+        [
+            (
+                Variant(job, x + h * e, sweep).residuals()
+                - Variant(job, x - h * e, sweep).residuals()
+            )
+            / (2 * h)
+            for e in np.eye(2)
+        ],
+        axis=1,
+    )
+    assert np.abs(exact - central).max() < 1e-7 * np.abs(central).max() + 1e-12
+
+
+# ---------------------------------------------------------------- bad input
+
+
+BAD = [
+    ({"variables": [{"point": "nowhere", "axis": "z", "range": [-1, 1]}]}, "variables[0].point: unknown hardpoint 'nowhere'"),
+    ({"variables": [{"point": "trackrod_inboard", "axis": "w", "range": [-1, 1]}]}, "variables[0].axis: expected one of x, y, z"),
+    ({"variables": [{"point": "trackrod_inboard", "axis": "z", "range": [1, 1]}]}, "variables[0].range: empty range [1, 1]"),
+    ({"variables": [{"point": "trackrod_inboard", "axis": "z", "range": [-1, 1], "side": "left"}]}, "variables[0].side: a corner has one side"),
+    ({"doe": {"method": "latin_hypercube", "samples": 0}}, "doe.samples: must be >= 1, got 0"),
+    ({"doe": {"method": "latin_hypercube", "samples": -3}}, "doe.samples: must be >= 1, got -3"),
+    ({"doe": {"method": "grid", "samples": 3}}, "doe.method: expected one of full_factorial"),
+    ({"summary": ["camberr"]}, "summary[0]: unknown column 'camberr'"),
+    ({"kind": "monte_carlo"}, "monte_carlo: missing key"),
+    ({"sweep": "/nonexistent/sweep.yaml"}, "/nonexistent/sweep.yaml: file not found"),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize(("change", "message"), BAD)
+def test_bad_study_files_get_one_line_and_nothing_written(tmp_path, capsys, change, message):
+    body = dict(LHS) | change
+    path = write_study(tmp_path, body)
+    out = tmp_path / "out"
+    code, text, err = run_cli(["study", path, "-o", out, "--scheduler", "none"], capsys)
+    assert code == 2
+    assert err.count("\n") == 1 and err.startswith("pin-susp: error: ")
+    assert message in err, err
+    assert "Traceback" not in err
+    assert not out.exists()
+
+
+def test_an_axle_variable_needs_its_side(tmp_path, capsys):
+    body = dict(LHS) | {
+        "geometry": str(EXAMPLES / "axle_front.yaml"),
+        "sweep": str(EXAMPLES / "roll.yaml"),
+        "summary": ["roll_center_z"],
+    }
+    code, _, err = run_cli(["study", write_study(tmp_path, body), "-o", tmp_path / "o"], capsys)
+    assert code == 2 and "variables[0].side: missing key" in err
+
+
+def test_an_output_directory_with_other_data_is_refused(tmp_path, capsys):
+    first = write_study(tmp_path, LHS, "first.yaml")
+    other = write_study(tmp_path, LHS | {"doe": {"method": "sobol", "samples": 4}}, "other.yaml")
+    out = tmp_path / "out"
+    assert run_cli(["study", first, "-o", out, "--scheduler", "none", "-q"], capsys)[0] == 0
+    before = {p: p.stat().st_mtime_ns for p in out.rglob("*")}
+    code, _, err = run_cli(["study", other, "-o", out, "--scheduler", "none"], capsys)
+    assert code == 2 and "holds the data of another study" in err
+    code, _, err = run_cli(["study", first, "-o", out, "--scheduler", "none"], capsys)
+    assert code == 2 and "already finished here" in err
+    assert {p: p.stat().st_mtime_ns for p in out.rglob("*")} == before
+    stranger = tmp_path / "stranger"
+    stranger.mkdir()
+    (stranger / "notes.txt").write_text("mine")
+    code, _, err = run_cli(["study", first, "-o", stranger, "--scheduler", "none"], capsys)
+    assert code == 2 and "holds no study" in err
+    assert [p.name for p in stranger.iterdir()] == ["notes.txt"]
+
+
+def test_workers_and_scheduler_flags_are_checked(tmp_path, capsys):
+    path = write_study(tmp_path, LHS)
+    code, _, err = run_cli(["study", path, "-o", tmp_path / "a", "--workers", "0"], capsys)
+    assert code == 2 and "--workers must be 1 or more" in err
+    code, _, err = run_cli(["study", path, "-o", tmp_path / "b", "--scheduler", "bogus"], capsys)
+    assert code == 2 and "expected an address like tcp://HOST:PORT" in err
+    assert not (tmp_path / "a").exists() and not (tmp_path / "b").exists()
+
+
+def test_summary_prints_spread_and_files(tmp_path, capsys):
+    code, text, _ = run_cli(
+        ["study", write_study(tmp_path, LHS), "-o", tmp_path / "o", "--scheduler", "none"], capsys
+    )
+    assert code == 0
+    assert "6 variants of double_wishbone.yaml through bump_rack_held.yaml: 6 converged" in text
+    variants = pd.read_parquet(tmp_path / "o" / "variants.parquet")
+    line = next(x for x in io.StringIO(text) if x.strip().startswith("camber_static"))
+    mean, std = map(float, line.split()[1:3])
+    assert mean == pytest.approx(variants["camber_static"].mean(), rel=1e-3)
+    assert std == pytest.approx(variants["camber_static"].std(), rel=1e-2)
+    assert f"wrote {tmp_path / 'o' / 'study.png'}" in text
