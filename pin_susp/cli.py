@@ -1637,16 +1637,29 @@ def _study(args) -> int:
     started = time.perf_counter()
     total = len(studies.batches(study))
     label = "starts" if study.kind == "optimise" else "batches"
-    outcome = studies.run_study(
-        study,
-        out,
-        scheduler=scheduler,
-        workers=args.workers,
-        steps=args.steps,
-        resume=args.resume,
-        progress=_progress_bar(total, args.quiet, minimum=1, label=label),
-        announce=None if args.quiet else print,
-    )
+    try:
+        outcome = studies.run_study(
+            study,
+            out,
+            scheduler=scheduler,
+            workers=args.workers,
+            steps=args.steps,
+            resume=args.resume,
+            progress=_progress_bar(total, args.quiet, minimum=1, label=label),
+            announce=None if args.quiet else print,
+        )
+    except (KeyboardInterrupt, _Terminated) as exc:
+        signal_number = exc.signal if isinstance(exc, _Terminated) else signal.SIGINT
+        kept = studies.finished_batches(out)
+        if kept is None:
+            print("pin-susp: interrupted, nothing written", file=sys.stderr)
+        else:
+            print(
+                f"\npin-susp: interrupted: {kept} of {total} batches are kept in {out}; "
+                "the same command with --resume solves the rest",
+                file=sys.stderr,
+            )
+        return 128 + signal_number
     seconds = time.perf_counter() - started
     variants = outcome.variants
     written = [out / "variants.parquet"] + ([out / "steps.parquet"] if args.steps else [])

@@ -221,6 +221,12 @@ def load_study(source: str | Path) -> Study:
         study.seed = _seed(b, "optimise", r)
         study.max_evaluations = _count(b.get("evaluations", 60), "optimise.evaluations", r)
         study.terms = _terms(b["objective"], design, r)
+        if axle and not holds_wheels(design.sweep):
+            r.fail(
+                "optimise",
+                "on an axle the optimiser's exact Jacobian holds each wheel centre's height "
+                "and the rack: give a sweep of those targets (roll and heave sweeps: kind doe)",
+            )
     summary = data.get("summary", ["camber", "roadwheel_angle"])
     if not isinstance(summary, list) or not summary:
         r.fail("summary", "expected a list of column names (e.g. [camber, roadwheel_angle])")
@@ -496,6 +502,11 @@ class Variant:
         except PinSuspError as exc:
             self.subject = None
             self.error = str(exc)
+        except (ArithmeticError, ValueError, np.linalg.LinAlgError) as exc:
+            # a degenerate variant (a link of zero length, a singular pose): reported in
+            # its row, not allowed to stop the thousands of others
+            self.subject = None
+            self.error = f"variant: cannot be solved ({type(exc).__name__}: {exc})"
 
     @property
     def converged(self) -> bool:
@@ -689,11 +700,13 @@ def sensitivities(subject, sweep, results, axle: bool) -> tuple:
 
         model = AxleSensitivity(subject, one_sided=True)
         at_design = model.at()
-        steps = {
-            i: model.at(results.meta["q"][i], step=i)
-            for i in range(len(results))
-            if results["solver_converged"][i]
-        }
+        steps = {}
+        if holds_wheels(sweep):  # else the steps' sensitivities hold other quantities
+            steps = {
+                i: model.at(results.meta["q"][i], step=i)
+                for i in range(len(results))
+                if results["solver_converged"][i]
+            }
         return at_design, steps
     from .sensitivity import HardpointSensitivity
 
@@ -705,6 +718,21 @@ def sensitivities(subject, sweep, results, axle: bool) -> tuple:
             targets = [replace(t, values=t.values[i]) for t in sweep.targets]
             steps[i] = model.at(results.meta["q"][i], targets, step=i)
     return at_design, steps
+
+
+def holds_wheels(sweep) -> bool:
+    """Whether an axle's sweep holds what its sensitivities hold: each wheel centre's
+    height and the rack (its roll and heave targets hold other quantities)."""
+    keys = set()
+    for t in sweep.targets:
+        if t.quantity is not None:
+            return False
+        d = tuple(t.unit_direction.tolist())
+        if (t.point, d) == ("wheel_center", (0.0, 0.0, 1.0)):
+            keys.add(t.side)
+        elif t.point != "trackrod_inboard":
+            return False
+    return keys == {"left", "right"}
 
 
 def _row(job: Job, vid: int, deltas, v: Variant) -> dict:
@@ -1027,6 +1055,8 @@ def _prepare(study: Study, outdir: Path, steps: bool, resume: bool) -> Path:
             )
     elif resume:
         raise PinSuspError(f"{outdir}: no unfinished run of this study to resume")
+    for stale in (outdir / PARTS).glob(".*.tmp"):  # a part cut short by an interruption
+        stale.unlink()
     try:
         (outdir / PARTS).mkdir(parents=True, exist_ok=True)
     except OSError as exc:
@@ -1035,12 +1065,21 @@ def _prepare(study: Study, outdir: Path, steps: bool, resume: bool) -> Path:
     return outdir / PARTS
 
 
+def finished_batches(outdir: str | Path) -> int | None:
+    """How many batches an unfinished run in ``outdir`` has written (None: no run there)."""
+    outdir = Path(outdir)
+    if not (outdir / MANIFEST).is_file() or (outdir / "variants.parquet").exists():
+        return None
+    return len(list((outdir / PARTS).glob("variants-*.parquet")))
+
+
 def _write_part(parts: Path, result: dict) -> None:
     """A batch's part files, each written whole (temporary name, then renamed); the
     variants' part last: its presence marks the batch done."""
     import pyarrow.parquet as pq
 
     i = result["index"]
+    parts.mkdir(exist_ok=True)
     order = [("steps", result["steps"]), ("variants", result["variants"])]
     for what, data in order:
         if data is None:
@@ -1057,6 +1096,12 @@ def _assemble(study: Study, outdir: Path, parts: Path, n: int, steps: bool):
     import pyarrow as pa
     import pyarrow.parquet as pq
 
+    missing = [i for i in range(n) if not (parts / f"variants-{i:06d}.parquet").is_file()]
+    if missing:  # removed under a running study: never a table with holes
+        raise PinSuspError(
+            f"{parts}: the part files of {len(missing)} batches went missing while the study "
+            "ran (removed by another program?): --resume solves them again"
+        )
     tables = [pq.read_table(parts / f"variants-{i:06d}.parquet") for i in range(n)]
     variants = pa.concat_tables(tables, promote_options="permissive").sort_by("variant_id")
     units = {v.name: "mm" for v in study.variables}
@@ -1119,10 +1164,8 @@ __all__ = [
 def linear_prediction(study: Study, variants) -> dict[str, np.ndarray] | None:
     """The first-order prediction of each summary column from the exact hardpoint
     sensitivities at design and at every step (no re-solve): name → values per
-    variant, for ``<metric>_static``, ``_min`` and ``_max``. None on an axle (its
-    sensitivities hold the wheel heights, not the sweep's targets)."""
-    if study.axle:
-        return None
+    variant, for ``<metric>_static``, ``_min`` and ``_max`` — on an axle the steps'
+    only where its sweep holds what the sensitivities hold (holds_wheels)."""
     from .sweep import load_sweep
 
     job = study.job()
@@ -1130,7 +1173,7 @@ def linear_prediction(study: Study, variants) -> dict[str, np.ndarray] | None:
     design = Variant(job, np.zeros(len(study.variables)), sweep, every_column=True)
     if design.results is None or not design.converged:
         return None
-    at_design, steps = sensitivities(design.subject, sweep, design.results, False)
+    at_design, steps = sensitivities(design.subject, sweep, design.results, study.axle)
     columns = _columns(at_design.hardpoints, study.variables)
     d = variants[study.names].to_numpy(dtype=float)
     out = {}
@@ -1138,6 +1181,8 @@ def linear_prediction(study: Study, variants) -> dict[str, np.ndarray] | None:
         if m not in at_design.values:
             continue
         out[f"{m}_static"] = float(design.static[m][0]) + d @ _pick(at_design, m, columns)
+        if not steps:  # an axle's roll or heave sweep: the static column alone
+            continue
         per_step = np.stack(
             [design.results[m][i] + d @ _pick(s, m, columns) for i, s in steps.items()], axis=1
         )

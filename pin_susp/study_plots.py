@@ -15,7 +15,8 @@
   spread of the means) and says so; the legend lists them largest first.
 - Optimise: a panel per objective term: the metric over the sweep for the
   design (before) and for the best start (after), and the target, against the
-  sweep's x column; a note gives each curve's RMS miss of the target.
+  sweep's x column; the legend gives each curve's RMS miss of the target, a
+  note under the panels the best start's objective and variables.
 
 Variants that did not converge may have NaN in their columns: NaN is skipped.
 The figure is a plain ``matplotlib.figure.Figure`` (no pyplot state); write it
@@ -29,7 +30,10 @@ from pathlib import Path
 
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+from matplotlib.patches import Patch
 
+from .errors import PinSuspError
 from .metrics import METRIC_BY_NAME, Derivative
 from .plots import _lone
 
@@ -61,14 +65,15 @@ def study_figure(study, variants, linear=None, curves=None) -> Figure:
 def _heading(study, variants) -> str:
     n = len(variants)
     bad = int((~variants["converged"].astype(bool)).sum())
+    what = "start" if study.kind == "optimise" else "variant"
     text = (
-        f"pin_susp study, {KIND[study.kind]}: {n} "
-        f"{'starts' if study.kind == 'optimise' else 'variants'} of "
+        f"pin_susp study, {KIND[study.kind]}: {n} {what}{'s' * (n != 1)} of "
         f"{Path(study.geometry_path).name} through {Path(study.sweep_path).name}, "
         f"{len(study.variables)} variable{'s' * (len(study.variables) != 1)}"
     )
     if study.kind == "monte_carlo":
-        text += f" ({study.distribution}: {'range = ±3σ' if study.distribution == 'normal' else 'uniform in range'})"
+        spread = "range = ±3σ" if study.distribution == "normal" else "uniform in range"
+        text += f" ({study.distribution}: {spread})"
     if bad:
         text += f"\n{bad} did not converge at every step: their missing values are left out"
     return text
@@ -130,6 +135,8 @@ def _summary_columns(study, variants) -> list[list[str]]:
         row = [f"{m}_{s}" for s, _ in STATS if f"{m}_{s}" in variants.columns]
         if row:
             rows.append(row)
+    if not rows:
+        raise PinSuspError("the variants' table has none of the study's summary columns")
     return rows
 
 
@@ -143,20 +150,17 @@ def _column_texts(column: str) -> tuple[str, str, str]:
 
 def _layout(fig: Figure, rows: list[list[str]]) -> tuple[list, list]:
     """The panels of a summary grid (a row per metric) and the columns they show;
-    unused panels hidden."""
+    unused panels removed."""
     cols = max(len(r) for r in rows)
     axes = _grid(fig, len(rows), cols)
-    shown, pairs = [], []
+    pairs = []
     for i, row in enumerate(rows):
         for j in range(cols):
             ax = axes[i * cols + j]
             if j < len(row):
                 pairs.append((ax, row[j]))
             else:
-                ax.set_visible(False)
-                shown.append(ax)
-    for ax in shown:
-        fig.delaxes(ax)
+                fig.delaxes(ax)
     return [a for a, _ in pairs], [c for _, c in pairs]
 
 
@@ -210,14 +214,16 @@ def _histograms(study, variants, linear, heading: str) -> Figure:
     for ax, column in zip(axes, columns, strict=True):
         predicted = None if linear is None else linear.get(column)
         _histogram(ax, column, variants[column], predicted, gaussian)
-    handles = {}
-    for ax in axes:
-        for h, name in zip(*ax.get_legend_handles_labels(), strict=True):
-            handles.setdefault(name, h)
-    if handles:
-        fig.legend(
-            handles.values(), handles.keys(), loc="outside lower center", ncol=3, fontsize=9
-        )
+    # the legend's keys as drawn in a histogram (a panel of one value draws lines)
+    drawn = {name for ax in axes for name in ax.get_legend_handles_labels()[1]}
+    keys = {
+        "sampled (solved)": Patch(color=SAMPLED, alpha=0.55),
+        "first-order prediction": Patch(fill=False, edgecolor=LINEAR, lw=1.3),
+        "normal (prediction's mean, σ)": Line2D([], [], color="k", lw=1.1),
+    }
+    keys = {name: h for name, h in keys.items() if name in drawn}
+    if keys:
+        fig.legend(keys.values(), keys.keys(), loc="outside lower center", ncol=3, fontsize=9)
     if linear is None:
         _footnote(fig, "no first-order prediction (an axle, or the design did not solve)")
     return fig
@@ -235,6 +241,11 @@ def bin_edges(sampled: np.ndarray, predicted: np.ndarray | None) -> np.ndarray:
     return np.linspace(lo, hi, int(np.clip(count, 10, 60)) + 1)
 
 
+def _flat(x: np.ndarray, scale: float) -> bool:
+    """Whether x is one value, to rounding (a column the variables do not move)."""
+    return not float(np.ptp(x)) > 1e-9 * max(1.0, scale)
+
+
 def _histogram(ax, column: str, values, predicted, gaussian: bool) -> None:
     title, xlabel, unit = _column_texts(column)
     ax.set_title(title, fontsize=10)
@@ -246,6 +257,10 @@ def _histogram(ax, column: str, values, predicted, gaussian: bool) -> None:
         line = None
     if not sampled.size:
         _note(ax, "no value: no variant converged here", "upper left")
+        return
+    scale = float(np.abs(sampled if line is None else np.r_[sampled, line]).max())
+    if _flat(sampled, scale) and (line is None or _flat(line, scale)):
+        _one_value(ax, sampled, line, unit)
         return
     edges = bin_edges(sampled, line)
     ax.hist(
@@ -271,9 +286,9 @@ def _histogram(ax, column: str, values, predicted, gaussian: bool) -> None:
         )
         mean, std = float(line.mean()), _std(line)
         notes.append(f"σ linear {std:.3g} {unit}".rstrip())
-        if _std(sampled) > 0.0:
+        if not _flat(sampled, scale):
             notes[-1] += f" ({std / _std(sampled) - 1.0:+.2%})"
-        if gaussian and std > 0.0:
+        if gaussian and not _flat(line, scale):
             lo, hi = edges[0], edges[-1]
             x = np.linspace(min(lo, mean - 4 * std), max(hi, mean + 4 * std), 241)
             y = np.exp(-0.5 * ((x - mean) / std) ** 2) / (std * np.sqrt(2.0 * np.pi))
@@ -281,11 +296,27 @@ def _histogram(ax, column: str, values, predicted, gaussian: bool) -> None:
                 x, y, "-", color="k", lw=1.1, label="normal (prediction's mean, σ)", gid="gaussian"
             )
             ax.set_xlim(lo - 0.05 * (hi - lo), hi + 0.05 * (hi - lo))
-    if not np.ptp(sampled) > 0.0:
-        notes.append(f"the same at every variant: {sampled[0]:.6g}")
     _note(ax, "\n".join(notes), "upper left" if _skew_right(sampled) else "upper right")
     ax.ticklabel_format(axis="x", useOffset=False)
     ax.set_ylim(0.0, ax.get_ylim()[1] * 1.25)  # room for the note
+
+
+def _one_value(ax, sampled: np.ndarray, line: np.ndarray | None, unit: str) -> None:
+    """A column with one value (and one predicted): no spread to draw, a line at each."""
+    value = float(np.mean(sampled))
+    ax.axvline(value, color=SAMPLED, lw=2.5, alpha=0.7, label="sampled (solved)", gid="sampled")
+    notes = [f"n = {sampled.size}", f"the same at every variant: {value:.6g} {unit}".rstrip()]
+    if line is not None:
+        predicted = float(np.mean(line))
+        ax.axvline(predicted, color=LINEAR, lw=1.3, ls="--", label="first-order prediction")
+        notes.append(f"first-order prediction: {predicted:.6g} {unit}".rstrip())
+    ends = [value] if line is None else [value, predicted]
+    middle, half = 0.5 * (min(ends) + max(ends)), 0.5 * (max(ends) - min(ends))
+    half = 1.5 * max(half, 0.01 * max(abs(middle), 1.0))
+    ax.set_xlim(middle - half, middle + half)
+    ax.set_yticks([])
+    ax.ticklabel_format(axis="x", useOffset=False)
+    _note(ax, "\n".join(notes), "upper left")
 
 
 def _skew_right(x: np.ndarray) -> bool:
@@ -361,8 +392,9 @@ def _effects_panel(ax, column: str, effects: dict, count: int, colours: dict | N
         _note(ax, "no value: no variant converged here", "upper left")
         return
     ax.ticklabel_format(axis="y", useOffset=False)
-    if all(sizes[name] == 0.0 for name in drawn):
-        level = _finite(effects[drawn[0]][1])[0]
+    levels = np.concatenate([_finite(effects[name][1]) for name in drawn])
+    if _flat(levels, float(np.abs(levels).max())):
+        level = levels[0]
         _note(ax, f"the same at every variant: {level:.6g} {unit}".rstrip())
     elif colours is None:
         ax.legend(
@@ -433,7 +465,11 @@ def _curve_panel(ax, entry: dict) -> None:
     ax.set_ylabel(_with_unit(("Δ " if relative else "") + metric, unit), fontsize=8)
     ax.set_xlabel(_with_unit(x_label, x_unit), fontsize=8)
     notes, targets = [], []
-    for which, name, colour in (("before", "design (before)", "C7"), ("after", "best (after)", "C0")):
+    # the design's line wider, under the best's: both show where they coincide
+    for which, name, colour, lw in (
+        ("before", "design (before)", "0.6", 3.0),
+        ("after", "best (after)", "C0", 1.5),
+    ):
         curve = entry.get(which)
         if curve is None:
             notes.append(f"{name}: did not solve")
@@ -443,7 +479,7 @@ def _curve_panel(ax, entry: dict) -> None:
         if target is not None:
             targets.append((x, np.asarray(target, dtype=float)))
             name += f", RMS miss {rms_miss(y, target):.3g} {unit}".rstrip()
-        ax.plot(x, y, "-", color=colour, lw=1.8, marker=_lone(y), label=name, gid=which)
+        ax.plot(x, y, "-", color=colour, lw=lw, marker=_lone(y), label=name, gid=which)
     if targets:
         x = np.concatenate([t[0] for t in targets])
         t = np.concatenate([t[1] for t in targets])

@@ -458,3 +458,62 @@ def test_summary_prints_spread_and_files(tmp_path, capsys):
     assert mean == pytest.approx(variants["camber_static"].mean(), rel=1e-3)
     assert std == pytest.approx(variants["camber_static"].std(), rel=1e-2)
     assert f"wrote {tmp_path / 'o' / 'study.png'}" in text
+
+
+def test_an_axle_objective_jacobian_is_exact_and_roll_sweeps_are_refused(tmp_path, capsys):
+    """On an axle's sweep of both wheel heights and the rack, the optimiser's Jacobian
+    (one-sided sensitivities) against central differences of full solves."""
+    from pin_susp.study import Variant, objective_jacobian
+
+    sweep = {
+        "version": 1,
+        "steps": 5,
+        "targets": [
+            {"point": "wheel_center", "side": "left", "direction": {"axis": "z"}, "start": -20, "stop": 20},
+            {"point": "wheel_center", "side": "right", "direction": {"axis": "z"}, "start": 20, "stop": -20},
+            {"point": "trackrod_inboard", "side": "left", "direction": {"axis": "y"}, "start": 0, "stop": 0},
+        ],
+    }  # fmt: skip
+    (tmp_path / "sweep.yaml").write_text(yaml.safe_dump(sweep))
+    body = {
+        "geometry": str(EXAMPLES / "axle_front.yaml"),
+        "sweep": str(tmp_path / "sweep.yaml"),
+        "variables": [
+            {"point": "trackrod_outboard", "axis": "z", "side": "left", "range": [-5, 5]},
+            {"point": "upper_wishbone_outboard", "axis": "y", "side": "right", "range": [-5, 5]},
+        ],
+        "kind": "optimise",
+        "optimise": {
+            "objective": [
+                {"metric": "roadwheel_angle_left", "relative": True, "target": 0},
+                {"metric": "track", "target": 1500},
+                {"metric": "camber_right", "curve": {"x": "wheel_travel_right", "points": [[-20, -1], [20, -2]]}},
+            ]
+        },
+        "summary": ["roadwheel_angle_left"],
+    }  # fmt: skip
+    study = load_study(write_study(tmp_path, body))
+    job, sweep = study.job(), load_sweep(tmp_path / "sweep.yaml")
+    x = np.array([1.0, -2.0])
+    exact = objective_jacobian(Variant(job, x, sweep), sweep)
+    h = 1e-4
+    central = np.stack(
+        [
+            (
+                Variant(job, x + h * e, sweep).residuals()
+                - Variant(job, x - h * e, sweep).residuals()
+            )
+            / (2 * h)
+            for e in np.eye(2)
+        ],
+        axis=1,
+    )
+    for k in range(3):  # each term's block against its own scale
+        rows = slice(5 * k, 5 * k + 5)
+        scale = np.abs(central[rows]).max()
+        assert scale > 0 and np.abs(exact[rows] - central[rows]).max() < 1e-6 * scale
+    roll = body | {"sweep": str(EXAMPLES / "roll.yaml")}
+    code, _, err = run_cli(
+        ["study", write_study(tmp_path, roll, "roll.yaml"), "-o", tmp_path / "o"], capsys
+    )
+    assert code == 2 and "optimise: on an axle" in err

@@ -12,11 +12,12 @@ from conftest import EXAMPLES, ROOT
 import pin_susp
 from pin_susp.urdf import read_closures
 
-# corner files (an axle file, scope: axle, has no corner URDF of its own yet)
+# corner files: a top-level hardpoints block (an axle file, scope: axle, has no corner
+# URDF of its own yet; a study file's all_hardpoints is no geometry)
 GEOMETRIES = sorted(
     p
     for p in EXAMPLES.glob("*.yaml")
-    if "hardpoints" in p.read_text() and "scope: axle" not in p.read_text()
+    if re.search(r"^hardpoints:", p.read_text(), re.M) and "scope: axle" not in p.read_text()
 )
 
 
