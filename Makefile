@@ -36,6 +36,7 @@ fuzz: $(STAMP)
 # Speed figures against baselines run in the same process (see README, Performance).
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_sweep.py --json benchmarks/last_run.json
+	$(BIN)/python benchmarks/bench_study.py --full --json benchmarks/last_study_run.json
 
 # Regenerate urdf/ from examples/ (a test fails when they differ).
 urdf: $(STAMP)

@@ -1,6 +1,7 @@
 """The benchmark runs, and the solver's effort stays within bounds (no timing asserted)."""
 
 import json
+import os
 import subprocess
 import sys
 
@@ -50,3 +51,25 @@ def test_benchmark_quick_mode_runs_with_few_iterations_and_tiny_residuals(tmp_pa
         assert report["corners"][name]["vs"]["ratio"] > 0  # measured, never asserted
     grid = report["corners"]["double_wishbone.yaml"]["grid"]
     assert grid["converged"] == grid["points"] and grid["max_residual_mm"] <= 1e-9
+
+
+def test_study_benchmark_runs_a_small_slice(tmp_path):
+    """bench_study.py's quick slice: every way runs and reports every variant (no timing
+    asserted; `make bench` has the figures). Its clusters listen on 127.0.0.1 only."""
+    out = tmp_path / "study.json"
+    proc = subprocess.run(
+        [sys.executable, str(ROOT / "benchmarks" / "bench_study.py"), "--variants", "64"]
+        + ["--json", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=tmp_path,
+        # its temporary folders and the workers' scratch space inside tmp_path
+        env=os.environ | {"TMPDIR": str(tmp_path), "DASK_TEMPORARY_DIRECTORY": str(tmp_path)},
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert "2 workers over 1" in proc.stdout
+    report = json.loads(out.read_text())
+    assert set(report["ways"]) == {"serial", "local, 1 worker", "local, 2 workers"}
+    for way in report["ways"].values():
+        assert way["variants"] == 64 and way["running"] > 0

@@ -120,9 +120,11 @@ def test_all_hardpoints_varies_every_coordinate(tmp_path):
 def test_variant_data_moves_only_its_coordinates():
     base = yaml.safe_load((EXAMPLES / "double_wishbone.yaml").read_text())
     moved = variant_data(
-        base, [Variable("trackrod_inboard", "z", -1, 1), Variable("axle_outboard", "x", -1, 1)],
-        [2.5, -1.25], axle=False,
-    )  # fmt: skip
+        base,
+        [Variable("trackrod_inboard", "z", -1, 1), Variable("axle_outboard", "x", -1, 1)],
+        [2.5, -1.25],
+        axle=False,
+    )
     assert moved["hardpoints"]["trackrod_inboard"] == {"x": 50, "y": 200, "z": 252.5}
     assert moved["hardpoints"]["axle_outboard"]["x"] == -21.25
     assert base["hardpoints"]["trackrod_inboard"]["z"] == 250  # the design is untouched
@@ -217,11 +219,25 @@ def test_results_convert_to_pandas():
     assert frame["solver_converged"].dtype == bool
 
 
-def test_a_local_cluster_gives_the_serial_numbers(tmp_path):
+def test_a_local_cluster_gives_the_serial_numbers(tmp_path, monkeypatch):
+    import dask
+    import psutil
+
+    # the workers' scratch space (and any temporary file) inside tmp_path
+    scratch = tmp_path / "scratch"
+    scratch.mkdir()
+    for name in ("DASK_TEMPORARY_DIRECTORY", "TMPDIR"):
+        monkeypatch.setenv(name, str(scratch))
     study = load_study(write_study(tmp_path, LHS))
     serial = run_study(study, tmp_path / "serial", scheduler=None).variants
-    local = run_study(study, tmp_path / "local", scheduler="local", workers=2).variants
-    pd.testing.assert_frame_equal(serial, local, check_exact=True)
+    with dask.config.set({"temporary-directory": str(scratch)}):
+        outcome = run_study(study, tmp_path / "local", scheduler="local", workers=2)
+    pd.testing.assert_frame_equal(serial, outcome.variants, check_exact=True)
+    assert any(scratch.iterdir())  # the workers wrote here, not in the system's /tmp
+    # the cluster is gone: no process of ours still listens
+    mine = {p.pid for p in psutil.Process().children(recursive=True)}
+    listening = [c for c in psutil.net_connections("tcp") if c.status == "LISTEN" and c.pid in mine]
+    assert not listening
 
 
 def test_an_axle_study_moves_one_side_and_equals_its_direct_sweep(tmp_path, capsys):
@@ -354,10 +370,14 @@ def test_objective_jacobian_is_the_derivative_of_the_residuals(tmp_path):
         "optimise": {
             "objective": [
                 {"metric": "roadwheel_angle", "relative": True, "target": 0.0},
-                {"metric": "camber", "curve": {"x": "wheel_travel", "points": [[-30, -1.5], [30, -2.5]]}, "weight": 2},
+                {
+                    "metric": "camber",
+                    "curve": {"x": "wheel_travel", "points": [[-30, -1.5], [30, -2.5]]},
+                    "weight": 2,
+                },
             ]
         },
-    }  # fmt: skip
+    }
     study = load_study(write_study(tmp_path, body))
     job = study.job()
     sweep = load_sweep(BUMP)
@@ -382,17 +402,33 @@ def test_objective_jacobian_is_the_derivative_of_the_residuals(tmp_path):
 
 
 BAD = [
-    ({"variables": [{"point": "nowhere", "axis": "z", "range": [-1, 1]}]}, "variables[0].point: unknown hardpoint 'nowhere'"),
-    ({"variables": [{"point": "trackrod_inboard", "axis": "w", "range": [-1, 1]}]}, "variables[0].axis: expected one of x, y, z"),
-    ({"variables": [{"point": "trackrod_inboard", "axis": "z", "range": [1, 1]}]}, "variables[0].range: empty range [1, 1]"),
-    ({"variables": [{"point": "trackrod_inboard", "axis": "z", "range": [-1, 1], "side": "left"}]}, "variables[0].side: a corner has one side"),
+    (
+        {"variables": [{"point": "nowhere", "axis": "z", "range": [-1, 1]}]},
+        "variables[0].point: unknown hardpoint 'nowhere'",
+    ),
+    (
+        {"variables": [{"point": "trackrod_inboard", "axis": "w", "range": [-1, 1]}]},
+        "variables[0].axis: expected one of x, y, z",
+    ),
+    (
+        {"variables": [{"point": "trackrod_inboard", "axis": "z", "range": [1, 1]}]},
+        "variables[0].range: empty range [1, 1]",
+    ),
+    (
+        {
+            "variables": [
+                {"point": "trackrod_inboard", "axis": "z", "range": [-1, 1], "side": "left"}
+            ]
+        },
+        "variables[0].side: a corner has one side",
+    ),
     ({"doe": {"method": "latin_hypercube", "samples": 0}}, "doe.samples: must be >= 1, got 0"),
     ({"doe": {"method": "latin_hypercube", "samples": -3}}, "doe.samples: must be >= 1, got -3"),
     ({"doe": {"method": "grid", "samples": 3}}, "doe.method: expected one of full_factorial"),
     ({"summary": ["camberr"]}, "summary[0]: unknown column 'camberr'"),
     ({"kind": "monte_carlo"}, "monte_carlo: missing key"),
     ({"sweep": "/nonexistent/sweep.yaml"}, "/nonexistent/sweep.yaml: file not found"),
-]  # fmt: skip
+]
 
 
 @pytest.mark.parametrize(("change", "message"), BAD)
@@ -469,11 +505,29 @@ def test_an_axle_objective_jacobian_is_exact_and_roll_sweeps_are_refused(tmp_pat
         "version": 1,
         "steps": 5,
         "targets": [
-            {"point": "wheel_center", "side": "left", "direction": {"axis": "z"}, "start": -20, "stop": 20},
-            {"point": "wheel_center", "side": "right", "direction": {"axis": "z"}, "start": 20, "stop": -20},
-            {"point": "trackrod_inboard", "side": "left", "direction": {"axis": "y"}, "start": 0, "stop": 0},
+            {
+                "point": "wheel_center",
+                "side": "left",
+                "direction": {"axis": "z"},
+                "start": -20,
+                "stop": 20,
+            },
+            {
+                "point": "wheel_center",
+                "side": "right",
+                "direction": {"axis": "z"},
+                "start": 20,
+                "stop": -20,
+            },
+            {
+                "point": "trackrod_inboard",
+                "side": "left",
+                "direction": {"axis": "y"},
+                "start": 0,
+                "stop": 0,
+            },
         ],
-    }  # fmt: skip
+    }
     (tmp_path / "sweep.yaml").write_text(yaml.safe_dump(sweep))
     body = {
         "geometry": str(EXAMPLES / "axle_front.yaml"),
@@ -487,11 +541,14 @@ def test_an_axle_objective_jacobian_is_exact_and_roll_sweeps_are_refused(tmp_pat
             "objective": [
                 {"metric": "roadwheel_angle_left", "relative": True, "target": 0},
                 {"metric": "track", "target": 1500},
-                {"metric": "camber_right", "curve": {"x": "wheel_travel_right", "points": [[-20, -1], [20, -2]]}},
+                {
+                    "metric": "camber_right",
+                    "curve": {"x": "wheel_travel_right", "points": [[-20, -1], [20, -2]]},
+                },
             ]
         },
         "summary": ["roadwheel_angle_left"],
-    }  # fmt: skip
+    }
     study = load_study(write_study(tmp_path, body))
     job, sweep = study.job(), load_sweep(tmp_path / "sweep.yaml")
     x = np.array([1.0, -2.0])
