@@ -1654,8 +1654,10 @@ def _study(args) -> int:
         if kept is None:
             print("pin-susp: interrupted, nothing written", file=sys.stderr)
         else:
+            bar = not args.quiet and sys.stderr.isatty()  # end the progress bar's line
             print(
-                f"\npin-susp: interrupted: {kept} of {total} batches are kept in {out}; "
+                f"{chr(10) if bar else ''}pin-susp: interrupted: {kept} of {total} batches "
+                f"are kept in {out}; "
                 "the same command with --resume solves the rest",
                 file=sys.stderr,
             )

@@ -858,6 +858,7 @@ def run_study(
     if not isinstance(study, Study):
         study = load_study(study)
     outdir = Path(outdir)
+    _check_outdir(study, outdir, steps, resume)  # before any connection or file
     if scheduler is None or scheduler == "none":
         return _run(study, outdir, None, steps, resume, progress, None)
     with _client(scheduler, workers) as client:  # a scheduler that answers, before any file
@@ -957,6 +958,7 @@ class _client:
                 f"--scheduler {self.scheduler}: expected an address like tcp://HOST:PORT, "
                 "'local' or 'none'"
             )
+        _reachable(self.scheduler)
         try:
             self.client = Client(self.scheduler, timeout="10s")
         except (OSError, TimeoutError) as exc:
@@ -975,6 +977,30 @@ class _client:
             self.cluster.close()
 
 
+def _reachable(address: str) -> None:
+    """A TCP scheduler's port must take a connection (Dask would retry a refusal until
+    its timeout): one clear line at once, or after 5 s of silence."""
+    import socket
+    from urllib.parse import urlsplit
+
+    if not address.startswith("tcp://"):
+        return
+    try:
+        parts = urlsplit(address)
+        host, port = parts.hostname, parts.port
+    except ValueError:
+        host = port = None
+    if not host or not port:
+        raise PinSuspError(f"--scheduler {address}: expected tcp://HOST:PORT")
+    try:
+        socket.create_connection((host, port), timeout=5.0).close()
+    except OSError as exc:
+        why = "timed out" if isinstance(exc, TimeoutError) else exc.strerror or str(exc)
+        raise PinSuspError(
+            f"--scheduler {address}: no Dask scheduler answers there ({why})"
+        ) from None
+
+
 def _has_dashboard() -> bool:
     import importlib.util
 
@@ -986,8 +1012,11 @@ def _dashboard(client, local: bool) -> str | None:
     if local and not _has_dashboard():
         return None
     try:
-        if "dashboard" in client.scheduler_info().get("services", {}):
-            return client.dashboard_link
+        if "dashboard" not in client.scheduler_info().get("services", {}):
+            return None
+        if not local and not client.run_on_scheduler(_has_dashboard):  # pages need bokeh
+            return None
+        return client.dashboard_link
     except Exception:  # the link is a courtesy: never a reason to fail
         return None
     return None
@@ -1015,10 +1044,24 @@ def _fingerprint(study: Study, steps: bool) -> dict:
 
 
 def _prepare(study: Study, outdir: Path, steps: bool, resume: bool) -> Path:
-    """Check OUTDIR (a new or empty directory, or this study's unfinished run with
-    ``resume``) and write its manifest; the parts' folder."""
+    """Check OUTDIR again and write its manifest; the parts' folder."""
     from .export import write_text
 
+    mine = _check_outdir(study, outdir, steps, resume)
+    manifest = outdir / MANIFEST
+    for stale in (outdir / PARTS).glob(".*.tmp"):  # a part cut short by an interruption
+        stale.unlink()
+    try:
+        (outdir / PARTS).mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise PinSuspError(f"{outdir}: cannot write here ({exc.strerror})") from None
+    write_text(json.dumps(mine, indent=2) + "\n", manifest)
+    return outdir / PARTS
+
+
+def _check_outdir(study: Study, outdir: Path, steps: bool, resume: bool) -> dict:
+    """OUTDIR must be new or empty, or hold this study's unfinished run (``resume``);
+    nothing is written. The manifest that the run will write."""
     mine = _fingerprint(study, steps)
     manifest = outdir / MANIFEST
     if outdir.exists() and not outdir.is_dir():
@@ -1055,14 +1098,20 @@ def _prepare(study: Study, outdir: Path, steps: bool, resume: bool) -> Path:
             )
     elif resume:
         raise PinSuspError(f"{outdir}: no unfinished run of this study to resume")
-    for stale in (outdir / PARTS).glob(".*.tmp"):  # a part cut short by an interruption
-        stale.unlink()
-    try:
-        (outdir / PARTS).mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise PinSuspError(f"{outdir}: cannot write here ({exc.strerror})") from None
-    write_text(json.dumps(mine, indent=2) + "\n", manifest)
-    return outdir / PARTS
+    else:
+        folder = outdir if outdir.exists() else _existing_parent(outdir)
+        if not os.access(folder, os.W_OK | os.X_OK):
+            raise PinSuspError(f"{outdir}: cannot write here (no permission in {folder})")
+    return mine
+
+
+def _existing_parent(path: Path) -> Path:
+    for parent in path.absolute().parents:
+        if parent.exists():
+            if not parent.is_dir():
+                raise PinSuspError(f"{path}: cannot write here ({parent} is not a directory)")
+            return parent
+    return Path("/")
 
 
 def finished_batches(outdir: str | Path) -> int | None:
