@@ -1685,7 +1685,7 @@ def _study(args) -> int:
         save_figure(study_figure(study, variants, outcome.linear, curves), extra["study.png"])
         written.append(extra["study.png"])
     if not args.quiet:
-        for line in studies.summary_lines(study, variants, outcome.linear):
+        for line in studies.summary_lines(study, variants, outcome.linear, curves):
             print(line)
         resumed = outcome.batches - outcome.computed
         rate = len(variants) / seconds if not resumed and study.kind != "optimise" else None

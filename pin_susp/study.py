@@ -1240,9 +1240,10 @@ def linear_prediction(study: Study, variants) -> dict[str, np.ndarray] | None:
     return out
 
 
-def summary_lines(study: Study, variants, linear=None) -> list[str]:
+def summary_lines(study: Study, variants, linear=None, curves=None) -> list[str]:
     """The study's summary as printed: counts, and per summary column its spread
-    (and, from Monte Carlo, beside the first-order prediction)."""
+    (and, from Monte Carlo, beside the first-order prediction); an optimisation's
+    starts, and with ``curves`` (see curves()) each term's miss at the best."""
     ok = variants["converged"].to_numpy()
     lines = [
         f"{len(variants)} variants of {Path(study.geometry_path).name} through "
@@ -1253,7 +1254,7 @@ def summary_lines(study: Study, variants, linear=None) -> list[str]:
     if len(failed):
         lines.append(f"  {len(failed)} variants could not be built, e.g.: {failed.iloc[0]}")
     if study.kind == "optimise":
-        return lines + _optimise_lines(study, variants)
+        return lines + _optimise_lines(study, variants, curves)
     head = f"  {'column':44s} {'mean':>10s} {'std':>9s} {'min':>10s} {'max':>10s}"
     if linear is not None:
         head += f" {'linear std':>10s} {'max |diff|':>10s}"
@@ -1313,7 +1314,7 @@ def _effect_lines(study: Study, variants) -> list[str]:
     return lines
 
 
-def _optimise_lines(study: Study, variants) -> list[str]:
+def _optimise_lines(study: Study, variants, curves=None) -> list[str]:
     order = variants.sort_values("objective")
     lines = ["  start  objective at start -> found  evaluations"]
     for _, row in variants.iterrows():
@@ -1325,7 +1326,26 @@ def _optimise_lines(study: Study, variants) -> list[str]:
     moves = ", ".join(f"{v.name} = {best[v.name]:+.3f} mm" for v in study.variables)
     lines.append(f"  best: start {int(best['variant_id'])}, objective {best['objective']:.4g}")
     lines.append(f"    {moves}")
+    for term, curve in zip(study.terms, curves or [], strict=False):
+        if curve.get("after") is None:
+            continue
+        miss = np.abs(curve["after"][1] - curve["after_target"])
+        what = f"{term.metric} (change from design)" if term.relative else term.metric
+        unit = _unit(term.metric)
+        lines.append(
+            f"    {what}: misses its target by {np.sqrt(np.mean(miss**2)):.3g} {unit} RMS, "
+            f"{np.nanmax(miss):.3g} {unit} at most over the sweep"
+        )
     return lines
+
+
+def _unit(column: str) -> str:
+    from .metrics import METRIC_BY_NAME
+
+    for name, m in METRIC_BY_NAME.items():
+        if column == name or column.startswith(f"{name}_"):
+            return m.unit
+    return ""
 
 
 def best_deltas(study: Study, variants) -> np.ndarray:
