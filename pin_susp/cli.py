@@ -551,20 +551,33 @@ def _mjcf(args) -> int:
 def _validate_command(sub) -> None:
     va = sub.add_parser(
         "validate",
-        help="re-solve a sweep with MuJoCo and a point-based solver; compare every column",
-        description="Solve SWEEP with pin_susp, then re-solve every step independently with "
-        "MuJoCo (from the exported MJCF) and with a point-based formulation (hardpoints as "
-        "unknowns, rigid distances, scipy); print the largest difference per column and "
-        "engine; exit 1 where one exceeds the tolerance. GEOMETRY is a corner or an axle "
-        "(scope: axle: each side's columns, the axle's, the bar). MuJoCo is optional: "
-        "pip install 'pin_susp[validate]'.",
+        help="re-solve a sweep with MuJoCo or Drake and a point-based solver; compare every column",
+        description="Solve SWEEP with pin_susp, then re-solve every step independently from "
+        "the design state with a point-based formulation (hardpoints as unknowns, rigid "
+        "distances, scipy) and with MuJoCo (from the exported MJCF) and/or Drake (the exported "
+        "URDF in Drake's own parser, its InverseKinematics solved by IPOPT); print the largest "
+        "difference per column and engine; exit 1 where one exceeds the tolerance. GEOMETRY "
+        "is a corner or an axle (scope: axle: each side's columns, the axle's, the bar). "
+        "MuJoCo and Drake are optional: pip install 'pin_susp[validate]'.",
     )
     _geometry_argument(va)
     va.add_argument("sweep", metavar="SWEEP", help="sweep YAML")
     va.add_argument(
+        "--engine",
+        choices=("mujoco", "drake", "all", "pointwise"),
+        default="mujoco",
+        help="the engine besides the point-based solver, which always runs: mujoco "
+        "(default), drake, all (both), or pointwise (that one only)",
+    )
+    va.add_argument(
         "--mjcf",
         metavar="FILE.xml",
-        help="an exported MJCF to check against (default: export it now)",
+        help="an exported MJCF for MuJoCo to check against (default: export it now)",
+    )
+    va.add_argument(
+        "--urdf",
+        metavar="FILE.urdf",
+        help="an exported URDF for Drake to check against (default: export it now)",
     )
     va.add_argument(
         "--tolerance",
@@ -585,16 +598,36 @@ def _validate(args) -> int:
     if not axle:  # an axle's target errors come from its solve, before any work
         corner.solver_for(sweep.targets, sweep.source)
     name = corner.axle.name if axle else corner.geometry.name
-    mjcf_text = None
-    if args.mjcf is not None:
+    engines = {
+        "mujoco": ("pointwise", "mujoco"),
+        "drake": ("pointwise", "drake"),
+        "all": ("pointwise", "mujoco", "drake"),
+        "pointwise": ("pointwise",),
+    }[args.engine]
+    texts = {}
+    for option, engine, what in (("mjcf", "mujoco", "MJCF"), ("urdf", "drake", "URDF")):
+        path = getattr(args, option)
+        if path is None:
+            continue
+        if engine not in engines:
+            raise PinSuspError(
+                f"--{option}: only {engine} reads it; add --engine {engine} (or --engine all)"
+            )
         try:
-            mjcf_text = Path(args.mjcf).read_bytes().decode("utf-8")
+            texts[option] = Path(path).read_bytes().decode("utf-8")
         except OSError as exc:
-            raise PinSuspError(f"{args.mjcf}: cannot be read ({exc.strerror})") from None
+            raise PinSuspError(f"{path}: cannot be read ({exc.strerror})") from None
         except UnicodeDecodeError:
-            raise PinSuspError(f"{args.mjcf}: not a text file (MJCF is XML)") from None
+            raise PinSuspError(f"{path}: not a text file ({what} is XML)") from None
     results, reports = validate(
-        corner, sweep, mjcf_text, args.tolerance, mjcf_source=args.mjcf or "--mjcf"
+        corner,
+        sweep,
+        texts.get("mjcf"),
+        args.tolerance,
+        mjcf_source=args.mjcf or "--mjcf",
+        engines=engines,
+        urdf_text=texts.get("urdf"),
+        urdf_source=args.urdf or "--urdf",
     )
     names = list(dict.fromkeys(n for r in reports for n in r.differences))
     print(
@@ -1627,13 +1660,13 @@ def _study(args) -> int:
     if args.workers is not None and args.workers < 1:
         raise PinSuspError(f"--workers must be 1 or more, got {args.workers}")
     scheduler = None if args.scheduler == "none" else args.scheduler
-    if scheduler not in (None, "local") and args.workers is not None:
-        raise PinSuspError("--workers sizes the local cluster: a scheduler has its own workers")
+    if scheduler != "local" and args.workers is not None:
+        raise PinSuspError(
+            "--workers sizes the local cluster: a scheduler has its own workers, and "
+            "--scheduler none runs in this process"
+        )
     study = studies.load_study(args.study)
     out = Path(args.output)
-    extra = {"study.png": out / "study.png"}
-    if study.kind == "optimise":
-        extra["best.yaml"] = out / "best.yaml"
     started = time.perf_counter()
     total = len(studies.batches(study))
     label = "starts" if study.kind == "optimise" else "batches"
@@ -1665,27 +1698,11 @@ def _study(args) -> int:
     seconds = time.perf_counter() - started
     variants = outcome.variants
     written = [out / "variants.parquet"] + ([out / "steps.parquet"] if args.steps else [])
-    curves = None
-    if study.kind == "optimise":
-        best = studies.best_deltas(study, variants)
-        row = variants.sort_values("objective").iloc[0]
-        comment = (
-            f"generated by pin_susp {__version__}: the best of {len(variants)} starts of "
-            f"{Path(study.source).name} (objective {row['objective']:.6g}, start "
-            f"{int(row['variant_id'])});\n"
-            + "".join(f"{v.name} = {row[v.name]!r} mm\n" for v in study.variables)
-        )
-        studies.write_geometry(study, best, extra["best.yaml"], comment.rstrip())
-        written.append(extra["best.yaml"])
-        curves = studies.curves(study, best)
-    if variants["converged"].any():
-        from .plots import save_figure
-        from .study_plots import study_figure
-
-        save_figure(study_figure(study, variants, outcome.linear, curves), extra["study.png"])
-        written.append(extra["study.png"])
+    written += [p for p in (outcome.best, outcome.figure) if p is not None]
+    if outcome.figure is None:
+        print(f"pin-susp: no variant converged: {out / 'study.png'} not drawn", file=sys.stderr)
     if not args.quiet:
-        for line in studies.summary_lines(study, variants, outcome.linear, curves):
+        for line in outcome.lines:
             print(line)
         resumed = outcome.batches - outcome.computed
         rate = len(variants) / seconds if not resumed and study.kind != "optimise" else None

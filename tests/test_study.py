@@ -479,7 +479,11 @@ def test_workers_and_scheduler_flags_are_checked(tmp_path, capsys):
     assert code == 2 and "--workers must be 1 or more" in err
     code, _, err = run_cli(["study", path, "-o", tmp_path / "b", "--scheduler", "bogus"], capsys)
     assert code == 2 and "expected an address like tcp://HOST:PORT" in err
-    assert not (tmp_path / "a").exists() and not (tmp_path / "b").exists()
+    code, _, err = run_cli(
+        ["study", path, "-o", tmp_path / "c", "--scheduler", "none", "--workers", "2"], capsys
+    )
+    assert code == 2 and "--workers sizes the local cluster" in err
+    assert not any((tmp_path / d).exists() for d in "abc")
 
 
 def test_summary_prints_spread_and_files(tmp_path, capsys):
@@ -574,3 +578,24 @@ def test_an_axle_objective_jacobian_is_exact_and_roll_sweeps_are_refused(tmp_pat
         ["study", write_study(tmp_path, roll, "roll.yaml"), "-o", tmp_path / "o"], capsys
     )
     assert code == 2 and "optimise: on an axle" in err
+
+
+def test_resume_finishes_a_run_cut_short_whatever_the_path_spelling(tmp_path, monkeypatch):
+    from pin_susp.study import finished_batches
+
+    path = write_study(tmp_path, LHS)  # 6 variants in 2 batches
+
+    def interrupt(done, total):
+        if done == 1:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        run_study(load_study(path), tmp_path / "o", scheduler=None, progress=interrupt)
+    assert finished_batches(tmp_path / "o") == 1
+    assert not (tmp_path / "o" / "variants.parquet").exists()
+    monkeypatch.chdir(tmp_path)  # the same file, typed relative to another folder
+    resumed = run_study(load_study("study.yaml"), "o", scheduler=None, resume=True)
+    assert (resumed.computed, resumed.batches) == (1, 2)
+    reference = run_study(load_study(path), tmp_path / "reference", scheduler=None)
+    pd.testing.assert_frame_equal(resumed.variants, reference.variants, check_exact=True)
+    assert finished_batches(tmp_path / "o") is None  # finished: nothing left to resume
