@@ -3,6 +3,10 @@
 - ``mujoco``: the exported MJCF in MuJoCo — its own forward kinematics,
   equality-constraint Jacobians (``efc_J``/``efc_pos``), site Jacobians and
   ``mj_integratePos``, driven by Newton to the same targets;
+- ``drake``: the exported URDF parsed by Drake's own parser into a
+  ``MultibodyPlant``, the loop closures and the targets as constraints of
+  Drake's ``InverseKinematics``, solved by IPOPT; points and Jacobians from
+  the plant (``CalcPointsPositions``, ``CalcJacobianTranslationalVelocity``);
 - ``pointwise``: hardpoints as unknowns, rigid distances, scipy least_squares.
 
 Each engine starts every step from the design state (no warm start), so a
@@ -20,6 +24,8 @@ points, drivers, targets and columns — is a scope (:class:`CornerScope`,
 
 from __future__ import annotations
 
+import logging
+import xml.etree.ElementTree as ET
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 
@@ -39,6 +45,7 @@ from .jet import Dual
 from .jet import value as plain
 from .metrics import METRICS, TOE_LINK, metric_columns
 from .pointwise import Along, PointwiseAxle, PointwiseCorner, Y, Z, as_target, axle_targets
+from .urdf import NAMESPACE, read_closures, tree_to_urdf
 
 TOLERANCE = 1e-6  # mm and deg
 # Instant centres of nearly parallel wishbones lie kilometres away, where a
@@ -61,7 +68,7 @@ class EngineReport:
     disagree: set[str] = field(default_factory=set)
     not_compared: set[str] = field(default_factory=set)  # the engine could not compute them
     note: str = ""
-    warnings: int = 0  # how many warnings the engine raised (MuJoCo's: silenced, counted)
+    warnings: int = 0  # how many warnings the engine raised (MuJoCo's, Drake's: silenced, counted)
     first_warning: str = ""
 
     @property
@@ -501,47 +508,470 @@ def _mujoco_points(scope, sweep, mjcf_text: str, source: str):
     return points, counter
 
 
+# ---------------------------------------------------------------- Drake
+
+# IPOPT's defaults stop near 1e-8 in its scaled error (SNOPT's near 1e-3 mm in
+# the points): a validation at 1e-6 mm needs the constraints met to ~1e-14 m.
+# Every example's steps converge within 8 iterations: 100 (not 3000) keeps a step
+# that cannot converge (a target out of reach) from costing seconds.
+IPOPT_OPTIONS = {"tol": 1e-14, "constr_viol_tol": 1e-14, "max_iter": 100, "print_level": 0}
+# A pose is accepted when Drake's own plant has every closure and target this close
+# (m, and rad for roll): what IPOPT's tight tolerance reaches, with margin.
+DRAKE_RESIDUAL = 1e-12
+# m: a frame this far from the origin is no suspension, and IPOPT's iterates on it
+# overflow, where Drake aborts the whole process (a non-finite q): refused instead.
+FAR = 1e6
+
+
+class _DrakePoint:
+    """A frame of Drake's plant as a point: position and (3 × nq) Jacobian in world."""
+
+    def __init__(self, frame, offset=None):
+        self.frame = frame
+        self.offset = np.zeros(3) if offset is None else np.asarray(offset, dtype=float)
+
+    def position(self, engine: DrakeCorner) -> np.ndarray:
+        p = engine.plant.CalcPointsPositions(engine.context, self.frame, self.offset, engine.world)
+        return p[:, 0]
+
+    def jacobian(self, engine: DrakeCorner) -> np.ndarray:
+        return engine.plant.CalcJacobianTranslationalVelocity(
+            engine.context, engine.wrt, self.frame, self.offset, engine.world, engine.world
+        )
+
+
+@dataclass(frozen=True)
+class _DrakeClosure:
+    """A loop closure read back from the URDF, its anchors as points of Drake's plant;
+    ``length``: a distance closure's, from Drake's design pose."""
+
+    name: str
+    kind: str
+    a: _DrakePoint
+    b: _DrakePoint
+    links: frozenset
+    length: float = 0.0
+
+
+class _Positions(dict):
+    """The points' world positions at the engine's pose, each computed when first asked."""
+
+    def __init__(self, engine: DrakeCorner):
+        super().__init__()
+        self.engine = engine
+
+    def __missing__(self, name: str) -> np.ndarray:
+        self[name] = position = self.engine.sites[name].position(self.engine)
+        return position
+
+
+class DrakeCorner:
+    """The exported URDF (a corner's or an axle's) in Drake, solved to targets by
+    Drake's InverseKinematics.
+
+    Drake's own URDF parser builds the ``MultibodyPlant`` (the root link welded
+    to the world); the loop closures are read back from the same text
+    (:func:`pin_susp.urdf.read_closures`): a ball closure is a position
+    constraint (one anchor at the other, in its link's frame), a distance
+    closure a point-to-point distance constraint at the length Drake's plant
+    has at the design configuration (all joints 0). A target along a direction
+    is a position constraint in a frame whose x axis is that direction; an
+    axle's heave and roll are constraints evaluated on the plant's points and
+    Jacobians. Build and use it inside :func:`quiet_drake`.
+    """
+
+    def __init__(self, urdf_text: str, subject, source: str = "the URDF"):
+        from pydrake.multibody.parsing import Parser
+        from pydrake.multibody.plant import MultibodyPlant
+        from pydrake.multibody.tree import FrameIndex, JacobianWrtVariable
+
+        scope = _scope(subject)
+        root = next(b.name for b in scope.tree.bodies if b.parent is None)
+        self.plant = plant = MultibodyPlant(0.0)
+        try:
+            Parser(plant).AddModelsFromString(urdf_text, "urdf")
+            plant.WeldFrames(plant.world_frame(), plant.GetFrameByName(root))
+            plant.Finalize()
+        except (RuntimeError, ValueError) as exc:
+            detail = " ".join(str(exc).replace("<literal-string>.urdf:", "line ").split())
+            raise PinSuspError(f"{source}: Drake cannot load it: {detail}") from None
+        self.world = plant.world_frame()
+        self.wrt = JacobianWrtVariable.kQDot
+        self.context = plant.CreateDefaultContext()
+        self.q_design = np.zeros(plant.num_positions())
+        plant.SetPositions(self.context, self.q_design)
+        for i in range(plant.num_frames()):
+            f = plant.get_frame(FrameIndex(i))
+            where = f.CalcPoseInWorld(self.context).translation()
+            if not np.all(np.abs(where) < FAR):
+                raise PinSuspError(
+                    f"{source}: frame {f.name()} is {np.max(np.abs(where)):g} m from the "
+                    "origin at the design state: not a suspension"
+                )
+
+        def frame(name):
+            if not plant.HasFrameNamed(name):
+                raise PinSuspError(f"{source}: is not the URDF of this geometry: no link {name}")
+            return plant.GetFrameByName(name)
+
+        self.sites = {name: _DrakePoint(frame(name)) for name in scope.sites}
+        for prefix, (radius, body) in scope.wheels.items():
+            self.sites[f"{prefix}contact_patch_center"] = ContactPatchPoint(
+                f"{prefix}contact_patch_center",
+                self.sites[f"{prefix}wheel_center"],
+                self.sites[f"{prefix}axle_inboard"],
+                self.sites[f"{prefix}axle_outboard"],
+                radius,
+                body,
+            )
+        self.closures = []
+        try:
+            specs = read_closures(urdf_text)
+        except ValueError as exc:
+            raise PinSuspError(f"{source}: its loop closures cannot be read: {exc}") from None
+        for spec in specs:
+            (link_a, offset_a), (link_b, offset_b) = spec.anchors
+            a = _DrakePoint(frame(link_a), offset_a)
+            b = _DrakePoint(frame(link_b), offset_b)
+            with np.errstate(over="ignore", invalid="ignore"):
+                length = float(np.linalg.norm(a.position(self) - b.position(self)))
+            if not np.isfinite(length):  # Drake aborts the process on a NaN bound
+                raise PinSuspError(
+                    f"{source}: loop closure {spec.name}: its anchors are not a finite "
+                    "distance apart"
+                )
+            links = frozenset((link_a, link_b))
+            self.closures.append(_DrakeClosure(spec.name, spec.kind, a, b, links, length))
+
+    def _target_constraint(self, target):
+        """A target as a function of q for Drake's MathematicalProgram: its error, and
+        for IPOPT's AutoDiff its gradient by the chain rule through the plant's
+        Jacobians."""
+        from pydrake.autodiffutils import ExtractGradient, ExtractValue, InitializeAutoDiff
+
+        def evaluate(q):
+            values = q if q.dtype != object else ExtractValue(q)[:, 0]
+            if not np.all(np.isfinite(values)):  # Drake aborts on a non-finite q
+                errors, rows = [np.nan], np.full((1, len(values)), np.nan)
+            else:
+                self.plant.SetPositions(self.context, values)
+                errors, rows = self._rows([target])
+            if q.dtype != object:
+                return np.array(errors)
+            return InitializeAutoDiff(np.array(errors), np.array(rows) @ ExtractGradient(q))[:, 0]
+
+        return evaluate
+
+    def _rows(self, targets) -> tuple[list, list]:
+        """Each target's residual and its row of d residual / dq (chain rule through
+        the points' Jacobians), at the context's pose."""
+        p = _Positions(self)
+        errors, rows = [], []
+        for t in map(as_target, targets):
+            errors.append(t.error(p))
+            rows.append(
+                sum(g @ self.sites[name].jacobian(self) for name, g in t.gradient(p).items())
+            )
+        return errors, rows
+
+    def _closure_residuals(self) -> np.ndarray:
+        out = []
+        for c in self.closures:
+            d = c.a.position(self) - c.b.position(self)
+            out.append(np.linalg.norm(d) if c.kind == "ball" else np.linalg.norm(d) - c.length)
+        return np.array(out)
+
+    def program(self, targets):
+        """Drake's InverseKinematics of one step: the closures and the targets as its
+        constraints (no cost: the system is square), joint limits left out as
+        pin_susp's solver has none."""
+        from pydrake.math import RigidTransform, RotationMatrix
+        from pydrake.multibody.inverse_kinematics import InverseKinematics
+
+        ik = InverseKinematics(self.plant, with_joint_limits=False)
+        for c in self.closures:
+            if c.kind == "ball":
+                # anchor a, seen from b's link, is at anchor b
+                ik.AddPositionConstraint(c.a.frame, c.a.offset, c.b.frame, c.b.offset, c.b.offset)
+            elif c.kind == "distance":
+                ik.AddPointToPointDistanceConstraint(
+                    c.a.frame, c.a.offset, c.b.frame, c.b.offset, c.length, c.length
+                )
+            else:
+                raise PinSuspError(f"loop closure {c.name}: Drake has no {c.kind!r} closure")
+        free = np.array([-np.inf, -np.inf])
+        for t in map(as_target, targets):
+            site = self.sites.get(getattr(t, "point", None))
+            if isinstance(t, Along) and isinstance(site, _DrakePoint):
+                # the point's coordinate along the direction: x of a frame A whose x it is
+                along = RigidTransform(
+                    RotationMatrix.MakeFromOneVector(t.direction, 0), np.zeros(3)
+                )
+                ik.AddPositionConstraint(
+                    site.frame,
+                    site.offset,
+                    self.world,
+                    along,
+                    np.r_[t.value, free],
+                    np.r_[t.value, -free],
+                )
+            else:
+                ik.prog().AddConstraint(self._target_constraint(t), [0.0], [0.0], ik.q())
+        return ik
+
+    def solve(self, targets) -> dict | None:
+        """IPOPT from the design configuration; None unless it succeeds and Drake's
+        plant has every closure and target within DRAKE_RESIDUAL at its answer."""
+        from pydrake.solvers import IpoptSolver, SolverOptions
+
+        ik = self.program(targets)
+        solver = IpoptSolver()
+        options = SolverOptions()
+        for key, value in IPOPT_OPTIONS.items():
+            options.SetOption(solver.solver_id(), key, value)
+        result = solver.Solve(ik.prog(), self.q_design, options)
+        q = result.GetSolution(ik.q())
+        if not (result.is_success() and np.all(np.isfinite(q))):
+            return None
+        self.plant.SetPositions(self.context, q)
+        residual = np.r_[self._closure_residuals(), self._rows(targets)[0]]
+        if not np.max(np.abs(residual), initial=0.0) < DRAKE_RESIDUAL:
+            return None
+        return {name: site.position(self).copy() for name, site in self.sites.items()}
+
+    def rates(self, held, links, k: int) -> dict[str, np.ndarray]:
+        """At the solved pose: each point's rate along the k drivers, J·dq = e: the
+        closures' rows (a ball's three, a distance's one along the link) and the held
+        targets' rows; a driver that is a link's length (``links``: its two points)
+        is a 1 on its distance closure's row. NaN for a link no closure joins."""
+        rows, link_row = [], {}
+        for c in self.closures:
+            Ja, Jb = c.a.jacobian(self), c.b.jacobian(self)
+            if c.kind == "ball":
+                rows += list(Ja - Jb)
+            else:
+                d = c.a.position(self) - c.b.position(self)
+                link_row[c.links] = len(rows)
+                rows.append(d @ (Ja - Jb) / np.linalg.norm(d))
+        first = len(rows)
+        rows += self._rows(held)[1]
+        rhs = np.zeros((len(rows), k))
+        rhs[first:, : len(held)] = np.eye(len(held))
+        known = list(range(len(held)))
+        for j, pair in enumerate(links, start=len(held)):
+            if frozenset(pair) in link_row:
+                rhs[link_row[frozenset(pair)], j] = 1.0
+                known.append(j)
+        dq = np.linalg.lstsq(np.array(rows), rhs, rcond=None)[0]
+        out = {}
+        for name, site in self.sites.items():
+            out[name] = np.full((k, 3), np.nan)
+            out[name][known] = (site.jacobian(self) @ dq[:, known]).T
+        return out
+
+
+class _DrakeLog(logging.Handler):
+    """Drake's log records (pydrake sends them to the ``drake`` logger) to a counter."""
+
+    def __init__(self, counter: _Warnings):
+        super().__init__(logging.WARNING)
+        self.counter = counter
+
+    def emit(self, record) -> None:
+        self.counter(record.getMessage())
+
+
+@contextmanager
+def quiet_drake():
+    """Drake's warnings (its parser's, its solvers') counted instead of printed.
+
+    pydrake routes Drake's log to Python's ``drake`` logger: a counting handler
+    stands in for its handlers and propagation while the engine runs; both are
+    restored on the way out. Yields the :class:`_Warnings` counter.
+    """
+    counter = _Warnings()
+    logger = logging.getLogger("drake")
+    handlers, propagate = logger.handlers[:], logger.propagate
+    logger.handlers, logger.propagate = [_DrakeLog(counter)], False
+    try:
+        yield counter
+    finally:
+        logger.handlers, logger.propagate = handlers, propagate
+
+
+def drake_points(subject, sweep, urdf_text: str | None = None, source: str = "the URDF") -> list:
+    """Drake's points at every step (None where it did not converge), quietly;
+    ``urdf_text`` defaults to the subject's own export."""
+    scope = _scope(subject)
+    text = scope.subject.urdf if urdf_text is None else urdf_text
+    return _drake_points(scope, sweep, text, source)[0]
+
+
+def _drake_points(scope, sweep, urdf_text: str, source: str):
+    """(points, warnings counter); Drake's errors as PinSuspError naming ``source``."""
+    with quiet_drake() as counter:
+        engine = DrakeCorner(urdf_text, scope, source)
+        points = []
+        for targets in scope.step_targets(sweep):
+            try:
+                at = engine.solve(targets)
+            except RuntimeError as exc:
+                detail = " ".join(str(exc).split())
+                raise PinSuspError(f"{source}: Drake failed on it: {detail}") from None
+            if at is None:
+                points.append(None)
+                continue
+            rates = engine.rates(scope.held(at), scope.links, scope.drivers)
+            points.append(scope.duals(at, rates))
+    return points, counter
+
+
+def check_urdf(text: str, tree, source: str = "URDF") -> None:
+    """Raise PinSuspError unless ``text`` is the URDF :func:`pin_susp.urdf.tree_to_urdf`
+    writes for ``tree``: XML with a ``<robot>`` root holding the same links, the same
+    joints (type, parent, child) and the same loop closures (type, the links of their
+    frames). Positions and axes are not compared: the URDF of a corner whose hardpoints
+    moved since the export passes, and the comparison of the solutions shows it."""
+    problem = _urdf_problem(text, tree)
+    if problem:
+        raise PinSuspError(f"{source}: {problem}")
+
+
+def _urdf_problem(text: str, tree) -> str | None:
+    if not text.strip():
+        return "is empty: expected the URDF written by pin-susp urdf"
+    if "\x00" in text or "\ufffd" in text:
+        return "is not a text file: expected the URDF (XML) written by pin-susp urdf"
+    try:
+        root = ET.fromstring(text)
+    except ET.ParseError as exc:
+        return f"is not valid XML ({exc})"
+    if root.tag != "robot":
+        what = " (an MJCF?)" if root.tag == "mujoco" else ""
+        return f"is not URDF{what}: its root element is <{root.tag}>, not <robot>"
+    ours, theirs = _urdf_elements(ET.fromstring(tree_to_urdf(tree))), _urdf_elements(root)
+    differences = []
+    for kind in ("link", "joint", "loop closure"):
+        mine, yours = ours[kind], theirs[kind]
+        differences += [f"missing {kind} {n or '(unnamed)'}" for n in mine if n not in yours]
+        differences += [
+            f"has a {kind} {n or '(unnamed)'} this model does not have"
+            for n in yours
+            if n not in mine
+        ]
+        differences += [
+            f"{kind} {n} is {' '.join(yours[n])}, not {' '.join(mine[n])}"
+            for n in mine
+            if n in yours and yours[n] != mine[n]
+        ]
+    if not differences:
+        return None
+    more = f" (and {len(differences) - 1} more differences)" if len(differences) > 1 else ""
+    return (
+        f"is not the URDF of this geometry ({tree.name}): {differences[0]}{more}; "
+        "write it with pin-susp urdf GEOMETRY -o FILE"
+    )
+
+
+def _urdf_elements(root) -> dict[str, dict[str, tuple[str, ...]]]:
+    """Named elements by kind, each with what must match: a joint's type, parent and
+    child; a loop closure's type and its frames' links."""
+    ns = {"pin_susp": NAMESPACE}
+    found = {
+        "link": {el.get("name", ""): () for el in root.findall("link")},
+        "joint": {},
+        "loop closure": {},
+    }
+    for el in root.findall("joint"):
+        ends = [
+            (el.find(end).get("link", "") if el.find(end) is not None else "")
+            for end in ("parent", "child")
+        ]
+        found["joint"].setdefault(
+            el.get("name", ""), (el.get("type", "?"), "from", ends[0] or "?", "to", ends[1] or "?")
+        )
+    for el in root.findall("pin_susp:loop_closure", ns):
+        links = [f.get("link", "?") for f in el.findall("pin_susp:frame", ns)]
+        found["loop closure"].setdefault(
+            el.get("name", ""), (el.get("type", "?"), "between", *links)
+        )
+    return found
+
+
+ENGINES = ("pointwise", "mujoco", "drake")
+INSTALL = {"mujoco": "MuJoCo", "drake": "Drake"}
+
+
 def validate(
     subject,
     sweep,
     mjcf_text: str | None = None,
     tolerance: float = TOLERANCE,
     mjcf_source: str = "--mjcf",
+    *,
+    engines=("pointwise", "mujoco"),
+    urdf_text: str | None = None,
+    urdf_source: str = "--urdf",
 ):
-    """Solve the sweep with pin_susp, then with each available engine; compare.
+    """Solve the sweep with pin_susp, then with each of ``engines`` (of :data:`ENGINES`)
+    that is installed; compare.
 
-    ``subject``: a Corner or an AxleModel. Returns (results, reports).
-    ``mjcf_text`` defaults to the subject's own export; given, it must be that
-    export (:func:`pin_susp.mjcf.check_mjcf`, checked before any solving) and
-    ``mjcf_source`` names it in errors (the file's path). A file that is not
-    this corner's (axle's) MJCF, or that MuJoCo cannot load, raises
-    PinSuspError; MuJoCo's warnings are counted in the report's ``warnings``,
-    never printed nor written to MUJOCO_LOG.TXT. An engine that cannot model
-    the subject gets a report with a ``note`` saying why.
+    ``subject``: a Corner or an AxleModel. Returns (results, reports), the reports
+    in the order of ENGINES. ``mjcf_text`` (MuJoCo's) and ``urdf_text`` (Drake's)
+    default to the subject's own export; given, each must be that export
+    (:func:`pin_susp.mjcf.check_mjcf`, :func:`check_urdf`, checked before any
+    solving) and ``mjcf_source`` / ``urdf_source`` name it in errors (the file's
+    path). A file that is not this corner's (axle's) model, or that its engine
+    cannot load, raises PinSuspError; the engines' warnings are counted in the
+    report's ``warnings``, never printed (nor, MuJoCo's, written to
+    MUJOCO_LOG.TXT). An engine that is not installed, or cannot model the
+    subject, gets a report with a ``note`` saying why.
     """
-    from .mjcf import check_mjcf, tree_to_mjcf
+    from .mjcf import check_mjcf
 
+    unknown = [e for e in engines if e not in ENGINES]
+    if unknown:
+        raise PinSuspError(f"unknown engine {unknown[0]!r}: expected one of {', '.join(ENGINES)}")
     scope = _scope(subject)
     if mjcf_text is not None:
         check_mjcf(mjcf_text, scope.tree, mjcf_source)
+    if urdf_text is not None:
+        check_urdf(urdf_text, scope.tree, urdf_source)
     results = scope.results(sweep)
+    reports = []
+    if "pointwise" in engines:
+        try:
+            points = pointwise_points(scope, sweep)
+        except PinSuspError as exc:
+            reports.append(EngineReport("pointwise", note=str(exc)))
+        else:
+            reports.append(compare(scope, results, points, "pointwise", tolerance))
+    if "mujoco" in engines:
+        reports.append(_mujoco_report(scope, sweep, results, mjcf_text, mjcf_source, tolerance))
+    if "drake" in engines:
+        reports.append(_drake_report(scope, sweep, results, urdf_text, urdf_source, tolerance))
+    return results, reports
+
+
+def _not_installed(engine: str, module: str) -> EngineReport | None:
+    """A report saying how to install the engine when its module is missing."""
     try:
-        points = pointwise_points(scope, sweep)
-    except PinSuspError as exc:
-        reports = [EngineReport("pointwise", note=str(exc))]
-    else:
-        reports = [compare(scope, results, points, "pointwise", tolerance)]
-    try:
-        import mujoco  # noqa: F401
+        __import__(module)
     except ImportError:
-        reports.append(
-            EngineReport(
-                "mujoco",
-                note="MuJoCo is not installed: "
-                "pip install 'pin_susp[validate]' (or pip install mujoco)",
-            )
+        return EngineReport(
+            engine,
+            note=f"{INSTALL[engine]} is not installed: "
+            f"pip install 'pin_susp[validate]' (or pip install {engine})",
         )
-        return results, reports
+    return None
+
+
+def _mujoco_report(scope, sweep, results, mjcf_text, mjcf_source, tolerance) -> EngineReport:
+    from .mjcf import tree_to_mjcf
+
+    missing = _not_installed("mujoco", "mujoco")
+    if missing:
+        return missing
     if mjcf_text is None:
         text, source = tree_to_mjcf(scope.tree), f"the {scope.kind}'s exported MJCF"
     else:
@@ -549,5 +979,18 @@ def validate(
     points, warnings = _mujoco_points(scope, sweep, text, source)
     report = compare(scope, results, points, "mujoco", tolerance)
     report.warnings, report.first_warning = warnings.count, warnings.first
-    reports.append(report)
-    return results, reports
+    return report
+
+
+def _drake_report(scope, sweep, results, urdf_text, urdf_source, tolerance) -> EngineReport:
+    missing = _not_installed("drake", "pydrake.multibody.inverse_kinematics")
+    if missing:
+        return missing
+    if urdf_text is None:
+        text, source = scope.subject.urdf, f"the {scope.kind}'s exported URDF"
+    else:
+        text, source = urdf_text, urdf_source
+    points, warnings = _drake_points(scope, sweep, text, source)
+    report = compare(scope, results, points, "drake", tolerance)
+    report.warnings, report.first_warning = warnings.count, warnings.first
+    return report
