@@ -8,7 +8,7 @@ STAMP := $(VENV)/.installed
 DEMO_DIR ?= demo_output
 GEOMETRIES := $(shell grep -l '^hardpoints:' examples/*.yaml | xargs grep -L '^scope: axle')
 
-.PHONY: demo test fuzz bench urdf lint format clean
+.PHONY: demo test fuzz drake bench urdf lint format clean
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -33,10 +33,16 @@ fuzz: $(STAMP)
 	PIN_SUSP_FUZZ_SEED=$${PIN_SUSP_FUZZ_SEED:-random} \
 	$(BIN)/python -m pytest -q -s tests/test_fuzz.py -k holds
 
+# Drake against pin_susp on every example with every sweep it takes, every step
+# (tests/test_validate_drake.py; `make test` runs a slice of three).
+drake: $(STAMP)
+	PIN_SUSP_DRAKE_ALL=1 $(BIN)/python -m pytest -q tests/test_validate_drake.py
+
 # Speed figures against baselines run in the same process (see README, Performance).
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_sweep.py --json benchmarks/last_run.json
 	$(BIN)/python benchmarks/bench_study.py --full --json benchmarks/last_study_run.json
+	$(BIN)/python benchmarks/bench_validate.py
 
 # Regenerate urdf/ from examples/ (a test fails when they differ).
 urdf: $(STAMP)

@@ -6,8 +6,8 @@ every committed URDF in Drake, Pinocchio and yourdfpy at a solved pose.
 """
 
 import logging
+import os
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -72,6 +72,15 @@ def every_example() -> list[tuple[str, str]]:
 
 
 EVERY = every_example()
+# `make drake` runs every pair (PIN_SUSP_DRAKE_ALL=1); `make test` a slice: a corner with
+# a rack, a fixed toe link, and the axle in roll (each mechanism's columns are checked on
+# short sweeps below)
+SLICE = {
+    ("double_wishbone.yaml", "bump_steer.yaml"),
+    ("fixed_toe_link.yaml", "bump.yaml"),
+    ("axle_front.yaml", "roll.yaml"),
+}
+RUN = EVERY if os.environ.get("PIN_SUSP_DRAKE_ALL") else [p for p in EVERY if p in SLICE]
 
 
 def test_every_example_geometry_is_validated():
@@ -97,7 +106,7 @@ def test_every_example_geometry_is_validated():
     }
 
 
-@pytest.mark.parametrize(("geometry", "sweep"), EVERY, ids=[f"{g[:-5]}-{s[:-5]}" for g, s in EVERY])
+@pytest.mark.parametrize(("geometry", "sweep"), RUN, ids=[f"{g[:-5]}-{s[:-5]}" for g, s in RUN])
 def test_validate_engine_drake_agrees_on_every_example(geometry, sweep, capsys):
     """Every step of the full sweep, every column within 1e-6 mm/deg (the instant
     centres within 1e-9 of their size); exit 0."""
@@ -532,23 +541,3 @@ def test_forward_kinematics_of_drake_pinocchio_and_yourdfpy_agree(name):
         wb = data.oMf[model.getFrameId(b)].act(pb)
         if spec.kind == "ball":
             assert np.linalg.norm(wa - wb) < 1e-12
-
-
-# -- speed ------------------------------------------------------------------------------
-
-
-def test_a_41_step_sweep_validates_with_drake_within_10_s(capsys):
-    start = time.perf_counter()
-    code = main(
-        [
-            "validate",
-            str(EXAMPLES / "double_wishbone.yaml"),
-            str(EXAMPLES / "bump_steer.yaml"),
-            "--engine",
-            "drake",
-        ]
-    )
-    elapsed = time.perf_counter() - start
-    out = capsys.readouterr().out
-    assert code == 0 and out.startswith("example corner: 41 steps of")
-    assert elapsed < 10.0, elapsed
