@@ -1665,6 +1665,8 @@ def _study(args) -> int:
             "--workers sizes the local cluster: a scheduler has its own workers, and "
             "--scheduler none runs in this process"
         )
+    if args.output.strip() == "":
+        raise PinSuspError("the output directory's path is empty: give -o OUTDIR")
     study = studies.load_study(args.study)
     out = Path(args.output)
     started = time.perf_counter()
@@ -1697,7 +1699,8 @@ def _study(args) -> int:
         return 128 + signal_number
     seconds = time.perf_counter() - started
     variants = outcome.variants
-    written = [out / "variants.parquet"] + ([out / "steps.parquet"] if args.steps else [])
+    written = [out / "variants.parquet"]
+    written += [out / "steps.parquet"] if (out / "steps.parquet").exists() else []
     written += [p for p in (outcome.best, outcome.figure) if p is not None]
     if outcome.figure is None:
         print(f"pin-susp: no variant converged: {out / 'study.png'} not drawn", file=sys.stderr)

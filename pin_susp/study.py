@@ -38,6 +38,7 @@ DOE_METHODS = ("full_factorial", "latin_hypercube", "sobol")
 DISTRIBUTIONS = ("normal", "uniform")
 AXES = "xyz"
 MAX_VARIANTS = 10_000_000  # a typo's 10^9 samples stops at the file, not in memory
+MAX_VALUES = 50_000_000  # variants × variables: the variants' table, 400 MB
 STUDY_KEYS = (
     "version",
     "name",
@@ -89,6 +90,26 @@ class Term:
     target: float | None = None
     curve_x: str | None = None  # the column the curve is over (e.g. wheel_travel)
     curve: np.ndarray | None = None  # (k, 2): x, metric, sorted by x
+
+    def goal(self, x) -> np.ndarray | float:
+        """The target at the curve's x: linear between its points, and beyond them
+        along the first and last segments."""
+        if self.curve is None:
+            return self.target
+        x = np.asarray(x, dtype=float)
+        return self.curve[:, 1][self._segment(x)] + self.slope(x) * (
+            x - self.curve[:, 0][self._segment(x)]
+        )
+
+    def slope(self, x) -> np.ndarray:
+        """d goal / d x: the slope of the segment that x falls in (the end ones beyond)."""
+        k = self._segment(np.asarray(x, dtype=float))
+        c = self.curve
+        return (c[k + 1, 1] - c[k, 1]) / (c[k + 1, 0] - c[k, 0])
+
+    def _segment(self, x: np.ndarray) -> np.ndarray:
+        inner = self.curve[1:-1, 0]
+        return np.searchsorted(inner, np.nan_to_num(x), side="right")
 
 
 @dataclass
@@ -237,7 +258,16 @@ def load_study(source: str | Path) -> Study:
         design.check_column(r.text(m, f"summary[{i}]"), f"summary[{i}]", r)
     study.summary = list(dict.fromkeys(summary))
     if "batch_size" in data:
+        if kind == "optimise":
+            r.fail("batch_size", "an optimisation runs one start per task: no batch_size")
         study.batch_size = _count(data["batch_size"], "batch_size", r)
+    size = study.samples * max(1, len(variables))
+    if size > MAX_VALUES:
+        r.fail(
+            kind,
+            f"{study.samples} variants x {len(variables)} variables is beyond the "
+            f"{MAX_VALUES:.0e} values a study holds in memory: fewer samples or variables",
+        )
     return study
 
 
@@ -252,7 +282,10 @@ def _count(value, key: str, r: Reader, minimum: int = 1) -> int:
 
 
 def _seed(block: dict, key: str, r: Reader) -> int:
-    return _count(block.get("seed", 1), f"{key}.seed", r, minimum=0)
+    value = block.get("seed", 1)
+    if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value < 2**32:
+        r.fail(f"{key}.seed", f"expected a whole number from 0 to 2^32 - 1, got {value!r}")
+    return value
 
 
 class _Design:
@@ -277,6 +310,15 @@ class _Design:
             self.results = subject.run_sweep(_at_design(self.sweep))
             self.points = {None: list(subject.geometry.hardpoints)}
         self.columns = [c for c in self.results.columns if c != "step_index"]
+
+    def check_defined(self, name: str, key: str, r: Reader) -> None:
+        """A target's column must have a value at the design state (not a blank cell)."""
+        if not np.isfinite(np.asarray(self.results[name], dtype=float)[0]):
+            r.fail(
+                key,
+                f"{name} is undefined at this geometry's design state (a blank cell in "
+                "the sweep's CSV): it cannot be a target",
+            )
 
     def check_column(self, name: str, key: str, r: Reader) -> None:
         if name not in self.columns:
@@ -342,6 +384,7 @@ def _terms(raw, design: _Design, r: Reader) -> list[Term]:
         )
         metric = r.text(t["metric"], f"{key}.metric")
         design.check_column(metric, f"{key}.metric", r)
+        design.check_defined(metric, f"{key}.metric", r)
         weight = r.positive(t.get("weight", 1.0), f"{key}.weight")
         relative = t.get("relative", False)
         if not isinstance(relative, bool):
@@ -356,6 +399,7 @@ def _terms(raw, design: _Design, r: Reader) -> list[Term]:
         c = r.mapping(t["curve"], f"{key}.curve", required=("x", "points"))
         x = r.text(c["x"], f"{key}.curve.x")
         design.check_column(x, f"{key}.curve.x", r)
+        design.check_defined(x, f"{key}.curve.x", r)
         pts = c["points"]
         if not isinstance(pts, list) or len(pts) < 2:
             r.fail(f"{key}.curve.points", "expected two or more [x, value] pairs")
@@ -568,21 +612,35 @@ def objective_residuals(terms: list[Term], results, static) -> np.ndarray:
     a weighted RMS in the metrics' units. A step that did not converge counts as a
     miss of 1000 units (no number is made up for it)."""
     n = len(results)
-    ok = results["solver_converged"]
-    total = sum(t.weight for t in terms) * n
     parts = []
-    for t in terms:
+    for t, w in zip(terms, _shares(terms, n), strict=True):
         m = np.asarray(results[t.metric], dtype=float)
         if t.relative:
             m = m - float(static[t.metric][0])
-        goal = (
-            t.target
-            if t.curve is None
-            else np.interp(results[t.curve_x], t.curve[:, 0], t.curve[:, 1])
-        )
-        miss = np.where(ok & np.isfinite(m), m - goal, 1000.0)
-        parts.append(math.sqrt(t.weight / total) * miss)
+        goal = t.goal(results[t.curve_x]) if t.curve is not None else t.target
+        miss = np.where(_counted(t, results, m, goal), m - goal, MISS)
+        parts.append(w * miss)
     return np.concatenate(parts)
+
+
+MISS = 1000.0  # a step's miss where it has no value (did not converge, undefined)
+
+
+def _shares(terms: list[Term], n: int) -> list[float]:
+    """√(w / Σw·n) per term: the residuals' weights (Σw taken in ratios: no overflow)."""
+    largest = max(t.weight for t in terms)
+    total = sum(t.weight / largest for t in terms) * n
+    return [math.sqrt(t.weight / largest / total) for t in terms]
+
+
+def _counted(t: Term, results, m, goal) -> np.ndarray:
+    """The steps whose miss is a number: converged, the metric and the target defined."""
+    return results["solver_converged"] & np.isfinite(m) & np.isfinite(goal)
+
+
+def _missed(terms: list[Term], n: int) -> np.ndarray:
+    """The residuals of a variant that could not be built: every step missed."""
+    return np.concatenate([np.full(n, w * MISS) for w in _shares(terms, n)])
 
 
 def run_batch(job: Job, index: int, ids: np.ndarray, table: np.ndarray, steps: bool) -> dict:
@@ -622,7 +680,7 @@ def run_start(job: Job, index: int, ids: np.ndarray, table: np.ndarray, steps: b
     def fun(x):
         v = solved(x)
         if v.results is None:
-            return np.full(len(job.terms) * sweep.steps, 1000.0)
+            return _missed(job.terms, sweep.steps)
         return v.residuals()
 
     def jac(x):
@@ -653,7 +711,7 @@ def run_start(job: Job, index: int, ids: np.ndarray, table: np.ndarray, steps: b
 def objective_jacobian(v: Variant, sweep) -> np.ndarray:
     """d r / d variables from the exact hardpoint sensitivities at every step and at
     design (a relative term's reference moves too); a curve's target moves with its
-    x column. A step that did not converge has a zero row."""
+    x column. A step without a number (see _counted) has a zero row."""
     job = v.job
     k = len(job.variables)
     n = sweep.steps
@@ -661,21 +719,23 @@ def objective_jacobian(v: Variant, sweep) -> np.ndarray:
         return np.zeros((len(job.terms) * n, k))
     at_design, steps = sensitivities(v.subject, sweep, v.results, job.axle)
     columns = _columns(at_design.hardpoints, job.variables)
-    ok = v.results["solver_converged"]
-    total = sum(t.weight for t in job.terms) * n
     blocks = []
-    for t in job.terms:
+    for t, w in zip(job.terms, _shares(job.terms, n), strict=True):
+        m = np.asarray(v.results[t.metric], dtype=float)
+        if t.relative:
+            m = m - float(v.static[t.metric][0])
+        goal = t.goal(v.results[t.curve_x]) if t.curve is not None else t.target
+        counted = _counted(t, v.results, m, goal)
         rows = np.zeros((n, k))
         ref = _pick(at_design, t.metric, columns) if t.relative else 0.0
         for i, s in steps.items():
+            if not counted[i]:
+                continue
             d = _pick(s, t.metric, columns) - ref
-            if t.curve is not None:
-                x = v.results[t.curve_x][i]
-                slope = np.interp(x, t.curve[:, 0], np.gradient(t.curve[:, 1], t.curve[:, 0]))
-                if t.curve_x in s.values:
-                    d = d - slope * _pick(s, t.curve_x, columns)
-            rows[i] = d if ok[i] else 0.0
-        blocks.append(math.sqrt(t.weight / total) * rows)
+            if t.curve is not None and t.curve_x in s.values:
+                d = d - t.slope(v.results[t.curve_x][i]) * _pick(s, t.curve_x, columns)
+            rows[i] = d
+        blocks.append(w * rows)
     return np.vstack(blocks)
 
 
@@ -873,8 +933,8 @@ def run_study(
 
 
 def _run(study, outdir, client, steps, resume, progress, dashboard) -> Outcome:
-    parts = _prepare(study, outdir, steps, resume)
     table = variant_table(study)
+    parts = _prepare(study, outdir, steps, resume)
     cut = batches(study)
     todo = [i for i in range(len(cut)) if not (parts / f"variants-{i:06d}.parquet").exists()]
     job = study.job()
@@ -906,9 +966,9 @@ def _run(study, outdir, client, steps, resume, progress, dashboard) -> Outcome:
             table = table.append_column(f"{name}_linear", pa.array(values, from_pandas=True))
         outcome.variants = variants = table.to_pandas()
     curves = None
-    if study.kind == "optimise":
+    if study.kind == "optimise" and variants["converged"].any():
         best = best_deltas(study, variants)
-        row = variants.sort_values("objective").iloc[0]
+        row = variants[variants["converged"]].sort_values("objective").iloc[0]
         comment = (
             f"generated by pin_susp {__version__}: the best of {len(variants)} starts of "
             f"{Path(study.source).name} (objective {float(row['objective']):.6g}, start "
@@ -977,19 +1037,13 @@ class _client:
             )
             self.client = Client(self.cluster)
             return self.client
-        if not self.scheduler.startswith(("tcp://", "tls://", "inproc://", "ucx://", "ws://")):
+        if not self.scheduler.startswith("tcp://"):
             raise PinSuspError(
                 f"--scheduler {self.scheduler}: expected an address like tcp://HOST:PORT, "
                 "'local' or 'none'"
             )
         _reachable(self.scheduler)
-        try:
-            self.client = Client(self.scheduler, timeout="10s")
-        except (OSError, TimeoutError) as exc:
-            raise PinSuspError(
-                f"--scheduler {self.scheduler}: no Dask scheduler answered within 10 s "
-                f"({type(exc).__name__})"
-            ) from None
+        self.client = _connect(Client, self.scheduler, seconds=8.0)  # an answer in < 10 s
         if self.workers is not None:
             raise PinSuspError("--workers is for the local cluster; a scheduler has its own")
         return self.client
@@ -999,6 +1053,31 @@ class _client:
             self.client.close()
         if self.cluster is not None:
             self.cluster.close()
+
+
+def _connect(client_class, address: str, seconds: float):
+    """A Client of the scheduler at ``address``, or one clear error within ``seconds``
+    (a port that accepts and never speaks Dask would otherwise hold the handshake)."""
+    import threading
+
+    box = {}
+
+    def connect() -> None:
+        try:
+            box["client"] = client_class(address, timeout=f"{seconds:g}s")
+        except BaseException as exc:  # reported below, in the caller's thread
+            box["error"] = exc
+
+    thread = threading.Thread(target=connect, daemon=True, name="pin-susp-connect")
+    thread.start()
+    thread.join(seconds + 1.0)
+    if "client" in box:
+        return box["client"]
+    why = "no answer" if thread.is_alive() else type(box.get("error")).__name__
+    raise PinSuspError(
+        f"--scheduler {address}: no Dask scheduler answered within {seconds:g} s ({why}): "
+        "is it a Dask scheduler's address?"
+    )
 
 
 def _reachable(address: str) -> None:
@@ -1099,10 +1178,16 @@ def _check_outdir(study: Study, outdir: Path, steps: bool, resume: bool) -> dict
         try:
             theirs = json.loads(manifest.read_text())
         except (OSError, ValueError):
-            raise PinSuspError(
-                f"{outdir}/{MANIFEST}: unreadable: not a study's directory"
-            ) from None
+            theirs = None
+        if not isinstance(theirs, dict):
+            raise PinSuspError(f"{manifest}: unreadable: not a study's directory")
         differs = [k for k in mine if k not in INFORMATION and theirs.get(k) != mine[k]]
+        if differs == ["steps"]:
+            how = "with" if theirs.get("steps") else "without"
+            raise PinSuspError(
+                f"{outdir}: holds a run of this study made {how} --steps: run it {how} "
+                "--steps, or give a new or empty directory"
+            )
         if differs:
             what = theirs.get("study", "another study")
             raise PinSuspError(
@@ -1183,7 +1268,7 @@ def _assemble(study: Study, outdir: Path, parts: Path, n: int, steps: bool):
         "variables": json.dumps([v.__dict__ for v in study.variables]),
     }
     variants = variants.replace_schema_metadata(meta)
-    if steps:
+    if steps and any(parts.glob("steps-*.parquet")):  # (no variant solved: no steps)
         folder = outdir / "steps.parquet"
         folder.mkdir(exist_ok=True)
         for i in range(n):
@@ -1346,7 +1431,7 @@ def _constant(x: np.ndarray) -> bool:
 
 
 def _optimise_lines(study: Study, variants, curves=None) -> list[str]:
-    order = variants.sort_values("objective")
+    order = variants.sort_values(["converged", "objective"], ascending=[False, True])
     lines = ["  start  objective at start -> found  evaluations"]
     for _, row in variants.iterrows():
         lines.append(
@@ -1380,8 +1465,8 @@ def _unit(column: str) -> str:
 
 
 def best_deltas(study: Study, variants) -> np.ndarray:
-    """The variables of the start with the least objective."""
-    best = variants.sort_values("objective").iloc[0]
+    """The variables of the converged start with the least objective."""
+    best = variants[variants["converged"]].sort_values("objective").iloc[0]
     return np.array([best[v.name] for v in study.variables], dtype=float)
 
 
@@ -1425,7 +1510,7 @@ def curves_of(study: Study, deltas) -> list[dict]:
             entry[f"{label}_target"] = (
                 np.full(len(y), t.target)
                 if t.curve is None
-                else np.interp(v.results[x_name], t.curve[:, 0], t.curve[:, 1])
+                else t.goal(np.asarray(v.results[x_name], dtype=float))
             )
         out.append(entry)
     return out

@@ -375,6 +375,16 @@ def test_objective_jacobian_is_the_derivative_of_the_residuals(tmp_path):
                     "curve": {"x": "wheel_travel", "points": [[-30, -1.5], [30, -2.5]]},
                     "weight": 2,
                 },
+                # over a column that the hardpoints move, with points inside the sweep's
+                # range: three segments and both ends extended
+                {
+                    "metric": "scrub_radius",
+                    "curve": {
+                        "x": "half_track",
+                        "points": [[959.6, -39], [959.9, -40], [960.1, -38]],
+                    },
+                    "weight": 0.5,
+                },
             ]
         },
     }
@@ -395,7 +405,11 @@ def test_objective_jacobian_is_the_derivative_of_the_residuals(tmp_path):
         ],
         axis=1,
     )
-    assert np.abs(exact - central).max() < 1e-7 * np.abs(central).max() + 1e-12
+    n = 21
+    for k in range(3):  # each term's block against its own scale
+        rows = slice(n * k, n * k + n)
+        scale = np.abs(central[rows]).max()
+        assert scale > 0 and np.abs(exact[rows] - central[rows]).max() < 1e-6 * scale
 
 
 # ---------------------------------------------------------------- bad input
@@ -599,3 +613,92 @@ def test_resume_finishes_a_run_cut_short_whatever_the_path_spelling(tmp_path, mo
     reference = run_study(load_study(path), tmp_path / "reference", scheduler=None)
     pd.testing.assert_frame_equal(resumed.variants, reference.variants, check_exact=True)
     assert finished_batches(tmp_path / "o") is None  # finished: nothing left to resume
+
+
+def test_a_curve_target_extends_its_end_segments():
+    from pin_susp.study import Term
+
+    t = Term("camber", curve_x="wheel_travel", curve=np.array([[-10, -0.5], [0, -1.0], [25, -2.5]]))
+    assert t.goal(np.array([-30.0, -10.0, -5.0, 0.0, 10.0, 25.0, 35.0])) == pytest.approx(
+        [0.5, -0.5, -0.75, -1.0, -1.6, -2.5, -3.1]
+    )
+    assert t.slope(np.array([-30.0, 5.0, 40.0])) == pytest.approx([-0.05, -0.06, -0.06])
+
+
+def test_a_silent_port_is_not_a_scheduler_and_says_so_within_10_s(tmp_path, capsys):
+    import socket
+    import threading
+    import time
+
+    server = socket.socket()
+    server.bind(("127.0.0.1", 0))
+    server.listen()
+    accepted = []
+    threading.Thread(target=lambda: accepted.append(server.accept()), daemon=True).start()
+    address = f"tcp://127.0.0.1:{server.getsockname()[1]}"
+    try:
+        started = time.monotonic()
+        code, _, err = run_cli(
+            ["study", write_study(tmp_path, LHS), "-o", tmp_path / "o", "--scheduler", address],
+            capsys,
+        )
+        elapsed = time.monotonic() - started
+    finally:
+        for connection, _ in accepted:
+            connection.close()
+        server.close()
+    assert code == 2 and err.count("\n") == 1
+    assert f"--scheduler {address}: no Dask scheduler answered within 8 s" in err
+    assert elapsed < 10.0
+    assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        (
+            {
+                "kind": "optimise",
+                "optimise": {"objective": [{"metric": "anti_dive", "target": 0}]},
+                "doe": None,
+                "batch_size": None,
+            },
+            "optimise.objective[0].metric: anti_dive is undefined at this geometry's design",
+        ),
+        (
+            {
+                "kind": "optimise",
+                "optimise": {"objective": [{"metric": "camber", "target": 0}]},
+                "doe": None,
+            },
+            "batch_size: an optimisation runs one start per task",
+        ),
+        ({"doe": {"method": "sobol", "samples": 4, "seed": 2**32}}, "doe.seed: expected a whole"),
+        (
+            {
+                "variables": {"all_hardpoints": {"tolerance": 1}},
+                "doe": {"method": "sobol", "samples": 2_000_000},
+            },
+            "doe: 2000000 variants x 30 variables is beyond",
+        ),
+    ],
+)
+def test_more_bad_study_files(tmp_path, capsys, change, message):
+    body = {k: v for k, v in (dict(LHS) | change).items() if v is not None}
+    code, _, err = run_cli(["study", write_study(tmp_path, body), "-o", tmp_path / "o"], capsys)
+    assert code == 2 and err.count("\n") == 1 and message in err, err
+    assert not (tmp_path / "o").exists()
+
+
+def test_a_large_seed_and_an_empty_output_path(tmp_path, capsys):
+    body = dict(LHS) | {"doe": {"method": "latin_hypercube", "samples": 2, "seed": 123456789}}
+    path = write_study(tmp_path, body)
+    assert (
+        run_cli(["study", path, "-o", tmp_path / "o", "--scheduler", "none", "-q"], capsys)[0] == 0
+    )
+    code, _, err = run_cli(["study", path, "-o", "", "--scheduler", "none"], capsys)
+    assert code == 2 and "the output directory's path is empty" in err
+    (tmp_path / "bad").mkdir()
+    (tmp_path / "bad" / "study.json").write_text("[1, 2]")
+    code, _, err = run_cli(["study", path, "-o", tmp_path / "bad", "--resume"], capsys)
+    assert code == 2 and "study.json: unreadable: not a study's directory" in err
