@@ -124,6 +124,9 @@ class Geometry:
     spring_rate: float | None = None
     spring_preload: float = 0.0
     opposite_axle_axis_height: float | None = None  # m, config (read, for the axle's pitch)
+    # config.inertia, for the URDF's and MJCF's masses (None: the defaults, docs/urdf.md)
+    density: float | None = None  # kg/m³ of the drawn links and joints
+    wheel_mass: float | None = None  # kg: rim, tyre, hub and brake
     source: str = "<dict>"
     sha256: str | None = None
     data: dict = field(default_factory=dict, repr=False)
@@ -331,6 +334,7 @@ def _parse(data: dict, r: Reader, sha: str | None) -> Geometry:
             "setup",
             "strut",
             "opposite_axle_axis_height",
+            "inertia",
         ),
     )
     for key, why in mech.FORBIDDEN.items():
@@ -394,6 +398,7 @@ def _parse(data: dict, r: Reader, sha: str | None) -> Geometry:
     mech.prepare(hardpoints, options, r)
     adjusters = _setup_block(config.get("setup", {}), actuation, mech.steering_points(options), r)
 
+    density, wheel_mass = _inertia(config.get("inertia", {}), r)
     cg = config.get("cg_position")
     bias = config.get("front_brake_bias")
     height = config.get("opposite_axle_axis_height")
@@ -435,10 +440,31 @@ def _parse(data: dict, r: Reader, sha: str | None) -> Geometry:
         opposite_axle_axis_height=(
             None if height is None else r.length(height, "config.opposite_axle_axis_height") * MM
         ),
+        density=density,
+        wheel_mass=wheel_mass,
         source=r.source,
         sha256=sha,
         data=data,
     )
+
+
+# beyond these a value is a unit slip, not a part: kg/m³ (osmium is 22 590), kg
+INERTIA_LIMITS = {"density": 30000.0, "wheel_mass": 1000.0}
+
+
+def _inertia(value, r: Reader) -> tuple[float | None, float | None]:
+    """config.inertia: the density (kg/m³) of the drawn links and joints and the wheel's
+    mass (kg), each None when not given (the exports' defaults then)."""
+    s = r.mapping(value, "config.inertia", optional=tuple(INERTIA_LIMITS))
+    out = []
+    for name, limit in INERTIA_LIMITS.items():
+        key = f"config.inertia.{name}"
+        x = None if name not in s else r.positive(s[name], key)
+        if x is not None and x > limit:
+            unit_text = "kg/m³" if name == "density" else "kg"
+            r.fail(key, f"{x:g} {unit_text} is beyond {limit:g} {unit_text}: a unit slip?")
+        out.append(x)
+    return out[0], out[1]
 
 
 def _strut(value, r: Reader) -> dict:

@@ -18,7 +18,8 @@ Each module has:
 - ``prepare(p, o, r)``: check the points (one clear error each), then ``settle``;
 - ``settle(p)``: hardpoints that others place (the MacPherson clamp on its
   strut line); runs on jet.Duals too;
-- ``tree(g)``: bodies, joints, points, closures, visuals (a urdf.Tree);
+- ``tree(g)``: bodies, joints, points, closures, visuals (a urdf.Tree), and
+  what robotics tools read beside them (``robot(g)`` below);
 - ``kingpin(ps)``: (lower, upper) points of the steering axis, or None;
 - ``instant_planes(ps)``: two planes (normal, point) whose line is the instant
   axis, or None (then the bump twist gives the instant centres);
@@ -38,7 +39,7 @@ from types import ModuleType
 import numpy as np
 
 from ..geometry import unit
-from ..urdf import Joint, Visual
+from ..urdf import DAMPER, DENSITY, Joint, Spring, Visual
 
 MATERIALS = {
     "chassis": (0.35, 0.35, 0.38, 1.0),
@@ -93,6 +94,40 @@ def get(name: str) -> ModuleType:
 def pivot(name: str, front: str, rear: str, p: dict[str, np.ndarray]) -> Joint:
     """A revolute joint about the line front → rear (two chassis pickups)."""
     return Joint(name, "revolute", p[front], unit(p[rear] - p[front]), (front, rear))
+
+
+def robot(g) -> dict:
+    """The Tree's fields beyond the kinematics: the masses' density and the wheel's
+    mass (config.inertia), the spring and damper (SI: a coilover's N/m, N and N·s/m; a
+    torsion bar, twisted by the rocker, N·m/rad, N·m and N·m·s/rad — its damper is a
+    coilover's on the rocker's arm to the pushrod) and the corner's description for
+    <pin_susp:corner>."""
+    spring = None
+    rate = g.spring_rate
+    if g.spring == "coilover":
+        rate = None if rate is None else rate * 1e3
+        ends = ("strut_top", "strut_bottom")
+        spring = Spring("coilover", ends, rate, g.spring_preload, DAMPER)
+    elif g.spring == "torsion_bar":
+        rate = None if rate is None else rate * 180.0 / np.pi
+        p = g.hardpoints
+        foot = axis_foot(p["rocker_axis_a"], p["rocker_axis_b"], p["pushrod_inboard"])
+        arm = float(np.linalg.norm(p["pushrod_inboard"] - foot))
+        spring = Spring("torsion_bar", ("rocker_pivot",), rate, g.spring_preload, DAMPER * arm**2)
+    metadata = {
+        "mechanism": g.type,
+        "side": g.side,
+        "wheel_link": g.mechanism.WHEEL_BODY,
+        "tyre_radius": repr(g.wheel.radius),
+        "tyre_width": repr(g.wheel.section_width),
+        "design": "as_set" if g.drawn is not None else "as_drawn",
+    }
+    return {
+        "density": DENSITY if g.density is None else g.density,
+        "wheel_mass": g.wheel_mass,
+        "spring": spring,
+        "metadata": metadata,
+    }
 
 
 def rack_joint(p: dict[str, np.ndarray], inner: str) -> Joint:

@@ -29,6 +29,7 @@ from . import (
     pivot,
     rack_joint,
     rack_rod,
+    robot,
     visuals,
     wheel_mounts,
     xml_name,
@@ -245,6 +246,7 @@ def tree(g) -> Tree:
         closures=closures,
         visuals=_visuals(g, p, body_of),
         materials=MATERIALS,
+        **robot(g),
     )
 
 

@@ -22,7 +22,17 @@ import numpy as np
 
 from ..geometry import AXLE_POINTS, STEERING_POINTS, unit
 from ..urdf import Body, Closure, Joint, Tree
-from . import MATERIALS, Pointwise, pivot, rack_joint, rack_rod, visuals, wheel_mounts, xml_name
+from . import (
+    MATERIALS,
+    Pointwise,
+    pivot,
+    rack_joint,
+    rack_rod,
+    robot,
+    visuals,
+    wheel_mounts,
+    xml_name,
+)
 from .double_wishbone import arm_off_axis, arm_plane, distinct, steering_arm, steering_link
 
 NAME = "macpherson"
@@ -171,6 +181,7 @@ def tree(g) -> Tree:
         closures=closures,
         visuals=visuals(g, p, body_of, rods, {"lower_wishbone": "wishbone"}),
         materials=MATERIALS,
+        **robot(g),
     )
 
 

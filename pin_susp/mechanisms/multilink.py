@@ -32,6 +32,7 @@ from . import (
     common_perpendicular_midpoint,
     rack_joint,
     rack_rod,
+    robot,
     visuals,
     wheel_mounts,
     xml_name,
@@ -192,6 +193,7 @@ def tree(g) -> Tree:
         closures=closures,
         visuals=visuals(g, p, body_of, rods, {TREE_LINK: "wishbone"}),
         materials=MATERIALS,
+        **robot(g),
     )
 
 

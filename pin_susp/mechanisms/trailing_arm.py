@@ -16,7 +16,16 @@ import numpy as np
 
 from ..geometry import AXLE_POINTS, COILOVER_POINTS
 from ..urdf import Body, Tree
-from . import MATERIALS, Pointwise, axis_foot, pivot, visuals, wheel_mounts, xml_name
+from . import (
+    MATERIALS,
+    Pointwise,
+    axis_foot,
+    pivot,
+    robot,
+    visuals,
+    wheel_mounts,
+    xml_name,
+)
 from .double_wishbone import distinct, off_axis
 
 NAME = "trailing_arm"
@@ -93,6 +102,7 @@ def tree(g) -> Tree:
         closures=[],
         visuals=visuals(g, p, body_of, rods, {"trailing_arm": "wishbone"}),
         materials=MATERIALS,
+        **robot(g),
     )
 
 
