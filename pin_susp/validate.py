@@ -357,16 +357,9 @@ class MujocoCorner:
             detail = " ".join(str(exc).split())
             raise PinSuspError(f"{source}: MuJoCo cannot load it: {detail}") from None
         self.data = mujoco.MjData(self.model)
-        self.sites = {name: _Site(self, name, source) for name in scope.sites}
-        for prefix, (radius, body) in scope.wheels.items():
-            self.sites[f"{prefix}contact_patch_center"] = ContactPatchPoint(
-                f"{prefix}contact_patch_center",
-                self.sites[f"{prefix}wheel_center"],
-                self.sites[f"{prefix}axle_inboard"],
-                self.sites[f"{prefix}axle_outboard"],
-                radius,
-                body,
-            )
+        self.sites = _with_contact_patches(
+            {name: _Site(self, name, source) for name in scope.sites}, scope
+        )
 
     def _rows(self, targets) -> tuple[list, list]:
         """Each target's residual and its row of d residual / dv (chain rule through
@@ -419,6 +412,21 @@ class MujocoCorner:
             out[name] = np.full((k, 3), np.nan)
             out[name][: len(held)] = (site.jacobian(self) @ dv).T
         return out
+
+
+def _with_contact_patches(sites: dict, scope) -> dict:
+    """An engine's points with each wheel's contact patch (from its wheel centre and
+    spin axis, as pin_susp's), named ``<prefix>contact_patch_center``."""
+    for prefix, (radius, body) in scope.wheels.items():
+        sites[f"{prefix}contact_patch_center"] = ContactPatchPoint(
+            f"{prefix}contact_patch_center",
+            sites[f"{prefix}wheel_center"],
+            sites[f"{prefix}axle_inboard"],
+            sites[f"{prefix}axle_outboard"],
+            radius,
+            body,
+        )
+    return sites
 
 
 class _Warnings:
@@ -614,16 +622,9 @@ class DrakeCorner:
                 raise PinSuspError(f"{source}: is not the URDF of this geometry: no link {name}")
             return plant.GetFrameByName(name)
 
-        self.sites = {name: _DrakePoint(frame(name)) for name in scope.sites}
-        for prefix, (radius, body) in scope.wheels.items():
-            self.sites[f"{prefix}contact_patch_center"] = ContactPatchPoint(
-                f"{prefix}contact_patch_center",
-                self.sites[f"{prefix}wheel_center"],
-                self.sites[f"{prefix}axle_inboard"],
-                self.sites[f"{prefix}axle_outboard"],
-                radius,
-                body,
-            )
+        self.sites = _with_contact_patches(
+            {name: _DrakePoint(frame(name)) for name in scope.sites}, scope
+        )
         self.closures = []
         try:
             specs = read_closures(urdf_text)

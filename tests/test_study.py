@@ -358,8 +358,28 @@ def test_bump_steer_optimisation_flattens_toe_and_best_yaml_reproduces_it(tmp_pa
     assert best["start_objective"] > 20 * best["objective"]
 
 
-def test_objective_jacobian_is_the_derivative_of_the_residuals(tmp_path):
+def assert_exact_jacobian(study, sweep, x: np.ndarray, h: float = 1e-4) -> None:
+    """The optimiser's Jacobian against central differences of full solves, each
+    objective term's block of rows against its own scale."""
     from pin_susp.study import Variant, objective_jacobian
+
+    job = study.job()
+    exact = objective_jacobian(Variant(job, x, sweep), sweep)
+
+    def residuals(at):
+        return Variant(job, at, sweep).residuals()
+
+    central = np.stack(
+        [(residuals(x + h * e) - residuals(x - h * e)) / (2 * h) for e in np.eye(len(x))], axis=1
+    )
+    n = sweep.steps
+    for k in range(len(study.terms)):
+        rows = slice(n * k, n * k + n)
+        scale = np.abs(central[rows]).max()
+        assert scale > 0 and np.abs(exact[rows] - central[rows]).max() < 1e-6 * scale, k
+
+
+def test_objective_jacobian_is_the_derivative_of_the_residuals(tmp_path):
 
     body = {
         "variables": [
@@ -389,27 +409,7 @@ def test_objective_jacobian_is_the_derivative_of_the_residuals(tmp_path):
         },
     }
     study = load_study(write_study(tmp_path, body))
-    job = study.job()
-    sweep = load_sweep(BUMP)
-    x = np.array([3.0, -2.0])
-    exact = objective_jacobian(Variant(job, x, sweep), sweep)
-    h = 1e-4
-    central = np.stack(
-        [
-            (
-                Variant(job, x + h * e, sweep).residuals()
-                - Variant(job, x - h * e, sweep).residuals()
-            )
-            / (2 * h)
-            for e in np.eye(2)
-        ],
-        axis=1,
-    )
-    n = 21
-    for k in range(3):  # each term's block against its own scale
-        rows = slice(n * k, n * k + n)
-        scale = np.abs(central[rows]).max()
-        assert scale > 0 and np.abs(exact[rows] - central[rows]).max() < 1e-6 * scale
+    assert_exact_jacobian(study, load_sweep(BUMP), np.array([3.0, -2.0]))
 
 
 # ---------------------------------------------------------------- bad input
@@ -517,7 +517,6 @@ def test_summary_prints_spread_and_files(tmp_path, capsys):
 def test_an_axle_objective_jacobian_is_exact_and_roll_sweeps_are_refused(tmp_path, capsys):
     """On an axle's sweep of both wheel heights and the rack, the optimiser's Jacobian
     (one-sided sensitivities) against central differences of full solves."""
-    from pin_susp.study import Variant, objective_jacobian
 
     sweep = {
         "version": 1,
@@ -568,25 +567,7 @@ def test_an_axle_objective_jacobian_is_exact_and_roll_sweeps_are_refused(tmp_pat
         "summary": ["roadwheel_angle_left"],
     }
     study = load_study(write_study(tmp_path, body))
-    job, sweep = study.job(), load_sweep(tmp_path / "sweep.yaml")
-    x = np.array([1.0, -2.0])
-    exact = objective_jacobian(Variant(job, x, sweep), sweep)
-    h = 1e-4
-    central = np.stack(
-        [
-            (
-                Variant(job, x + h * e, sweep).residuals()
-                - Variant(job, x - h * e, sweep).residuals()
-            )
-            / (2 * h)
-            for e in np.eye(2)
-        ],
-        axis=1,
-    )
-    for k in range(3):  # each term's block against its own scale
-        rows = slice(5 * k, 5 * k + 5)
-        scale = np.abs(central[rows]).max()
-        assert scale > 0 and np.abs(exact[rows] - central[rows]).max() < 1e-6 * scale
+    assert_exact_jacobian(study, load_sweep(tmp_path / "sweep.yaml"), np.array([1.0, -2.0]))
     roll = body | {"sweep": str(EXAMPLES / "roll.yaml")}
     code, _, err = run_cli(
         ["study", write_study(tmp_path, roll, "roll.yaml"), "-o", tmp_path / "o"], capsys
