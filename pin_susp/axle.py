@@ -73,7 +73,31 @@ def prefixed(tree: Tree, side: str) -> Tree:
         for c in tree.closures
     ]
     visuals = [replace(v, body=body(v.body)) for v in tree.visuals]
-    return Tree(f"{side}_{tree.name}", bodies, points, closures, visuals, dict(tree.materials))
+    # the spring's ends (two points, or a torsion bar's joint) and the wheel's body
+    springs = [
+        replace(
+            s,
+            side=side,
+            ends=tuple(point(e) if e in tree.points else body(e) for e in s.ends),
+        )
+        for s in tree.springs
+    ]
+    corners = [
+        {**m, "wheel_link": body(m["wheel_link"])} if "wheel_link" in m else dict(m)
+        for m in tree.corners
+    ]
+    return Tree(
+        f"{side}_{tree.name}",
+        bodies,
+        points,
+        closures,
+        visuals,
+        dict(tree.materials),
+        density=tree.density,
+        wheel_mass=tree.wheel_mass,
+        spring=springs,
+        metadata=corners,
+    )
 
 
 def axle_tree(left: Geometry, right: Geometry, name: str = "axle", elements=None) -> Tree:
@@ -90,14 +114,31 @@ def axle_tree(left: Geometry, right: Geometry, name: str = "axle", elements=None
                 bodies.append(b)
                 seen.add(b.name)
     points, closures, visuals, materials = {}, [], [], {}
+    springs, corners = [], []
     for tree in trees.values():
         points |= tree.points
         closures += tree.closures
         visuals += tree.visuals
         materials |= tree.materials
+        springs += tree.springs
+        corners += tree.corners
     if elements is not None:
         _add_elements(elements, bodies, points, closures, visuals, materials)
-    return Tree(name, bodies, points, closures, visuals, materials)
+    # the masses: the left's density and wheel mass (config.inertia is the axle's, so the
+    # sides' are the same); each side's spring and <pin_susp:corner>
+    left_tree = trees["left"]
+    return Tree(
+        name,
+        bodies,
+        points,
+        closures,
+        visuals,
+        materials,
+        density=left_tree.density,
+        wheel_mass=left_tree.wheel_mass,
+        spring=springs,
+        metadata=corners,
+    )
 
 
 def _add_elements(a: AxleGeometry, bodies, points, closures, visuals, materials) -> None:
@@ -311,6 +352,7 @@ AXLE_KEYS = (
     "axle_position",
     "steering",
     "wheel",
+    "inertia",
     "actuation",
     "spring",
     "anti_roll",
@@ -464,7 +506,7 @@ def load_axle(source) -> AxleGeometry:
             optional=("camber_shim", "trackrod_length_delta", "pushrod_length_delta"),
         )
         corner_config = {
-            k: config[k] for k in ("steering", "wheel", "axle_position") if k in config
+            k: config[k] for k in ("steering", "wheel", "axle_position", "inertia") if k in config
         }
         corner_config |= {k: vehicle[k] for k in VEHICLE_KEYS if k in vehicle}
         if "camber_shim" in setup:

@@ -13,9 +13,10 @@ It simulates as written (docs/urdf.md): every body has the URDF's mass and
 inertia (a closure's rod the mass of its drawn rod), every joint the URDF's
 range; gravity is on; the spring is a tendon ``spring`` between its ends (a
 torsion bar: the rocker pivot's stiffness) with the geometry's rate and
-preload, and a damper; the rack is held where ``ctrl`` puts it by the
-position actuator ``steering``; the closures are stiff enough that a corner
-load opens them by micrometres, not millimetres.
+preload, and a damper (an axle's: ``left_spring`` and ``right_spring``); the
+rack is held where ``ctrl`` puts it by the position actuator ``steering``; the
+closures are stiff enough that a corner load opens them by micrometres, not
+millimetres.
 """
 
 from __future__ import annotations
@@ -224,38 +225,39 @@ def _spring(root, element: dict, tree: Tree, steps: list, rates) -> None:
     grows by k per metre of compression), with the damper. A torsion bar: the rocker
     pivot's stiffness k about a reference −s·P/k (s: the sense bump turns it), so that
     it resists bump with P at design, with the damper and the armature that keeps
-    MuJoCo's explicit spring stable."""
-    spring = tree.spring
-    if spring is None:
-        return
-    rate = SPRING_RATE[spring.kind] if spring.rate is None else spring.rate
-    if spring.kind == "coilover":
-        top, bottom = spring.ends
-        length = float(np.linalg.norm(tree.points[bottom][1] - tree.points[top][1]))
-        tendon = ET.SubElement(root, "tendon")
-        el = ET.SubElement(
-            tendon,
-            "spatial",
-            {
-                "name": "spring",
-                "stiffness": _fmt([rate]),
-                "springlength": _fmt([length + spring.preload / rate]),
-                "damping": _fmt([spring.damping]),
-                "width": "0.012",
-                "rgba": _fmt(tree.materials.get("strut", (0.8, 0.15, 0.15, 1.0))),
-            },
-        )
-        ET.SubElement(el, "site", {"site": top})
-        ET.SubElement(el, "site", {"site": bottom})
-        return
-    sense = spring_sense(tree, steps, rates)
-    for joint in root.iter("joint"):
-        if joint.get("name") == spring.ends[0]:
-            joint.set("stiffness", _fmt([rate]))
-            joint.set("springref", _fmt([-sense * spring.preload / rate]))
-            joint.set("damping", _fmt([spring.damping]))
-            armature = rate * (ARMATURE_STEPS * TIMESTEP) ** 2 + 0.5 * spring.damping * TIMESTEP
-            joint.set("armature", _fmt([armature]))
+    MuJoCo's explicit spring stable. An axle's springs: one per side, the tendons
+    ``left_spring`` and ``right_spring`` (or each side's rocker pivot's stiffness)."""
+    tendon = None
+    for spring in tree.springs:
+        rate = SPRING_RATE[spring.kind] if spring.rate is None else spring.rate
+        if spring.kind == "coilover":
+            top, bottom = spring.ends
+            length = float(np.linalg.norm(tree.points[bottom][1] - tree.points[top][1]))
+            if tendon is None:
+                tendon = ET.SubElement(root, "tendon")
+            el = ET.SubElement(
+                tendon,
+                "spatial",
+                {
+                    "name": "spring" if spring.side is None else f"{spring.side}_spring",
+                    "stiffness": _fmt([rate]),
+                    "springlength": _fmt([length + spring.preload / rate]),
+                    "damping": _fmt([spring.damping]),
+                    "width": "0.012",
+                    "rgba": _fmt(tree.materials.get("strut", (0.8, 0.15, 0.15, 1.0))),
+                },
+            )
+            ET.SubElement(el, "site", {"site": top})
+            ET.SubElement(el, "site", {"site": bottom})
+            continue
+        sense = spring_sense(tree, steps, rates, spring)
+        for joint in root.iter("joint"):
+            if joint.get("name") == spring.ends[0]:
+                joint.set("stiffness", _fmt([rate]))
+                joint.set("springref", _fmt([-sense * spring.preload / rate]))
+                joint.set("damping", _fmt([spring.damping]))
+                armature = rate * (ARMATURE_STEPS * TIMESTEP) ** 2 + 0.5 * spring.damping * TIMESTEP
+                joint.set("armature", _fmt([armature]))
 
 
 # what identifies the MJCF of a corner: its named elements, by kind, in this order

@@ -19,7 +19,8 @@ world coordinates at the design state; this module writes it as URDF
   to first order, with a margin (:func:`joint_limits`);
 - ``<pin_susp:corner>``, ``<pin_susp:spring>`` and
   ``<pin_susp:design_configuration>`` say which side, which tyre, which spring
-  and which joint values are the design state.
+  and which joint values are the design state (an axle: a corner and a spring
+  per side, each with its ``side``).
 
 docs/urdf.md has the rules and their numbers.
 """
@@ -137,13 +138,15 @@ class Spring:
     between two points (``ends``: top, bottom; rate N/m, preload N in compression at
     design, damping N·s/m) or a torsion bar twisted by a joint (``ends``: the joint;
     rate N·m/rad, preload N·m resisting bump at design, damping N·m·s/rad). ``rate``
-    None: the geometry gives none."""
+    None: the geometry gives none. ``side``: in an axle, the side whose spring it is
+    (its ends are that side's ``left_…`` names); None in a corner."""
 
     kind: str  # "coilover" | "torsion_bar"
     ends: tuple[str, ...]
     rate: float | None = None
     preload: float = 0.0
     damping: float = 0.0
+    side: str | None = None
 
 
 @dataclass
@@ -156,8 +159,10 @@ class Tree:
     materials: dict[str, tuple[float, float, float, float]] = field(default_factory=dict)
     density: float = DENSITY  # kg/m³ of the drawn links and joints
     wheel_mass: float | None = None  # kg of each tyre cylinder; None: TYRE_DENSITY × volume
-    spring: Spring | None = None
-    metadata: dict[str, str] = field(default_factory=dict)  # <pin_susp:corner>'s attributes
+    # a corner's spring, or an axle's (one per side, each with its ``side``)
+    spring: Spring | list[Spring] | None = None
+    # <pin_susp:corner>'s attributes: a corner's, or an axle's (one per side)
+    metadata: dict[str, str] | list[dict[str, str]] = field(default_factory=dict)
 
     def __post_init__(self):
         # A rod between coincident points (a strut bottom on the rocker axis) has
@@ -167,6 +172,20 @@ class Tree:
             for v in self.visuals
             if v.shape != "rod" or np.linalg.norm(v.end - v.start) > ROD_MIN_LENGTH
         ]
+
+    @property
+    def springs(self) -> list[Spring]:
+        """Every spring: none, the corner's, or an axle's two."""
+        if self.spring is None:
+            return []
+        return [self.spring] if isinstance(self.spring, Spring) else list(self.spring)
+
+    @property
+    def corners(self) -> list[dict[str, str]]:
+        """Every <pin_susp:corner>'s attributes: none, the corner's, or an axle's two."""
+        if isinstance(self.metadata, dict):
+            return [self.metadata] if self.metadata else []
+        return [m for m in self.metadata if m]
 
 
 @dataclass(frozen=True)
@@ -308,16 +327,18 @@ def _inertial(link, mass: float, center: np.ndarray, inertia: np.ndarray, origin
 
 
 def _metadata(robot, tree: Tree, steps: list[Step], rates) -> None:
-    """The corner's side, tyre and spring, and its design configuration (all joints 0)."""
-    if tree.metadata:
-        ET.SubElement(robot, "pin_susp:corner", dict(tree.metadata))
-    spring = tree.spring
-    if spring is not None:
-        attrs = {"type": spring.kind}
+    """The corner's side, tyre and spring (an axle's: each side's), and its design
+    configuration (all joints 0)."""
+    for corner in tree.corners:
+        ET.SubElement(robot, "pin_susp:corner", dict(corner))
+    for spring in tree.springs:
+        attrs = {} if spring.side is None else {"side": spring.side}
+        attrs["type"] = spring.kind
         if spring.kind == "coilover":
             attrs |= {"top": spring.ends[0], "bottom": spring.ends[1]}
         else:
-            attrs |= {"joint": spring.ends[0], "bump": _fmt([spring_sense(tree, steps, rates)])}
+            sense = spring_sense(tree, steps, rates, spring)
+            attrs |= {"joint": spring.ends[0], "bump": _fmt([sense])}
         if spring.rate is not None:
             attrs["rate"] = _fmt([spring.rate])
         attrs["preload"] = _fmt([spring.preload])
@@ -462,15 +483,24 @@ def joint_limits(steps: list[Step], rates) -> dict[str, tuple[float, float]]:
     return out
 
 
-def spring_sense(tree: Tree, steps: list[Step], rates) -> float:
-    """+1 when bump turns a torsion bar's joint positively (the first wheel's rate), else −1."""
-    if tree.spring is None or rates is None:
+def spring_sense(tree: Tree, steps: list[Step], rates, spring: Spring | None = None) -> float:
+    """+1 when bump turns a torsion bar's joint positively, else −1: the rate of
+    ``spring``'s joint (default: the corner's spring) per its wheel's travel — the
+    first wheel's, or in an axle the wheel of the spring's side."""
+    spring = spring if spring is not None else (tree.springs or [None])[0]
+    if spring is None or rates is None:
         return 1.0
     drivers, x = rates
     names = [s.name for s in steps]
-    if tree.spring.ends[0] not in names or "wheel" not in drivers:
+    if spring.ends[0] not in names or "wheel" not in drivers:
         return 1.0
-    return -1.0 if x[names.index(tree.spring.ends[0]), drivers.index("wheel")] < 0.0 else 1.0
+    column = drivers.index("wheel")
+    if spring.side is not None:  # the k-th wheel driver is the k-th wheel centre point
+        wheels = [n for n in tree.points if n == "wheel_center" or n.endswith("_wheel_center")]
+        mine = f"{spring.side}_wheel_center"
+        if mine in wheels:
+            column = [i for i, d in enumerate(drivers) if d == "wheel"][wheels.index(mine)]
+    return -1.0 if x[names.index(spring.ends[0]), column] < 0.0 else 1.0
 
 
 def _visual(link, v: Visual, link_origin: np.ndarray):
