@@ -279,17 +279,11 @@ def check_mjcf(text: str, tree: Tree, source: str = "MJCF") -> None:
 
 
 def _mjcf_problem(text: str, tree: Tree) -> str | None:
-    if not text.strip():
-        return "is empty: expected the MJCF written by pin-susp mjcf"
-    if "\x00" in text or "\ufffd" in text:
-        return "is not a text file: expected the MJCF (XML) written by pin-susp mjcf"
-    try:
-        root = ET.fromstring(text)
-    except ET.ParseError as exc:
-        return f"is not valid XML ({exc})"
-    if root.tag != "mujoco":
-        what = " (a URDF?)" if root.tag == "robot" else ""
-        return f"is not MJCF{what}: its root element is <{root.tag}>, not <mujoco>"
+    from .urdf import model_file_root
+
+    root, problem = model_file_root(text, "MJCF")
+    if problem:
+        return problem
     ours, theirs = _elements(ET.fromstring(tree_to_mjcf(tree))), _elements(root)
     differences = []
     for kind in KINDS:

@@ -535,3 +535,27 @@ def _fmt(values) -> str:
     if not all(math.isfinite(x) for x in values):
         raise PinSuspError(f"refusing to write a non-finite number ({values}) into a model file")
     return " ".join(map(repr, values))
+
+
+# the two model files a user may hand back to validate: (format, root tag, command)
+MODEL_FILES = {"URDF": ("robot", "urdf"), "MJCF": ("mujoco", "mjcf")}
+
+
+def model_file_root(text: str, kind: str) -> tuple[ET.Element | None, str | None]:
+    """A model file's XML root (``kind``: URDF or MJCF), or why the text is not one:
+    empty, not text, not XML, or the other format."""
+    tag, command = MODEL_FILES[kind]
+    if not text.strip():
+        return None, f"is empty: expected the {kind} written by pin-susp {command}"
+    if "\x00" in text or "\ufffd" in text:
+        return None, f"is not a text file: expected the {kind} (XML) written by pin-susp {command}"
+    try:
+        root = ET.fromstring(text)
+    except ET.ParseError as exc:
+        return None, f"is not valid XML ({exc})"
+    if root.tag != tag:
+        other = next((k for k, (t, _) in MODEL_FILES.items() if t == root.tag), None)
+        article = {"URDF": "a URDF", "MJCF": "an MJCF"}
+        what = f" ({article[other]}?)" if other else ""
+        return None, f"is not {kind}{what}: its root element is <{root.tag}>, not <{tag}>"
+    return root, None

@@ -839,17 +839,11 @@ def check_urdf(text: str, tree, source: str = "URDF") -> None:
 
 
 def _urdf_problem(text: str, tree) -> str | None:
-    if not text.strip():
-        return "is empty: expected the URDF written by pin-susp urdf"
-    if "\x00" in text or "\ufffd" in text:
-        return "is not a text file: expected the URDF (XML) written by pin-susp urdf"
-    try:
-        root = ET.fromstring(text)
-    except ET.ParseError as exc:
-        return f"is not valid XML ({exc})"
-    if root.tag != "robot":
-        what = " (an MJCF?)" if root.tag == "mujoco" else ""
-        return f"is not URDF{what}: its root element is <{root.tag}>, not <robot>"
+    from .urdf import model_file_root
+
+    root, problem = model_file_root(text, "URDF")
+    if problem:
+        return problem
     ours, theirs = _urdf_elements(ET.fromstring(tree_to_urdf(tree))), _urdf_elements(root)
     differences = []
     for kind in ("link", "joint", "loop closure"):
