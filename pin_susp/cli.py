@@ -223,7 +223,9 @@ def _run_arguments(parser, output: str, plot: str, cases: bool = False) -> None:
         parser.add_argument(
             "--cases", required=True, metavar="LOADS.yaml", help="load cases (N, N·m, world axes)"
         )
-    parser.add_argument("-o", "--output", required=True, metavar="OUT.csv", help=output)
+    parser.add_argument(
+        "-o", "--output", required=True, metavar="OUT.csv", help=f"{output} (Parquet: OUT.parquet)"
+    )
     parser.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
     parser.add_argument("--plot", metavar="OUT.png", help=plot)
 
@@ -248,11 +250,17 @@ def _sweep(args) -> int:
 
 
 def _write_results(args, results) -> bool:
-    """The CSV and, with --plot, the report: both or neither; whether it was drawn."""
+    """The CSV (Parquet for an OUT ending .parquet) and, with --plot, the report: both or
+    neither; whether it was drawn."""
     plot = args.plot is not None and results["solver_converged"].any()
     text = csv_text(results)
     with all_or_none():
-        write_text(text, args.output)
+        if str(args.output).endswith(".parquet"):
+            from .export import write_parquet
+
+            write_parquet(results, args.output)
+        else:
+            write_text(text, args.output)
         if plot:  # drawn from the CSV's text: the output may be a stream
             from .plots import ResultsFile, report_figure, save_figure
 

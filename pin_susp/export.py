@@ -231,6 +231,26 @@ def write_csv(results, path: str | Path) -> None:
     write_text(csv_text(results), path)
 
 
+def write_parquet(results, path: str | Path) -> None:
+    """Results as a Parquet file (pyarrow), whole or not at all: the CSV's columns, an
+    undefined value (a blank CSV cell) as a null, the units, the sources and the
+    pin_susp version in the schema's metadata."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    columns = {}
+    for name, values in results.columns.items():
+        values = np.asarray(values)
+        columns[name] = pa.array(values, from_pandas=values.dtype.kind == "f")
+    meta = {"pin_susp": __version__, "units": json.dumps(results.units)}
+    for what in ("geometry", "sweep"):
+        source, sha = results.meta[what]
+        meta[what] = json.dumps({"source": str(source), "sha256": sha})
+    table = pa.table(columns).replace_schema_metadata(meta)
+    with atomic_write(path, binary=True) as f:
+        pq.write_table(table, f)
+
+
 def write_text(text: str, path: str | Path) -> None:
     with atomic_write(path) as f:
         f.write(text)
