@@ -221,9 +221,24 @@ def csv_text(results) -> str:
         lines.append(f"# {what}: {source}" + (f" sha256={sha}" if sha else ""))
     lines.append("# units: " + json.dumps(results.units))
     lines.append(",".join(names))
-    for i in range(len(results)):
-        lines.append(",".join(format_cell(c[i]) for c in columns))
+    cells = [_column_cells(c) for c in columns]
+    lines.extend(",".join(row) for row in zip(*cells, strict=True))
     return "\n".join(lines) + "\n"
+
+
+def _column_cells(values) -> list[str]:
+    """format_cell for a whole column at once (numpy's str of a float64 is the same
+    shortest round-trip text as repr): a column of numbers or flags in one call."""
+    v = np.asarray(values)
+    if v.dtype.kind == "b":
+        return np.where(v, "True", "False").tolist()
+    if v.dtype.kind in "iu":
+        return v.astype(str).tolist()
+    if v.dtype.kind == "f":
+        text = v.astype(str)
+        text[np.isnan(v)] = ""
+        return text.tolist()
+    return [format_cell(x) for x in v]  # names and mixed columns, one by one
 
 
 def write_csv(results, path: str | Path) -> None:
