@@ -101,6 +101,9 @@ def _cli(args: list[str], home: Path) -> subprocess.Popen:
         stdout=out,
         stderr=err,
         start_new_session=True,
+        # Ctrl+C's default action, even when this run inherited SIGINT ignored (a
+        # background job): Python then turns it into KeyboardInterrupt as in a terminal
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
     proc.files = (out, err)
     return proc
