@@ -399,16 +399,16 @@ def test_urdf_with_an_unwritable_sidecar_writes_neither(tmp_path, capsys):
 def test_sigterm_during_a_write_leaves_no_temporary_file(tmp_path, capsys, monkeypatch):
     from pin_susp import export
 
-    real = export.format_cell
+    real = export._column_cells
     calls = []
 
-    def slow(value):
-        calls.append(value)
-        if len(calls) == 500:  # part-way through the rows
+    def slow(values):
+        calls.append(values)
+        if len(calls) == 30:  # part-way through the columns
             signal.raise_signal(signal.SIGTERM)
-        return real(value)
+        return real(values)
 
-    monkeypatch.setattr(export, "format_cell", slow)
+    monkeypatch.setattr(export, "_column_cells", slow)
     code = main(["sweep", GEOMETRY, BUMP_STEER, "-o", str(tmp_path / "r.csv"), "-q"])
     assert code == 128 + signal.SIGTERM
     assert files(tmp_path) == set()
