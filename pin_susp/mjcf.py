@@ -279,31 +279,13 @@ def check_mjcf(text: str, tree: Tree, source: str = "MJCF") -> None:
 
 
 def _mjcf_problem(text: str, tree: Tree) -> str | None:
-    from .urdf import model_file_root
+    from .urdf import model_file_root, not_this_model
 
     root, problem = model_file_root(text, "MJCF")
     if problem:
         return problem
     ours, theirs = _elements(ET.fromstring(tree_to_mjcf(tree))), _elements(root)
-    differences = []
-    for kind in KINDS:
-        mine, yours = ours[kind], theirs[kind]
-        differences += [f"missing {kind} {_name(n)}" for n in mine if n not in yours]
-        differences += [
-            f"has a {kind} {_name(n)} this model does not have" for n in yours if n not in mine
-        ]
-        differences += [
-            f"{kind} {_name(n)} is {' '.join(yours[n])}, not {' '.join(mine[n])}"
-            for n in mine
-            if n in yours and yours[n] != mine[n]
-        ]
-    if not differences:
-        return None
-    more = f" (and {len(differences) - 1} more differences)" if len(differences) > 1 else ""
-    return (
-        f"is not the MJCF of this geometry ({tree.name}): {differences[0]}{more}; "
-        "write it with pin-susp mjcf GEOMETRY -o FILE"
-    )
+    return not_this_model("MJCF", tree.name, {k: ours[k] for k in KINDS}, theirs, name=_name)
 
 
 def _name(name: str) -> str:

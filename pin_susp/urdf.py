@@ -559,3 +559,28 @@ def model_file_root(text: str, kind: str) -> tuple[ET.Element | None, str | None
         what = f" ({article[other]}?)" if other else ""
         return None, f"is not {kind}{what}: its root element is <{root.tag}>, not <{tag}>"
     return root, None
+
+
+def not_this_model(kind: str, tree_name: str, ours: dict, theirs: dict, name=str) -> str | None:
+    """Why a model file (``kind``: URDF or MJCF) is not this geometry's, from its
+    elements and ours (element kind → {name: description}); None when they match."""
+    differences = []
+    for element, mine in ours.items():
+        yours = theirs[element]
+        differences += [f"missing {element} {name(n)}" for n in mine if n not in yours]
+        differences += [
+            f"has a {element} {name(n)} this model does not have" for n in yours if n not in mine
+        ]
+        differences += [
+            f"{element} {name(n)} is {' '.join(yours[n])}, not {' '.join(mine[n])}"
+            for n in mine
+            if n in yours and yours[n] != mine[n]
+        ]
+    if not differences:
+        return None
+    more = f" (and {len(differences) - 1} more differences)" if len(differences) > 1 else ""
+    command = MODEL_FILES[kind][1]
+    return (
+        f"is not the {kind} of this geometry ({tree_name}): {differences[0]}{more}; "
+        f"write it with pin-susp {command} GEOMETRY -o FILE"
+    )

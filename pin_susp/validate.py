@@ -839,32 +839,19 @@ def check_urdf(text: str, tree, source: str = "URDF") -> None:
 
 
 def _urdf_problem(text: str, tree) -> str | None:
-    from .urdf import model_file_root
+    from .urdf import model_file_root, not_this_model
 
     root, problem = model_file_root(text, "URDF")
     if problem:
         return problem
     ours, theirs = _urdf_elements(ET.fromstring(tree_to_urdf(tree))), _urdf_elements(root)
-    differences = []
-    for kind in ("link", "joint", "loop closure"):
-        mine, yours = ours[kind], theirs[kind]
-        differences += [f"missing {kind} {n or '(unnamed)'}" for n in mine if n not in yours]
-        differences += [
-            f"has a {kind} {n or '(unnamed)'} this model does not have"
-            for n in yours
-            if n not in mine
-        ]
-        differences += [
-            f"{kind} {n} is {' '.join(yours[n])}, not {' '.join(mine[n])}"
-            for n in mine
-            if n in yours and yours[n] != mine[n]
-        ]
-    if not differences:
-        return None
-    more = f" (and {len(differences) - 1} more differences)" if len(differences) > 1 else ""
-    return (
-        f"is not the URDF of this geometry ({tree.name}): {differences[0]}{more}; "
-        "write it with pin-susp urdf GEOMETRY -o FILE"
+    kinds = ("link", "joint", "loop closure")
+    return not_this_model(
+        "URDF",
+        tree.name,
+        {k: ours[k] for k in kinds},
+        theirs,
+        name=lambda n: n or "(unnamed)",
     )
 
 
