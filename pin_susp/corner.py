@@ -282,7 +282,7 @@ class Results:
     def to_pandas(self):
         """The columns as a pandas DataFrame, one row per step; the units (mm, deg, ...)
         in ``.attrs["units"]``; an undefined value (a blank CSV cell) is NaN."""
-        from .study import results_frame
+        from .export import results_frame
 
         return results_frame(self)
 

@@ -253,10 +253,7 @@ def write_parquet(results, path: str | Path) -> None:
     import pyarrow as pa
     import pyarrow.parquet as pq
 
-    columns = {}
-    for name, values in results.columns.items():
-        values = np.asarray(values)
-        columns[name] = pa.array(values, from_pandas=values.dtype.kind == "f")
+    columns = arrow_columns(results)
     meta = {"pin_susp": __version__, "units": json.dumps(results.units)}
     for what in ("geometry", "sweep"):
         source, sha = results.meta[what]
@@ -264,6 +261,28 @@ def write_parquet(results, path: str | Path) -> None:
     table = pa.table(columns).replace_schema_metadata(meta)
     with atomic_write(path, binary=True) as f:
         pq.write_table(table, f)
+
+
+def arrow_column(values):
+    """A column for Arrow (Parquet): an undefined value (NaN, a blank CSV cell) is null."""
+    import pyarrow as pa
+
+    values = np.asarray(values)
+    return pa.array(values, from_pandas=values.dtype.kind == "f")
+
+
+def arrow_columns(results) -> dict:
+    """Every column of results for Arrow, in the CSV's order (arrow_column)."""
+    return {name: arrow_column(values) for name, values in results.columns.items()}
+
+
+def results_frame(results):
+    """Results as a pandas DataFrame, one row per step (units in ``.attrs['units']``)."""
+    import pandas as pd
+
+    frame = pd.DataFrame({k: np.asarray(v) for k, v in results.columns.items()})
+    frame.attrs["units"] = {k: u for k, u in results.units.items() if u}
+    return frame
 
 
 def write_text(text: str, path: str | Path) -> None:

@@ -97,19 +97,18 @@ class Term:
         if self.curve is None:
             return self.target
         x = np.asarray(x, dtype=float)
-        return self.curve[:, 1][self._segment(x)] + self.slope(x) * (
-            x - self.curve[:, 0][self._segment(x)]
-        )
+        k, slope = self._segment(x)
+        return self.curve[k, 1] + slope * (x - self.curve[k, 0])
 
     def slope(self, x) -> np.ndarray:
         """d goal / d x: the slope of the segment that x falls in (the end ones beyond)."""
-        k = self._segment(np.asarray(x, dtype=float))
-        c = self.curve
-        return (c[k + 1, 1] - c[k, 1]) / (c[k + 1, 0] - c[k, 0])
+        return self._segment(np.asarray(x, dtype=float))[1]
 
-    def _segment(self, x: np.ndarray) -> np.ndarray:
-        inner = self.curve[1:-1, 0]
-        return np.searchsorted(inner, np.nan_to_num(x), side="right")
+    def _segment(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The segment that x falls in (its first point's index) and its slope."""
+        c = self.curve
+        k = np.searchsorted(c[1:-1, 0], np.nan_to_num(x), side="right")
+        return k, (c[k + 1, 1] - c[k, 1]) / (c[k + 1, 0] - c[k, 0])
 
 
 @dataclass
@@ -181,7 +180,7 @@ def load_study(source: str | Path) -> Study:
     geometry_data, _, geometry_sha = load_yaml(geometry_path)
     sweep_data, _, sweep_sha = load_yaml(sweep_path)
     axle = geometry_data.get("scope") == "axle"
-    design = _Design(geometry_data, geometry_path, sweep_data, sweep_path, axle)
+    design = _Design(geometry_data, geometry_path, sweep_path, axle)
     variables = _variables(data, design, r)
     study = Study(
         source=name,
@@ -291,23 +290,22 @@ def _seed(block: dict, key: str, r: Reader) -> int:
 class _Design:
     """The study's geometry and sweep solved at design: names to check the file against."""
 
-    def __init__(self, geometry: dict, geometry_path: str, sweep: dict, sweep_path, axle):
+    def __init__(self, geometry: dict, geometry_path: str, sweep_path: str, axle: bool):
         self.axle = axle
         # errors name the files, as `pin-susp sweep` would
         subject = build(geometry, geometry_path, axle)
         from .sweep import load_sweep
 
         self.sweep = load_sweep(sweep_path)
+        design = _at_design(self.sweep)
         if axle:
             from .axle import axle_results, solve_axle_sweep
 
-            self.results = axle_results(
-                subject, self.sweep, solve_axle_sweep(subject, _at_design(self.sweep))
-            )
+            self.results = axle_results(subject, design, solve_axle_sweep(subject, design))
             self.points = {s: list(subject.geometries[s].hardpoints) for s in ("left", "right")}
         else:
             subject.solver_for(self.sweep.targets, self.sweep.source)
-            self.results = subject.run_sweep(_at_design(self.sweep))
+            self.results = subject.run_sweep(design)
             self.points = {None: list(subject.geometry.hardpoints)}
         self.columns = [c for c in self.results.columns if c != "step_index"]
 
@@ -432,9 +430,7 @@ def variant_table(study: Study) -> np.ndarray:
         if study.method == "latin_hypercube":
             unit = qmc.LatinHypercube(d=k, seed=study.seed).random(study.samples)
         else:
-            with warnings.catch_warnings():  # "balance properties": n not a power of 2
-                warnings.simplefilter("ignore")
-                unit = qmc.Sobol(d=k, scramble=True, seed=study.seed).random(study.samples)
+            unit = _sobol(k, study.samples, study.seed)
         return qmc.scale(unit, low, high)
     if study.kind == "monte_carlo":
         rng = np.random.default_rng(study.seed)
@@ -446,10 +442,17 @@ def variant_table(study: Study) -> np.ndarray:
     first = np.clip(np.zeros(k), low, high)
     if study.starts == 1:
         return first[None]
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        unit = qmc.Sobol(d=k, scramble=True, seed=study.seed).random(study.starts - 1)
+    unit = _sobol(k, study.starts - 1, study.seed)
     return np.vstack([first, qmc.scale(unit, low, high)])
+
+
+def _sobol(k: int, n: int, seed: int) -> np.ndarray:
+    """n scrambled Sobol points in the unit cube of k dimensions."""
+    from scipy.stats import qmc
+
+    with warnings.catch_warnings():  # "balance properties": n not a power of 2
+        warnings.simplefilter("ignore")
+        return qmc.Sobol(d=k, scramble=True, seed=seed).random(n)
 
 
 def variant_data(base: dict, variables: list[Variable], deltas, axle: bool) -> dict:
@@ -474,11 +477,10 @@ def variant_data(base: dict, variables: list[Variable], deltas, axle: bool) -> d
     return data
 
 
-def build(data: dict, source: str, axle: bool, warn: bool = True):
-    """A corner or an axle from a geometry file's data (errors name ``source``);
-    ``warn``: the plausibility warnings (a variant's are skipped: the design's were shown)."""
-    from .errors import InputError as _Input
-
+def build(data: dict, source: str, axle: bool, variant: bool = False):
+    """A corner or an axle from a geometry file's data (errors name ``source``). A
+    ``variant``'s corner goes without the plausibility warnings (the design's were
+    shown) and the URDF's shapes (never drawn)."""
     try:
         if axle:
             from .axle import AxleModel, load_axle
@@ -487,10 +489,11 @@ def build(data: dict, source: str, axle: bool, warn: bool = True):
         from .corner import Corner
         from .geometry import _parse
 
-        return Corner(_parse(data, Reader("<dict>"), None), warn=warn, visuals=warn)
-    except _Input as exc:
+        geometry = _parse(data, Reader("<dict>"), None)
+        return Corner(geometry, warn=not variant, visuals=not variant)
+    except InputError as exc:
         if exc.source == "<dict>":
-            raise _Input(source, exc.key, exc.problem) from None
+            raise InputError(source, exc.key, exc.problem) from None
         raise
 
 
@@ -543,7 +546,7 @@ class Variant:
         try:
             with warnings.catch_warnings():  # a variant's plausibility: the design's was shown
                 warnings.simplefilter("ignore")
-                self.subject = build(data, "variant", job.axle, warn=False)
+                self.subject = build(data, "variant", job.axle, variant=True)
                 only = None if every_column else job.needs
                 self.results, self.static = _solve(self.subject, self.sweep, job.axle, only)
         except PinSuspError as exc:
@@ -575,7 +578,10 @@ class Variant:
         return row
 
     def residuals(self) -> np.ndarray:
-        """The objective's residual vector (see objective_residuals)."""
+        """The objective's residual vector (see objective_residuals); a variant that
+        could not be built misses at every step."""
+        if self.results is None:
+            return _missed(self.job.terms, len(self.sweep.targets[0].values))
         return objective_residuals(self.job.terms, self.results, self.static)
 
 
@@ -614,12 +620,8 @@ def objective_residuals(terms: list[Term], results, static) -> np.ndarray:
     n = len(results)
     parts = []
     for t, w in zip(terms, _shares(terms, n), strict=True):
-        m = np.asarray(results[t.metric], dtype=float)
-        if t.relative:
-            m = m - float(static[t.metric][0])
-        goal = t.goal(results[t.curve_x]) if t.curve is not None else t.target
-        miss = np.where(_counted(t, results, m, goal), m - goal, MISS)
-        parts.append(w * miss)
+        miss, counted = _miss(t, results, static)
+        parts.append(w * np.where(counted, miss, MISS))
     return np.concatenate(parts)
 
 
@@ -633,9 +635,16 @@ def _shares(terms: list[Term], n: int) -> list[float]:
     return [math.sqrt(t.weight / largest / total) for t in terms]
 
 
-def _counted(t: Term, results, m, goal) -> np.ndarray:
-    """The steps whose miss is a number: converged, the metric and the target defined."""
-    return results["solver_converged"] & np.isfinite(m) & np.isfinite(goal)
+def _miss(t: Term, results, static) -> tuple[np.ndarray, np.ndarray]:
+    """A term's miss at every step (the metric, from the design state's if relative,
+    less its target), and the steps where that is a number: converged, the metric and
+    the target defined."""
+    m = np.asarray(results[t.metric], dtype=float)
+    if t.relative:
+        m = m - float(static[t.metric][0])
+    goal = t.goal(results[t.curve_x]) if t.curve is not None else t.target
+    counted = results["solver_converged"] & np.isfinite(m) & np.isfinite(goal)
+    return m - goal, counted
 
 
 def _missed(terms: list[Term], n: int) -> np.ndarray:
@@ -678,10 +687,7 @@ def run_start(job: Job, index: int, ids: np.ndarray, table: np.ndarray, steps: b
         return cache[key]
 
     def fun(x):
-        v = solved(x)
-        if v.results is None:
-            return _missed(job.terms, sweep.steps)
-        return v.residuals()
+        return solved(x).residuals()
 
     def jac(x):
         return objective_jacobian(solved(x), sweep)
@@ -711,7 +717,7 @@ def run_start(job: Job, index: int, ids: np.ndarray, table: np.ndarray, steps: b
 def objective_jacobian(v: Variant, sweep) -> np.ndarray:
     """d r / d variables from the exact hardpoint sensitivities at every step and at
     design (a relative term's reference moves too); a curve's target moves with its
-    x column. A step without a number (see _counted) has a zero row."""
+    x column. A step without a number (see _miss) has a zero row."""
     job = v.job
     k = len(job.variables)
     n = sweep.steps
@@ -721,11 +727,7 @@ def objective_jacobian(v: Variant, sweep) -> np.ndarray:
     columns = _columns(at_design.hardpoints, job.variables)
     blocks = []
     for t, w in zip(job.terms, _shares(job.terms, n), strict=True):
-        m = np.asarray(v.results[t.metric], dtype=float)
-        if t.relative:
-            m = m - float(v.static[t.metric][0])
-        goal = t.goal(v.results[t.curve_x]) if t.curve is not None else t.target
-        counted = _counted(t, v.results, m, goal)
+        counted = _miss(t, v.results, v.static)[1]
         rows = np.zeros((n, k))
         ref = _pick(at_design, t.metric, columns) if t.relative else 0.0
         for i, s in steps.items():
@@ -815,40 +817,24 @@ def _row(job: Job, vid: int, deltas, v: Variant) -> dict:
 # ---------------------------------------------------------------- tables
 
 
-def results_frame(results):
-    """A sweep's results as a pandas DataFrame (units in ``.attrs['units']``)."""
-    import pandas as pd
-
-    frame = pd.DataFrame({k: np.asarray(v) for k, v in results.columns.items()})
-    frame.attrs["units"] = {k: u for k, u in results.units.items() if u}
-    return frame
-
-
 def _steps_table(results, vid: int):
     import pyarrow as pa
 
-    n = len(results)
-    arrays = {"variant_id": pa.array(np.full(n, vid, dtype=np.int64))}
-    for k, v in results.columns.items():
-        arrays[k] = _arrow(np.asarray(v))
+    from .export import arrow_columns
+
+    arrays = {"variant_id": pa.array(np.full(len(results), vid, dtype=np.int64))}
+    arrays |= arrow_columns(results)
     units = {k: u for k, u in results.units.items() if u}
     return pa.table(arrays).replace_schema_metadata({"units": json.dumps(units)})
-
-
-def _arrow(values: np.ndarray):
-    """A column for Arrow: NaN (an undefined value, a blank CSV cell) becomes null."""
-    import pyarrow as pa
-
-    if values.dtype.kind == "f":
-        return pa.array(values, from_pandas=True)
-    return pa.array(values)
 
 
 def _variants_table(rows: list[dict]):
     import pyarrow as pa
 
+    from .export import arrow_column
+
     names = list(rows[0])
-    return pa.table({k: _arrow(np.array([r[k] for r in rows])) for k in names})
+    return pa.table({k: arrow_column(np.array([r[k] for r in rows])) for k in names})
 
 
 def _ipc(table) -> bytes:
@@ -967,8 +953,8 @@ def _run(study, outdir, client, steps, resume, progress, dashboard) -> Outcome:
         outcome.variants = variants = table.to_pandas()
     curves = None
     if study.kind == "optimise" and variants["converged"].any():
-        best = best_deltas(study, variants)
-        row = variants[variants["converged"]].sort_values("objective").iloc[0]
+        row = best_row(variants)
+        best = np.array([row[v.name] for v in study.variables], dtype=float)
         comment = (
             f"generated by pin_susp {__version__}: the best of {len(variants)} starts of "
             f"{Path(study.source).name} (objective {float(row['objective']):.6g}, start "
@@ -985,12 +971,7 @@ def _run(study, outdir, client, steps, resume, progress, dashboard) -> Outcome:
 
         outcome.figure = outdir / "study.png"
         save_figure(study_figure(study, variants, outcome.linear, curves), outcome.figure)
-    # variants.parquet last: its presence marks the run finished
-    import pyarrow.parquet as pq
-
-    temporary = outdir / ".variants.parquet.tmp"
-    pq.write_table(table, temporary)
-    os.replace(temporary, outdir / "variants.parquet")
+    _write_parquet(table, outdir / "variants.parquet")  # last: it marks the run finished
     _drop_parts(parts)
     return outcome
 
@@ -1206,19 +1187,14 @@ def _check_outdir(study: Study, outdir: Path, steps: bool, resume: bool) -> dict
     elif resume:
         raise PinSuspError(f"{outdir}: no unfinished run of this study to resume")
     else:
-        folder = outdir if outdir.exists() else _existing_parent(outdir)
+        from .export import _existing_ancestor
+
+        folder = _existing_ancestor(outdir.absolute())
+        if not folder.is_dir():
+            raise PinSuspError(f"{outdir}: cannot write here ({folder} is not a directory)")
         if not os.access(folder, os.W_OK | os.X_OK):
             raise PinSuspError(f"{outdir}: cannot write here (no permission in {folder})")
     return mine
-
-
-def _existing_parent(path: Path) -> Path:
-    for parent in path.absolute().parents:
-        if parent.exists():
-            if not parent.is_dir():
-                raise PinSuspError(f"{path}: cannot write here ({parent} is not a directory)")
-            return parent
-    return Path("/")
 
 
 def finished_batches(outdir: str | Path) -> int | None:
@@ -1230,20 +1206,24 @@ def finished_batches(outdir: str | Path) -> int | None:
 
 
 def _write_part(parts: Path, result: dict) -> None:
-    """A batch's part files, each written whole (temporary name, then renamed); the
-    variants' part last: its presence marks the batch done."""
-    import pyarrow.parquet as pq
-
+    """A batch's part files, each written whole; the variants' part last: its
+    presence marks the batch done."""
     i = result["index"]
     parts.mkdir(exist_ok=True)
     order = [("steps", result["steps"]), ("variants", result["variants"])]
     for what, data in order:
-        if data is None:
-            continue
-        final = parts / f"{what}-{i:06d}.parquet"
-        temporary = parts / f".{what}-{i:06d}.parquet.tmp"
-        pq.write_table(_from_ipc(data), temporary)
-        os.replace(temporary, final)
+        if data is not None:
+            _write_parquet(_from_ipc(data), parts / f"{what}-{i:06d}.parquet")
+
+
+def _write_parquet(table, path: Path) -> None:
+    """A table as Parquet, whole or not at all (export.atomic_write)."""
+    import pyarrow.parquet as pq
+
+    from .export import atomic_write
+
+    with atomic_write(path, binary=True) as f:
+        pq.write_table(table, f)
 
 
 def _assemble(study: Study, outdir: Path, parts: Path, n: int, steps: bool):
@@ -1307,7 +1287,6 @@ __all__ = [
     "Variable",
     "load_study",
     "read_steps",
-    "results_frame",
     "run_study",
     "variant_data",
     "variant_table",
@@ -1464,9 +1443,14 @@ def _unit(column: str) -> str:
     return ""
 
 
+def best_row(variants):
+    """The converged start with the least objective."""
+    return variants[variants["converged"]].sort_values("objective").iloc[0]
+
+
 def best_deltas(study: Study, variants) -> np.ndarray:
-    """The variables of the converged start with the least objective."""
-    best = variants[variants["converged"]].sort_values("objective").iloc[0]
+    """The variables of the best start (best_row)."""
+    best = best_row(variants)
     return np.array([best[v.name] for v in study.variables], dtype=float)
 
 
