@@ -929,9 +929,13 @@ def validate(
         else:
             reports.append(compare(scope, results, points, "pointwise", tolerance))
     if "mujoco" in engines:
-        reports.append(_mujoco_report(scope, sweep, results, mjcf_text, mjcf_source, tolerance))
+        reports.append(
+            _engine_report("mujoco", scope, sweep, results, mjcf_text, mjcf_source, tolerance)
+        )
     if "drake" in engines:
-        reports.append(_drake_report(scope, sweep, results, urdf_text, urdf_source, tolerance))
+        reports.append(
+            _engine_report("drake", scope, sweep, results, urdf_text, urdf_source, tolerance)
+        )
     return results, reports
 
 
@@ -948,31 +952,22 @@ def _not_installed(engine: str, module: str) -> EngineReport | None:
     return None
 
 
-def _mujoco_report(scope, sweep, results, mjcf_text, mjcf_source, tolerance) -> EngineReport:
+def _engine_report(engine, scope, sweep, results, text, source, tolerance) -> EngineReport:
+    """An engine's comparison (mujoco from the MJCF, drake from the URDF): the text
+    given, else the subject's own export; a report saying how to install it if missing."""
     from .mjcf import tree_to_mjcf
 
-    missing = _not_installed("mujoco", "mujoco")
+    module, points_of, fmt = {
+        "mujoco": ("mujoco", _mujoco_points, "MJCF"),
+        "drake": ("pydrake.multibody.inverse_kinematics", _drake_points, "URDF"),
+    }[engine]
+    missing = _not_installed(engine, module)
     if missing:
         return missing
-    if mjcf_text is None:
-        text, source = tree_to_mjcf(scope.tree), f"the {scope.kind}'s exported MJCF"
-    else:
-        text, source = mjcf_text, mjcf_source
-    points, warnings = _mujoco_points(scope, sweep, text, source)
-    report = compare(scope, results, points, "mujoco", tolerance)
-    report.warnings, report.first_warning = warnings.count, warnings.first
-    return report
-
-
-def _drake_report(scope, sweep, results, urdf_text, urdf_source, tolerance) -> EngineReport:
-    missing = _not_installed("drake", "pydrake.multibody.inverse_kinematics")
-    if missing:
-        return missing
-    if urdf_text is None:
-        text, source = scope.subject.urdf, f"the {scope.kind}'s exported URDF"
-    else:
-        text, source = urdf_text, urdf_source
-    points, warnings = _drake_points(scope, sweep, text, source)
-    report = compare(scope, results, points, "drake", tolerance)
+    if text is None:
+        text = tree_to_mjcf(scope.tree) if engine == "mujoco" else scope.subject.urdf
+        source = f"the {scope.kind}'s exported {fmt}"
+    points, warnings = points_of(scope, sweep, text, source)
+    report = compare(scope, results, points, engine, tolerance)
     report.warnings, report.first_warning = warnings.count, warnings.first
     return report
