@@ -148,7 +148,8 @@ class Corner(Linkage):
             progress=progress,
             step_times=step_times,
             tangents=tangents if order is not None else None,
-            keep=None if order is None else lambda tangent: tangent[:, order],
+            keep=None if order is None else lambda tangent: tangent[..., order],
+            bulk=True,
         )
 
     def _values_at(self, solver: NewtonSolver, q: np.ndarray) -> np.ndarray:

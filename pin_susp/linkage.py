@@ -17,6 +17,7 @@ import numpy as np
 import pinocchio as pin
 
 from . import __version__
+from .bulk import solve_all
 from .closures import (
     BallClosure,
     ContactPatchPoint,
@@ -106,10 +107,23 @@ class FrameMotion:
             (j, np.array([i for i, _ in g]), np.array([o for _, o in g])) for j, g in groups.items()
         ]
 
-    def __call__(self, qs: list, tangent_at, k: int) -> tuple[np.ndarray, np.ndarray]:
+    def __call__(
+        self, qs: list, tangent_at, k: int, tangents=None
+    ) -> tuple[np.ndarray, np.ndarray]:
         """Positions (n, m, 3) and rates (k, n, m, 3) of the m points at the n
         configurations; ``tangent_at(i, q)`` updates the kinematics (Jacobians too) at
-        q and returns dq per driver (nv × k). A None configuration gives NaN."""
+        q and returns dq per driver (nv × k). A None configuration gives NaN.
+
+        ``tangents(Q, steps)``: dq per driver at every solved configuration at once
+        ((len(Q), nv, k), or None): then every step is evaluated at once on the
+        model's tree (bulk.Tree) instead of one Pinocchio call after another.
+        """
+        if tangents is not None and self.kin.tree.supported:
+            solved = [i for i, q in enumerate(qs) if q is not None]
+            Q = np.array([qs[i] for i in solved]).reshape(len(solved), self.kin.model.nq)
+            T = tangents(Q, solved) if solved else np.zeros((0, self.kin.model.nv, k))
+            if T is not None:
+                return self._at_once(len(qs), solved, Q, T, k)
         n, m = len(qs), len(self.names)
         pos = np.full((n, m, 3), np.nan)
         rates = np.full((k, n, m, 3), np.nan)
@@ -145,6 +159,30 @@ class FrameMotion:
         pos[unsolved] = np.nan
         rates[:, unsolved] = np.nan
         return pos, rates
+
+    def _at_once(self, n: int, solved: list, Q: np.ndarray, T: np.ndarray, k: int):
+        """__call__ for every solved configuration Q at once (T: their tangents)."""
+        tree = self.kin.tree
+        R, o = tree.placements(Q)
+        a = tree.axes(R)
+        count = len(Q)
+        pos = np.empty((count, len(self.names), 3))
+        rates = np.empty((k, count, len(self.names), 3))
+        for j, index, local in self.groups:
+            if j == 0:  # the chassis: fixed points
+                pos[:, index] = local
+                rates[:, :, index] = 0.0
+                continue
+            arms = np.einsum("nij,mj->nmi", R[j], local)
+            pos[:, index] = arms + o[j][:, None]
+            twist = np.einsum("nsv,nvk->kns", tree.twist_jacobian(j, o, a), T)  # (k, n, 6)
+            rates[:, :, index] = twist[:, :, None, :3] + cross(twist[:, :, None, 3:], arms[None])
+        if count == n:
+            return pos, rates
+        out_pos = np.full((n, len(self.names), 3), np.nan)
+        out_rates = np.full((k, n, len(self.names), 3), np.nan)
+        out_pos[solved], out_rates[:, solved] = pos, rates
+        return out_pos, out_rates
 
 
 class Linkage:
@@ -253,7 +291,16 @@ class Linkage:
             self._drive.evaluate(q)
             return self._drive.tangent(self.drive_rhs)
 
-        pos, rates = self._frame_motion(qs, tangent_at, len(self.drivers))
+        def at_once(Q: np.ndarray, steps: list) -> np.ndarray | None:
+            if tangents is not None and all(tangents[i] is not None for i in steps):
+                return np.array([tangents[i] for i in steps])
+            rows = self._drive.bulk
+            if not rows.supported or rows.nrows != self.model.nv:
+                return None
+            _, J = rows.evaluate(Q, np.zeros((len(Q), len(self._drive.targets))))
+            return solve_all(J, self.drive_rhs)
+
+        pos, rates = self._frame_motion(qs, tangent_at, len(self.drivers), at_once)
         frames = self._frame_motion.names
         points = {f: Dual(pos[:, i], rates[:, :, i]) for i, f in enumerate(frames)}
         axis = unit(points["axle_outboard"] - points["axle_inboard"])

@@ -13,11 +13,13 @@ two half steps (continuation) before it is reported as failed.
 Speed: rows of the common kinds (ball and distance closures, targets on
 frame points, held joints) are evaluated together — one Pinocchio call per
 frame they need, numpy on stacked arrays — and the small square system goes
-to LAPACK's dgesv directly. Other rows (the shim's, a contact-patch target)
+to LAPACK's gesv (numpy.linalg.solve). Other rows (the shim's, a contact-patch target)
 take their own ``residual``/``jacobian``, or are computed from their frames
 (``from_frames``: an axle's heave and roll). A sweep (``march``) also predicts each step
 from the last two solutions and the tangent (see ``predict``), so that one
-Newton iteration usually suffices.
+Newton iteration usually suffices. A long sweep can instead be solved for all its
+steps at once (``march(..., bulk=True)``, see bulk.py): this march on a coarse
+path, then batched Newton iterations on Pinocchio's model evaluated in numpy.
 """
 
 from __future__ import annotations
@@ -28,7 +30,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
-from scipy.linalg import lapack
 
 from .closures import (
     WORLD,
@@ -94,6 +95,16 @@ class NewtonSolver:
         self.keep_jacobian = False
         self._unit_rhs = np.zeros((self.nrows, len(self.targets)))
         self._unit_rhs[self.target_rows, np.arange(len(self.targets))] = 1.0
+        self._bulk = None
+
+    @property
+    def bulk(self):
+        """The rows for many configurations at once (bulk.Rows), built when first used."""
+        if self._bulk is None:
+            from .bulk import Rows
+
+            self._bulk = Rows(self.kin.tree, self.rows, len(self.targets))
+        return self._bulk
 
     def evaluate(self, q: np.ndarray, jacobian: bool = True) -> None:
         """Fill self.residual, and self.jacobian unless ``jacobian`` is False, at q."""
@@ -118,8 +129,8 @@ class NewtonSolver:
             miss = np.abs(self.jacobian @ T - rhs).max(axis=0)
             T[:, miss > 1e-9 * (1.0 + np.abs(T).max(axis=0))] = np.nan
             return T
-        _, _, T, info = lapack.dgesv(self.jacobian, rhs)
-        return T if info == 0 else np.full((self.jacobian.shape[1], rhs.shape[1]), np.nan)
+        T = _solve(self.jacobian, rhs)
+        return T if T is not None else np.full((self.jacobian.shape[1], rhs.shape[1]), np.nan)
 
     def newton(self, q: np.ndarray) -> Solution:
         """Iterate from q with the current target values."""
@@ -152,10 +163,10 @@ class NewtonSolver:
     def _step(self) -> np.ndarray:
         J, r = self.jacobian, self.residual
         if J.shape[0] == J.shape[1]:
-            _, _, dv, info = lapack.dgesv(J, -r)
+            dv = _solve(J, -r)
         else:  # consistent but redundant rows: Gauss-Newton
-            dv, info = np.linalg.lstsq(J, -r, rcond=None)[0], 0
-        if info == 0 and max(dv.max(), -dv.min()) <= MAX_STEP:  # False for NaN too
+            dv = np.linalg.lstsq(J, -r, rcond=None)[0]
+        if dv is not None and max(dv.max(), -dv.min()) <= MAX_STEP:  # False for NaN too
             return dv
         # Damped least squares: dv = −Jᵀ (J Jᵀ + λI)⁻¹ r, λ = μ|r|².
         lam = DAMPING * float(r @ r) + 1e-14
@@ -198,6 +209,14 @@ class NewtonSolver:
         return full
 
 
+def _solve(J: np.ndarray, b: np.ndarray) -> np.ndarray | None:
+    """J·x = b for a square J (LAPACK's gesv through numpy); None if J is singular."""
+    try:
+        return np.linalg.solve(J, b)
+    except np.linalg.LinAlgError:
+        return None
+
+
 def march(
     solver: NewtonSolver,
     values: np.ndarray,
@@ -207,6 +226,7 @@ def march(
     step_times=None,
     tangents: list | None = None,
     keep=None,
+    bulk: bool = False,
 ) -> list[Solution]:
     """Solve a sweep's steps (``values``: a row of target values each) in order, each
     from a prediction off the last solutions (halving toward it on failure).
@@ -215,8 +235,21 @@ def march(
     ``progress(done, total)`` after each step; ``step_times``: a list that receives
     each step's solve time (s); ``tangents``: a list that receives each step's exact
     tangent (solver.keep_jacobian must be set), or ``keep(tangent)`` if given — called
-    with the kinematics (Jacobians too) at the solution.
+    with the kinematics (Jacobians too) at the solution. ``bulk``: a long sweep may be
+    solved for all its steps at once (bulk.solve_sweep: the same solutions, to the
+    tolerance), and ``keep`` is then called once with every step's tangent stacked
+    (n, nv, k): it must act on the last axes alone; the sweep is marched step by step
+    when that does not apply or any step fails there.
     """
+    if bulk and step_times is None:
+        from .bulk import solve_sweep
+
+        solved = solve_sweep(solver, values, q, previous, progress)
+        if solved is not None:
+            solutions, T = solved
+            if tangents is not None:
+                tangents.extend(T if keep is None else keep(T))
+            return solutions
     predictor = Predictor(solver.kin.model)
     # which steps repeat the one before (a uniform sweep): worked out once for all
     steps = np.diff(np.vstack([previous, values]), axis=0)

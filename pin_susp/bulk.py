@@ -1,0 +1,428 @@
+"""A sweep's steps solved together: Pinocchio's model evaluated for every step at once.
+
+Pinocchio's Python API evaluates one configuration per call; a sweep of
+thousands of steps then spends its time in the calls around it, not in the
+kinematics. This module takes the Pinocchio model's own tree — each joint's
+parent, placement and motion subspace, each frame's joint and placement —
+and evaluates it for n configurations at once with numpy: joint placements
+(oMi), frame positions and their LOCAL_WORLD_ALIGNED Jacobians, the same
+quantities ``pin.computeJointJacobians`` / ``getFrameJacobian`` give (a test
+checks them against Pinocchio on every example to 1e-15 m).
+
+A long sweep is then solved in two passes (``solve_sweep``):
+
+1. Pinocchio's Newton solver (solver.march) marches a coarse path — every
+   s-th step, with its continuation and branch checks — and gives the exact
+   tangent dq/dv at each coarse solution;
+2. every step's configuration is predicted from its two coarse neighbours
+   (cubic Hermite along the segment, exact to O(h⁴)) and all steps take
+   Newton iterations together: one batched residual, Jacobian and linear
+   solve per iteration.
+
+Each step must meet the same tolerance and stay on every loop's design
+branch; if any step does not, the sweep is solved step by step instead
+(solver.march), so a difficult sweep is never worse off than before.
+Only joints with one degree of freedom (revolute or prismatic, aligned or
+not) and rows of the common kinds (ball and distance closures, targets on
+frame points, held joints) are handled here; anything else goes step by step.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+from .closures import BallClosure, DistanceClosure, FramePoint, JointTarget, PointTarget
+
+# A sweep shorter than this is marched step by step (the coarse pass would be most of it).
+MIN_STEPS = 200
+COARSE_STEPS = 64  # about this many coarse steps, whatever the sweep's length
+MAX_ITERATIONS = 8
+
+
+class Tree:
+    """A Pinocchio model's kinematic tree as arrays: joints with one degree of freedom.
+
+    ``supported`` is False when the model has another kind of joint.
+    """
+
+    def __init__(self, model: pin.Model):
+        self.model = model
+        self.nq, self.nv = model.nq, model.nv
+        self.nframes = model.nframes
+        self.supported = model.nq == model.nv
+        self.joints = []  # (parent, revolute?, axis (3,), placement R, placement p, idx)
+        for i in range(1, model.njoints):
+            joint = model.joints[i]
+            if joint.nq != 1 or joint.nv != 1:
+                self.supported = False
+                break
+            data = joint.createData()
+            joint.calc(data, np.zeros(model.nq))
+            s = np.array(data.S).ravel()
+            revolute = bool(np.any(s[3:]))
+            if revolute == bool(np.any(s[:3])):  # a helical joint, or none at all
+                self.supported = False
+                break
+            axis = s[3:] if revolute else s[:3]
+            placement = model.jointPlacements[i]
+            self.joints.append(
+                (
+                    model.parents[i],
+                    revolute,
+                    axis.copy(),
+                    placement.rotation.copy(),
+                    placement.translation.copy(),
+                    joint.idx_q,
+                )
+            )
+        if not self.supported:
+            return
+        # per joint: whether its placement turns nothing, and [axis]× and its square
+        self._identity = [True] + [np.array_equal(j[3], np.eye(3)) for j in self.joints]
+        self._skew = [None] + [_skew(j[2]) for j in self.joints]
+        # the joints that move each joint (its supports, the universe excluded): the
+        # revolute ones and the prismatic ones, each as (joint indices, indices in v)
+        self._moves = []
+        for i in range(model.njoints):
+            support = list(model.supports[i])[1:]
+            kinds = []
+            for revolute in (True, False):
+                ks = [k for k in support if self.joints[k - 1][1] == revolute]
+                kinds.append((ks, [self.joints[k - 1][5] for k in ks]))
+            self._moves.append(tuple(kinds))
+
+    def placements(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """World rotation (njoints, n, 3, 3) and origin (njoints, n, 3) of every joint
+        at the n configurations q (n, nq); joint 0 is the universe. (A product with a
+        constant matrix is one (3n × 3)·(3 × 3) product: numpy's stacked 3 × 3 products
+        are slower.)"""
+        n = q.shape[0]
+        R = np.empty((len(self.joints) + 1, n, 3, 3))
+        o = np.empty((len(self.joints) + 1, n, 3))
+        R[0], o[0] = np.eye(3), 0.0
+        for i, (parent, revolute, axis, Rp, pp, k) in enumerate(self.joints, start=1):
+            base = R[parent] if self._identity[i] else _times(R[parent], Rp)
+            origin = o[parent] + _apply(R[parent], pp)
+            if revolute:  # base·(I + sin θ K + (1 − cos θ) K²), K = [axis]×
+                K, K2 = self._skew[i]
+                s, c = np.sin(q[:, k])[:, None, None], np.cos(q[:, k])[:, None, None]
+                R[i] = base + s * _times(base, K) + (1.0 - c) * _times(base, K2)
+                o[i] = origin
+            else:
+                R[i] = base
+                o[i] = origin + _apply(base, axis) * q[:, k, None]
+        return R, o
+
+    def axes(self, R: np.ndarray) -> np.ndarray:
+        """World axis of every joint (njoints, n, 3) from its world rotation (a joint's own
+        motion turns about, or slides along, its axis: the axis is the same before it)."""
+        out = np.zeros((R.shape[0], R.shape[1], 3))
+        for i, (_, _, axis, _, _, _) in enumerate(self.joints, start=1):
+            out[i] = _apply(R[i], axis)
+        return out
+
+    def point_jacobian(self, joint: int, p: np.ndarray, o: np.ndarray, a: np.ndarray):
+        """d(p)/dv (n, 3, nv) of points p (n, 3) fixed to ``joint``: a revolute joint k
+        among its supports moves them at a_k × (p − o_k), a prismatic one at a_k."""
+        J = np.zeros((p.shape[0], 3, self.nv))
+        revolute, prismatic = self._moves[joint]
+        if revolute[0]:
+            ks, vs = revolute
+            J[:, :, vs] = cross(a[ks], p - o[ks]).transpose(1, 2, 0)
+        if prismatic[0]:
+            ks, vs = prismatic
+            J[:, :, vs] = a[ks].transpose(1, 2, 0)
+        return J
+
+    def twist_jacobian(self, joint: int, o: np.ndarray, a: np.ndarray) -> np.ndarray:
+        """The joint frame's LOCAL_WORLD_ALIGNED Jacobian (n, 6, nv): the velocity of its
+        origin, then its angular velocity."""
+        J = np.zeros((o.shape[1], 6, self.nv))
+        revolute, prismatic = self._moves[joint]
+        if revolute[0]:
+            ks, vs = revolute
+            J[:, :3, vs] = cross(a[ks], o[joint] - o[ks]).transpose(1, 2, 0)
+            J[:, 3:, vs] = a[ks].transpose(1, 2, 0)
+        if prismatic[0]:
+            ks, vs = prismatic
+            J[:, :3, vs] = a[ks].transpose(1, 2, 0)
+        return J
+
+
+def _times(A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """A·B for stacked A (n, 3, 3) and one B (3, 3)."""
+    return (A.reshape(-1, 3) @ B).reshape(A.shape)
+
+
+def _apply(A: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """A·x for stacked A (n, 3, 3) and one vector x (3,): (n, 3)."""
+    return (A.reshape(-1, 3) @ x).reshape(A.shape[:-1])
+
+
+def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a × b over the last axis, written out (np.cross costs more on these shapes)."""
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
+
+
+def _skew(axis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    K = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+    return K, K @ K
+
+
+class Frames:
+    """Frame positions and Jacobians over many configurations: each frame as its joint
+    and its offset in that joint's frame (frames on the chassis stay where they are)."""
+
+    def __init__(self, tree: Tree, frame_ids: list[int]):
+        model = tree.model
+        self.tree = tree
+        self.ids = list(frame_ids)
+        self.joint = [model.frames[f].parentJoint for f in self.ids]
+        self.offset = [model.frames[f].placement.translation.copy() for f in self.ids]
+
+    def evaluate(self, q: np.ndarray, jacobians: bool = True):
+        """Positions (list of (n, 3)) and Jacobians (list of (n, 3, nv), or None)."""
+        R, o = self.tree.placements(q)
+        P = [o[j] + _apply(R[j], x) for j, x in zip(self.joint, self.offset, strict=True)]
+        if not jacobians:
+            return P, None
+        a = self.tree.axes(R)
+        J = [self.tree.point_jacobian(j, p, o, a) for j, p in zip(self.joint, P, strict=True)]
+        return P, J
+
+
+class Rows:
+    """A solver's stacked rows (closures, then one row per target) for many steps."""
+
+    def __init__(self, tree: Tree, rows: list, ntargets: int):
+        self.tree = tree
+        self.supported = tree.supported
+        frames: list[int] = []
+
+        def frame(point) -> int:
+            if point.frame_id not in frames:
+                frames.append(point.frame_id)
+            return frames.index(point.frame_id)
+
+        self.items = []
+        i = 0
+        for row in rows:
+            if isinstance(row, BallClosure) and _framed(row.a, row.b):
+                self.items.append(("ball", i, frame(row.a), frame(row.b), None))
+            elif isinstance(row, DistanceClosure) and _framed(row.a, row.b):
+                self.items.append(("distance", i, frame(row.a), frame(row.b), row.length))
+            elif isinstance(row, PointTarget) and _framed(row.point):
+                self.items.append(("target", i, frame(row.point), None, row.direction.copy()))
+            elif isinstance(row, JointTarget):
+                self.items.append(("joint", i, row.index_q, row.index_v, None))
+            else:
+                self.supported = False
+            i += row.size
+        self.nrows = i
+        self.first_target = i - ntargets
+        self.frames = Frames(tree, frames)
+
+    def evaluate(self, q: np.ndarray, values: np.ndarray, jacobian: bool = True):
+        """Residuals (n, nrows) and Jacobians (n, nrows, nv) at q (n, nq) with the target
+        values (n, ntargets); a target row's value is its column of ``values``."""
+        n = q.shape[0]
+        P, Jf = self.frames.evaluate(q, jacobian)
+        r = np.empty((n, self.nrows))
+        J = np.zeros((n, self.nrows, self.tree.nv)) if jacobian else None
+        for kind, i, a, b, extra in self.items:
+            if kind == "ball":
+                r[:, i : i + 3] = P[b] - P[a]
+                if jacobian:
+                    J[:, i : i + 3] = Jf[b] - Jf[a]
+            elif kind == "distance":
+                d = P[b] - P[a]
+                length = np.sqrt(np.einsum("ni,ni->n", d, d))
+                r[:, i] = length - extra
+                if jacobian:
+                    J[:, i] = np.einsum("ni,niv->nv", d / length[:, None], Jf[b] - Jf[a])
+            elif kind == "target":
+                value = values[:, i - self.first_target]
+                r[:, i] = P[a] @ extra - value
+                if jacobian:
+                    J[:, i] = np.einsum("i,niv->nv", extra, Jf[a])
+            else:  # a held joint: a is its index in q, b in v
+                r[:, i] = q[:, a] - values[:, i - self.first_target]
+                if jacobian:
+                    J[:, i, b] = 1.0
+        return r, J
+
+
+def _framed(*points) -> bool:
+    return all(type(p) is FramePoint for p in points)
+
+
+def solve_sweep(solver, values: np.ndarray, q: np.ndarray, previous: np.ndarray, progress=None):
+    """Every step of a sweep, or None when it must be marched step by step.
+
+    Returns (solutions, tangents (n, nv, ntargets)) with every step converged and on
+    its design branches; None when the solver's rows or the model are not of the
+    kinds handled here, the sweep is short, or any step fails here.
+    """
+    from .solver import ACCEPT, TOLERANCE, Solution, march
+
+    n = values.shape[0]
+    if n < MIN_STEPS or not getattr(solver, "bulk", None) or not solver.bulk.supported:
+        return None
+    rows = solver.bulk
+    if len(solver.targets) != values.shape[1] or rows.nrows != solver.kin.model.nv:
+        return None
+    stride = max(2, n // COARSE_STEPS)
+    coarse = np.unique(np.r_[np.arange(stride - 1, n, stride), n - 1])
+    keep = solver.keep_jacobian
+    solver.keep_jacobian = True  # exact tangents at the coarse solutions
+    try:
+        tangents: list = []
+        marched = march(solver, values[coarse], q, previous, tangents=tangents)
+    finally:
+        solver.keep_jacobian = keep
+    if not all(s.converged for s in marched):
+        return None
+    if progress is not None:
+        progress(len(coarse), n)
+    # the predictions: cubic Hermite between coarse neighbours (the design state, or the
+    # given start, before the first)
+    q0 = np.vstack([q[None], np.array([s.q for s in marched])])
+    v0 = np.vstack([previous[None], values[coarse]])
+    start_tangent = _tangent_at(solver, q, previous)
+    if start_tangent is None:
+        return None
+    T0 = np.stack([start_tangent, *tangents])  # (m + 1, nv, k)
+    segment = np.searchsorted(coarse, np.arange(n))  # step i lies in (coarse[s-1], coarse[s]]
+    guess = _hermite(q0, v0, T0, segment, values)
+    qs, T, iterations, error = _newton(rows, guess, values, ACCEPT, TOLERANCE)
+    if qs is None:
+        return None
+    if not _on_branches(solver, qs):
+        return None
+    solutions = [Solution(qs[i], True, int(iterations[i]), float(error[i])) for i in range(n)]
+    if progress is not None:
+        progress(n, n)
+    return solutions, T
+
+
+def _tangent_at(solver, q: np.ndarray, values: np.ndarray) -> np.ndarray | None:
+    """The exact tangent at a solved q (its targets' values ``values``)."""
+    r, J = solver.bulk.evaluate(q[None], values[None])
+    T = solve_all(J, solver._unit_rhs)
+    return None if T is None else T[0]
+
+
+def _hermite(q0, v0, T0, segment, values) -> np.ndarray:
+    """Each step's configuration predicted along its coarse segment: t is where its
+    values project onto the segment; the cubic Hermite curve through both ends with
+    their slopes, plus the near end's tangent times any part off the segment's line."""
+    qa, qb = q0[segment], q0[segment + 1]
+    va, vb = v0[segment], v0[segment + 1]
+    Ta, Tb = T0[segment], T0[segment + 1]
+    step = vb - va
+    length2 = np.einsum("ni,ni->n", step, step)
+    t = np.where(
+        length2 > 0,
+        np.einsum("ni,ni->n", values - va, step) / np.where(length2 > 0, length2, 1.0),
+        1.0,
+    )
+    t2, t3 = t * t, t * t * t
+    h00, h10 = 2 * t3 - 3 * t2 + 1, t3 - 2 * t2 + t
+    h01, h11 = -2 * t3 + 3 * t2, t3 - t2
+    slope_a = np.einsum("nvk,nk->nv", Ta, step)
+    slope_b = np.einsum("nvk,nk->nv", Tb, step)
+    guess = h00[:, None] * qa + h10[:, None] * slope_a + h01[:, None] * qb + h11[:, None] * slope_b
+    off = values - (va + t[:, None] * step)
+    near = np.where((t < 0.5)[:, None, None], Ta, Tb)
+    return guess + np.einsum("nvk,nk->nv", near, off)
+
+
+def _newton(rows: Rows, q: np.ndarray, values: np.ndarray, accept: float, tolerance: float):
+    """Newton iterations for every step at once: (q, tangents, iterations, max |r|) or
+    (None, ...) if any step does not converge to ``tolerance`` (or takes a wild step)."""
+    from .solver import MAX_STEP
+
+    n = q.shape[0]
+    q = q.copy()
+    iterations = np.zeros(n, dtype=int)
+    error = np.zeros(n)
+    tangents = np.empty((n, rows.tree.nv, values.shape[1]))
+    rhs = np.zeros((rows.nrows, values.shape[1]))
+    rhs[rows.first_target :] = np.eye(values.shape[1])
+    active = np.arange(n)
+    for iteration in range(MAX_ITERATIONS + 1):
+        r, J = rows.evaluate(q[active], values[active])
+        done = np.einsum("ni,ni->n", r, r) <= tolerance * tolerance
+        if done.any():
+            finished = active[done]
+            T = solve_all(J[done], rhs)
+            if T is None:
+                return None, None, None, None
+            tangents[finished] = T
+            iterations[finished] = iteration
+            error[finished] = np.abs(r[done]).max(axis=1)
+            active, r, J = active[~done], r[~done], J[~done]
+        if not active.size:
+            return q, tangents, iterations, error
+        if iteration == MAX_ITERATIONS:
+            break
+        dv = solve_all(J, -r[:, :, None])
+        if dv is None:
+            return None, None, None, None
+        dv = dv[:, :, 0]
+        if not np.all(np.abs(dv) <= MAX_STEP):  # a wild step (or NaN): step by step
+            return None, None, None, None
+        q[active] += dv
+    return None, None, None, None
+
+
+def solve_all(J: np.ndarray, rhs: np.ndarray) -> np.ndarray | None:
+    """J·x = rhs for stacked J (n, m, m) and rhs (m, k) or (n, m, k); None if any J is
+    singular."""
+    try:
+        if rhs.ndim == 2:
+            rhs = np.broadcast_to(rhs, (J.shape[0], *rhs.shape))
+        x = np.linalg.solve(J, rhs)
+    except np.linalg.LinAlgError:
+        return None
+    return x if np.isfinite(x).all() else None
+
+
+def _on_branches(solver, qs: np.ndarray) -> bool:
+    """Every step on every loop's design assembly (closures.BranchGuard, for all steps)."""
+    guard = solver.branches
+    if not guard.loops:
+        return True
+    ids = sorted({p.frame_id for loop in guard.loops for p in loop.points})
+    frames = Frames(solver.bulk.tree, ids)
+    P, _ = frames.evaluate(qs, jacobians=False)
+    at = dict(zip(ids, P, strict=True))
+    for loop in guard.loops:
+        points = [at[p.frame_id] for p in loop.points]
+        if np.any(MEASURES[loop.measure.__name__](*points) * loop.sign <= 0.0):
+            return False
+    return True
+
+
+def chirality(a, b, c, d) -> np.ndarray:
+    """closures.chirality for arrays of points (n, 3)."""
+    u, v, w = b - a, c - a, d - a
+    det = np.einsum("ni,ni->n", u, np.cross(v, w))
+    scale = np.sqrt(
+        np.einsum("ni,ni->n", u, u) * np.einsum("ni,ni->n", v, v) * np.einsum("ni,ni->n", w, w)
+    )
+    return np.where(scale > 0.0, det / np.where(scale > 0.0, scale, 1.0), 0.0)
+
+
+def alignment(a, b, c, d) -> np.ndarray:
+    """closures.alignment for arrays of points (n, 3)."""
+    u, w = b - a, d - c
+    scale = np.sqrt(np.einsum("ni,ni->n", u, u) * np.einsum("ni,ni->n", w, w))
+    dot = np.einsum("ni,ni->n", u, w)
+    return np.where(scale > 0.0, dot / np.where(scale > 0.0, scale, 1.0), 0.0)
+
+
+MEASURES = {"chirality": chirality, "alignment": alignment}

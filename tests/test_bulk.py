@@ -1,0 +1,192 @@
+"""A long sweep solved for every step at once (pin_susp.bulk) against Pinocchio itself,
+the step-by-step march, and the independent point-based formulation."""
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from conftest import EXAMPLES, example
+from pointwise import PointwiseCorner
+
+import pin_susp
+import pin_susp.corner
+from pin_susp import bulk, solver
+from pin_susp.bulk import Frames, Tree
+from pin_susp.corner import Results
+from pin_susp.sweep import Sweep, Target
+
+CORNERS = [
+    "double_wishbone.yaml",
+    "camber_shim.yaml",
+    "pushrod_rocker.yaml",
+    "macpherson.yaml",
+    "multilink_front.yaml",
+    "multilink_rear.yaml",
+    "fixed_toe_link.yaml",
+    "semi_trailing_arm.yaml",
+]
+
+
+def build(name: str) -> pin_susp.Corner:
+    return pin_susp.Corner(EXAMPLES / name, warn=False)
+
+
+def long_sweep(corner, steps: int = 401, bump=(-40.0, 60.0), rack=(-10.0, 10.0), curve=False):
+    targets = [Target("wheel_center", "z", np.linspace(*bump, steps))]
+    if corner.geometry.steering == "rack":
+        values = np.linspace(*rack, steps)
+        if curve:  # a path that is no straight line in target space
+            values = rack[1] * np.sin(np.linspace(0.0, 3.0 * np.pi, steps))
+        targets.append(Target("trackrod_inboard", "y", values))
+    return Sweep(targets, "long")
+
+
+def step_by_step(monkeypatch):
+    """Make Corner.solve_steps march every step (the reference)."""
+    march = solver.march
+    monkeypatch.setattr(pin_susp.corner, "march", lambda *a, **k: march(*a, **{**k, "bulk": False}))
+
+
+@pytest.mark.parametrize("name", CORNERS)
+def test_tree_matches_pinocchio_frames_and_jacobians(name):
+    """Every frame's position and LOCAL_WORLD_ALIGNED Jacobian, and every joint's
+    placement and Jacobian, at random configurations: numpy's evaluation of the
+    model's tree against Pinocchio's own."""
+    corner = build(name)
+    model = corner.model
+    data = model.createData()
+    tree = Tree(model)
+    assert tree.supported
+    q = corner.q_design + np.random.default_rng(7).normal(0.0, 0.4, (9, model.nq))
+    frames = Frames(tree, list(range(model.nframes)))
+    P, J = frames.evaluate(q)
+    R, o = tree.placements(q)
+    a = tree.axes(R)
+    for n in range(len(q)):
+        pin.computeJointJacobians(model, data, q[n])
+        pin.updateFramePlacements(model, data)
+        for k, f in enumerate(frames.ids):
+            np.testing.assert_allclose(P[k][n], data.oMf[f].translation, rtol=0, atol=1e-15)
+            expected = pin.getFrameJacobian(model, data, f, pin.LOCAL_WORLD_ALIGNED)
+            expected = expected.reshape(6, model.nv)[:3]
+            np.testing.assert_allclose(J[k][n], expected, rtol=0, atol=1e-15)
+        for j in range(1, model.njoints):
+            np.testing.assert_allclose(R[j, n], data.oMi[j].rotation, rtol=0, atol=1e-15)
+            np.testing.assert_allclose(o[j, n], data.oMi[j].translation, rtol=0, atol=1e-15)
+            expected = pin.getJointJacobian(model, data, j, pin.LOCAL_WORLD_ALIGNED)
+            np.testing.assert_allclose(
+                tree.twist_jacobian(j, o, a)[n], expected.reshape(6, model.nv), atol=1e-15
+            )
+
+
+@pytest.mark.parametrize("name", CORNERS)
+def test_long_sweep_equals_the_step_by_step_march(name, monkeypatch):
+    """Every column of a 401-step sweep, solved at once, equals the same sweep marched
+    step by step (to the solver's tolerance), and every step converged here."""
+    corner = build(name)
+    sweep = long_sweep(corner)
+    tangents = []
+    solutions = corner.solve_steps(sweep, tangents=tangents)
+    assert all(s.converged for s in solutions)
+    ours = Results.from_solutions(corner, solutions, sweep, tangents or None)
+    step_by_step(monkeypatch)
+    reference = corner.run_sweep(sweep)
+    assert ours.columns.keys() == reference.columns.keys()
+    for key, expected in reference.columns.items():
+        got = np.asarray(ours.columns[key])
+        if key in ("solver_iterations", "solver_max_residual"):
+            continue
+        expected = np.asarray(expected)
+        if expected.dtype.kind != "f":
+            np.testing.assert_array_equal(got, expected, err_msg=key)
+            continue
+        np.testing.assert_array_equal(np.isnan(got), np.isnan(expected), err_msg=key)
+        # (an instant centre 20 km away carries the roundoff of a near-parallel pair)
+        scale = 1.0 + np.nanmax(np.abs(expected), initial=0.0)
+        np.testing.assert_allclose(got, expected, rtol=1e-7, atol=1e-9 * scale, err_msg=key)
+    assert np.max(ours["solver_max_residual"]) <= 1e-9  # mm
+
+
+def test_solved_at_once_rather_than_step_by_step(monkeypatch):
+    """The example's long sweep takes the at-once path (a test that the path above is
+    not the march's in disguise): the march sees only the coarse steps."""
+    corner = build("double_wishbone.yaml")
+    sweep = long_sweep(corner, steps=1001)
+    seen = []
+    march = solver.march
+
+    def counting(solver_, values, *args, **kwargs):
+        seen.append(len(values))
+        return march(solver_, values, *args, **kwargs)
+
+    monkeypatch.setattr(solver, "march", counting)
+    monkeypatch.setattr(pin_susp.corner, "march", counting)
+    solutions = corner.solve_steps(sweep)
+    assert all(s.converged for s in solutions)
+    assert seen[0] == 1001 and max(seen[1:]) <= 2 * bulk.COARSE_STEPS
+
+
+def test_each_step_closes_in_pinocchio_and_matches_the_point_based_solve():
+    """The at-once solution's residual recomputed by Pinocchio (closures and targets),
+    and its points against the point-based formulation solved with scipy."""
+    corner = build("double_wishbone.yaml")
+    sweep = long_sweep(corner, steps=601, curve=True)
+    results = corner.run_sweep(sweep)
+    assert results["solver_converged"].all()
+    solutions = corner.solve_steps(sweep)
+    s = corner.solver_for(sweep.targets, sweep.source)
+    values = corner.target_values(sweep.targets)
+    for i in range(0, 601, 25):
+        s.set_targets(values[i])
+        s.evaluate(solutions[i].q)
+        assert np.abs(s.residual).max() <= 1e-12  # m
+    reference = PointwiseCorner(example("double_wishbone.yaml"))
+    design_z = corner.design_positions["wheel_center"][2] * 1e3
+    x = None
+    for i in range(0, 601, 50):
+        bump = results["wheel_center_z"][i]
+        rack = sweep.targets[1].values[i]
+        x, residual = reference.solve(bump, rack, x)
+        assert residual < 1e-10
+        points = reference.points(x)
+        for name in ("upper_wishbone_outboard", "trackrod_outboard", "axle_outboard"):
+            for j, axis in enumerate("xyz"):
+                assert results[f"{name}_{axis}"][i] == pytest.approx(points[name][j], abs=1e-8)
+    assert results["wheel_center_z"][0] == pytest.approx(design_z - 40.0, abs=1e-9)
+
+
+def test_a_sweep_past_the_linkage_reach_is_flagged_as_step_by_step(monkeypatch):
+    """Steps the linkage cannot reach: the at-once path gives up, and the march's flags
+    and explanations are the result (same as marching from the start)."""
+    corner = build("pushrod_rocker.yaml")
+    sweep = long_sweep(corner, steps=241, bump=(-40.0, 160.0))
+    ours = corner.run_sweep(sweep)
+    assert not ours["solver_converged"].all()
+    step_by_step(monkeypatch)
+    reference = corner.run_sweep(sweep)
+    np.testing.assert_array_equal(ours["solver_converged"], reference["solver_converged"])
+    np.testing.assert_array_equal(ours["wheel_center_z"], reference["wheel_center_z"])
+
+
+def test_a_branch_flip_inside_a_coarse_segment_is_refused():
+    """A step off a loop's design assembly found at once is refused (then marched)."""
+    corner = build("double_wishbone.yaml")
+    s = corner.solver_for(long_sweep(corner).targets, "long")
+    qs = np.array([corner.q_design, corner.q_design])
+    assert bulk._on_branches(s, qs)
+    loop = s.branches.loops[0]
+    loop.sign = -loop.sign
+    try:
+        assert not bulk._on_branches(s, qs)
+    finally:
+        loop.sign = -loop.sign
+
+
+def test_vectorised_branch_measures_match_the_scalar_ones():
+    from pin_susp.closures import alignment, chirality
+
+    rng = np.random.default_rng(3)
+    points = rng.normal(size=(4, 50, 3))
+    for mine, theirs in ((bulk.chirality, chirality), (bulk.alignment, alignment)):
+        values = mine(*points)
+        for n in range(50):
+            assert values[n] == pytest.approx(theirs(*(p[n].tolist() for p in points)), abs=1e-15)
