@@ -149,6 +149,45 @@ class Tree:
             J[:, :3, vs] = a[ks].transpose(1, 2, 0)
         return J
 
+    def motion(self, o: np.ndarray, a: np.ndarray, qd: np.ndarray, qdd: np.ndarray):
+        """Every joint's body at velocity qd and acceleration qdd (n, nv): angular velocity
+        ω, angular acceleration α, and the velocity and classical acceleration of the
+        joint's origin, each (njoints, n, 3), from the root outward (Pinocchio's
+        forwardKinematics(q, v, a) with frame velocities and classical accelerations).
+
+        A joint's origin is a point of its parent body (a prismatic joint's slides along
+        the axis, which turns with the parent: the Coriolis term 2·q̇·ω × a); a joint's
+        axis turns with its parent body: d(a)/dt = ω_parent × a.
+        """
+        n = qd.shape[0]
+        w, dw = np.zeros((len(o), n, 3)), np.zeros((len(o), n, 3))
+        v, dv = np.zeros((len(o), n, 3)), np.zeros((len(o), n, 3))
+        for i, (parent, revolute, _, _, _, k) in enumerate(self.joints, start=1):
+            wp, dwp = w[parent], dw[parent]
+            r = o[i] - o[parent]
+            wr = cross(wp, r)
+            v[i] = v[parent] + wr
+            dv[i] = dv[parent] + cross(dwp, r) + cross(wp, wr)
+            rate, accel = qd[:, k, None], qdd[:, k, None]
+            turn = cross(wp, a[i])  # the axis's own rate
+            if revolute:
+                w[i] = wp + rate * a[i]
+                dw[i] = dwp + accel * a[i] + rate * turn
+            else:
+                w[i], dw[i] = wp, dwp
+                v[i] += rate * a[i]
+                dv[i] += accel * a[i] + 2.0 * rate * turn
+        return w, dw, v, dv
+
+
+def point_motion(joint: int, p: np.ndarray, o: np.ndarray, state) -> tuple:
+    """Velocity and classical acceleration (n, 3) of points p (n, 3) fixed to ``joint``'s
+    body, from Tree.motion's state (ω, α, v, a of each joint)."""
+    w, dw, v, dv = (x[joint] for x in state)
+    r = p - o[joint]
+    wr = cross(w, r)
+    return v + wr, dv + cross(dw, r) + cross(w, wr)
+
 
 def _times(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     """A·B for stacked A (n, 3, 3) and one B (3, 3)."""
@@ -186,12 +225,21 @@ class Frames:
     def evaluate(self, q: np.ndarray, jacobians: bool = True):
         """Positions (list of (n, 3)) and Jacobians (list of (n, 3, nv), or None)."""
         R, o = self.tree.placements(q)
-        P = [o[j] + _apply(R[j], x) for j, x in zip(self.joint, self.offset, strict=True)]
+        P = self.positions(R, o)
         if not jacobians:
             return P, None
         a = self.tree.axes(R)
         J = [self.tree.point_jacobian(j, p, o, a) for j, p in zip(self.joint, P, strict=True)]
         return P, J
+
+    def positions(self, R: np.ndarray, o: np.ndarray) -> list[np.ndarray]:
+        """Each frame's position (n, 3) from the joints' placements (Tree.placements)."""
+        return [o[j] + _apply(R[j], x) for j, x in zip(self.joint, self.offset, strict=True)]
+
+    def motion(self, P: list, o: np.ndarray, state) -> tuple[list, list]:
+        """Each frame's velocity and classical acceleration (n, 3) in a Tree.motion state."""
+        out = [point_motion(j, p, o, state) for j, p in zip(self.joint, P, strict=True)]
+        return [v for v, _ in out], [acc for _, acc in out]
 
 
 class Rows:
@@ -254,6 +302,30 @@ class Rows:
                     J[:, i, b] = 1.0
         return r, J
 
+    def second(self, R, o, P, state, qdd: np.ndarray) -> np.ndarray:
+        """Every row's second time derivative (n, nrows) in a Tree.motion state (at q with
+        velocity q̇ and acceleration ``qdd``; P: the frames' positions): with q̈ = 0, the
+        drift J̇·q̇ of the second-order closure solve J·q̈ = −J̇·q̇."""
+        V, A = self.frames.motion(P, o, state)
+        out = np.empty((len(qdd), self.nrows))
+        for kind, i, a, b, extra in self.items:
+            if kind == "ball":
+                out[:, i : i + 3] = A[b] - A[a]
+            elif kind == "distance":  # |d|″ = u·d″ + (|d′|² − (u·d′)²)/|d|
+                d, dv = P[b] - P[a], V[b] - V[a]
+                length = np.sqrt(np.einsum("ni,ni->n", d, d))
+                u = d / length[:, None]
+                along = np.einsum("ni,ni->n", u, dv)
+                out[:, i] = (
+                    np.einsum("ni,ni->n", u, A[b] - A[a])
+                    + (np.einsum("ni,ni->n", dv, dv) - along * along) / length
+                )
+            elif kind == "target":
+                out[:, i] = A[a] @ extra
+            else:
+                out[:, i] = qdd[:, b]
+        return out
+
 
 def _framed(*points) -> bool:
     return all(type(p) is FramePoint for p in points)
@@ -302,7 +374,7 @@ def solve_sweep(solver, values: np.ndarray, q: np.ndarray, previous: np.ndarray,
         return None
     if not _on_branches(solver, qs):
         return None
-    solutions = [Solution(qs[i], True, int(iterations[i]), float(error[i])) for i in range(n)]
+    solutions = list(map(Solution, qs, [True] * n, iterations.tolist(), error.tolist()))
     if progress is not None:
         progress(n, n)
     return solutions, T

@@ -36,10 +36,12 @@ class Dual:
         return Dual(-self.val, -self.der)
 
     def __sub__(self, other):
-        return self + (-other)
+        if isinstance(other, Dual):
+            return Dual(self.val - other.val, self.der - other.der)
+        return Dual(self.val - other, self.der)
 
     def __rsub__(self, other):
-        return (-self) + other
+        return Dual(other - self.val, -self.der)
 
     def __mul__(self, other):
         if isinstance(other, Dual):

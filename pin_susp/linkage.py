@@ -173,9 +173,9 @@ class FrameMotion:
                 pos[:, index] = local
                 rates[:, :, index] = 0.0
                 continue
-            arms = np.einsum("nij,mj->nmi", R[j], local)
+            arms = (R[j].reshape(-1, 3) @ local.T).reshape(count, 3, -1).transpose(0, 2, 1)
             pos[:, index] = arms + o[j][:, None]
-            twist = np.einsum("nsv,nvk->kns", tree.twist_jacobian(j, o, a), T)  # (k, n, 6)
+            twist = (tree.twist_jacobian(j, o, a) @ T).transpose(2, 0, 1)  # (k, n, 6)
             rates[:, :, index] = twist[:, :, None, :3] + cross(twist[:, :, None, 3:], arms[None])
         if count == n:
             return pos, rates

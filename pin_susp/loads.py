@@ -761,24 +761,85 @@ class SpringRates:
             return self.sense * angle, self.sense * axis @ w.angular, self.sense * axis @ dw.angular
         return self._length(self.top.frame_id, self.bottom.frame_id)
 
+    def derivatives_at_once(self, qs: list) -> tuple | None:
+        """``derivatives`` for every configuration at once, on the model's tree (bulk.py):
+        arrays (x, ẋ, ẍ) with NaN where q is None; None where the tree or the rows are
+        not of the kinds handled there (then each is computed by ``derivatives``)."""
+        from .bulk import Frames, solve_all
+
+        tree, rows = self.corner.kin.tree, self.solver.bulk
+        if not (tree.supported and rows.supported and rows.nrows == self.model.nv):
+            return None
+        solved = [i for i, q in enumerate(qs) if q is not None]
+        n, out = len(solved), np.full((3, len(qs)), np.nan)
+        if not n:
+            return tuple(out)
+        Q = np.array([qs[i] for i in solved])
+        R, o = tree.placements(Q)
+        a = tree.axes(R)
+        _, J = rows.evaluate(Q, np.zeros((n, len(self.solver.targets))))
+        T = solve_all(J, self.solver._unit_rhs)
+        if T is None:
+            return None
+        v, zero = T[:, :, 0], np.zeros((n, self.model.nv))  # dq/dz, the other drivers held
+        P = rows.frames.positions(R, o)
+        drift = rows.second(R, o, P, tree.motion(o, a, v, zero), zero)
+        qdd = solve_all(J, -drift[:, :, None])
+        if qdd is None:
+            return None
+        state = tree.motion(o, a, v, qdd[:, :, 0])
+        points = self.corner.points
+        if self.torsion:
+            names = ("rocker_axis_a", "rocker_axis_b", "pushrod_inboard")
+            frames = Frames(tree, [points[k].frame_id for k in names])
+            A, B, arm = frames.positions(R, o)
+            u = (B - A) / np.linalg.norm(B - A, axis=1)[:, None]
+            arm = arm - A
+            arm0 = self.corner.design_positions["pushrod_inboard"] - A
+            arm = arm - u * np.einsum("ni,ni->n", u, arm)[:, None]
+            arm0 = arm0 - u * np.einsum("ni,ni->n", u, arm0)[:, None]
+            angle = np.arctan2(
+                np.einsum("ni,ni->n", u, np.cross(arm0, arm)), np.einsum("ni,ni->n", arm0, arm)
+            )
+            joint = frames.joint[2]  # the rocker's
+            w, dw = state[0][joint], state[1][joint]
+            values = (angle, np.einsum("ni,ni->n", u, w), np.einsum("ni,ni->n", u, dw))
+            out[:, solved] = self.sense * np.array(values)
+            return tuple(out)
+        frames = Frames(tree, [self.top.frame_id, self.bottom.frame_id])
+        P = frames.positions(R, o)
+        V, A = frames.motion(P, o, state)
+        d, dv = P[1] - P[0], V[1] - V[0]
+        length = np.linalg.norm(d, axis=1)
+        u = d / length[:, None]
+        along = np.einsum("ni,ni->n", u, dv)
+        second = (
+            np.einsum("ni,ni->n", u, A[1] - A[0])
+            + (np.einsum("ni,ni->n", dv, dv) - along * along) / length
+        )
+        out[:, solved] = length, along, second
+        return tuple(out)
+
     def columns(self, qs: list) -> dict:
         """name → (values per configuration, unit); None configurations give NaN."""
         g = self.corner.geometry
         n = len(qs)
-        force, wheel = np.full(n, np.nan), np.full(n, np.nan)
-        for i, q in enumerate(qs):
-            if q is None:
-                continue
-            x, dx, ddx = self.derivatives(q)
-            if self.torsion:  # wind-up (rad, + in bump) and its rates
-                stiffness = g.spring_rate * 180.0 / np.pi  # N·m/rad
-                force[i] = g.spring_preload + stiffness * (x - self.design)
-                ratio, dratio = dx, ddx
-            else:  # compression (m) and the motion ratio, −dℓ/dz
-                stiffness = g.spring_rate * 1e3  # N/m
-                force[i] = g.spring_preload + stiffness * (self.design - x)
-                ratio, dratio = -dx, -ddx
-            wheel[i] = (stiffness * ratio * ratio + force[i] * dratio) * 1e-3  # N/mm
+        derivatives = self.derivatives_at_once(qs)
+        if derivatives is None:  # one configuration after another
+            derivatives = np.full((3, n), np.nan)
+            for i, q in enumerate(qs):
+                if q is not None:
+                    derivatives[:, i] = self.derivatives(q)
+        x, dx, ddx = derivatives
+        if self.torsion:  # wind-up (rad, + in bump) and its rates
+            stiffness = g.spring_rate * 180.0 / np.pi  # N·m/rad
+            force = g.spring_preload + stiffness * (x - self.design)
+            ratio, dratio = dx, ddx
+        else:  # compression (m) and the motion ratio, −dℓ/dz
+            stiffness = g.spring_rate * 1e3  # N/m
+            force = g.spring_preload + stiffness * (self.design - x)
+            ratio, dratio = -dx, -ddx
+        wheel = (stiffness * ratio * ratio + force * dratio) * 1e-3  # N/mm
         out = {
             ("spring_torque" if self.torsion else "spring_force"): (
                 force,

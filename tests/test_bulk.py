@@ -190,3 +190,75 @@ def test_vectorised_branch_measures_match_the_scalar_ones():
         values = mine(*points)
         for n in range(50):
             assert values[n] == pytest.approx(theirs(*(p[n].tolist() for p in points)), abs=1e-15)
+
+
+@pytest.mark.parametrize("name", ["macpherson.yaml", "pushrod_rocker.yaml", "multilink_front.yaml"])
+def test_tree_velocities_and_accelerations_match_pinocchio(name):
+    """Every frame's velocity and classical acceleration, and every body's angular
+    velocity and acceleration, at random (q, v, a): against Pinocchio's
+    forwardKinematics(q, v, a)."""
+    corner = build(name)
+    model = corner.model
+    data = model.createData()
+    tree = Tree(model)
+    rng = np.random.default_rng(11)
+    q = corner.q_design + rng.normal(0.0, 0.3, (5, model.nq))
+    qd, qdd = rng.normal(size=(5, model.nv)), rng.normal(size=(5, model.nv))
+    R, o = tree.placements(q)
+    a = tree.axes(R)
+    state = tree.motion(o, a, qd, qdd)
+    frames = Frames(tree, list(range(model.nframes)))
+    P, _ = frames.evaluate(q, jacobians=False)
+    world = pin.LOCAL_WORLD_ALIGNED
+    for n in range(len(q)):
+        pin.forwardKinematics(model, data, q[n], qd[n], qdd[n])
+        pin.updateFramePlacements(model, data)
+        for k, f in enumerate(frames.ids):
+            j = frames.joint[k]
+            vel, acc = bulk.point_motion(
+                j, P[k][n : n + 1], o[:, n : n + 1], [x[:, n : n + 1] for x in state]
+            )
+            np.testing.assert_allclose(
+                vel[0], pin.getFrameVelocity(model, data, f, world).linear, atol=1e-13
+            )
+            np.testing.assert_allclose(
+                acc[0], pin.getFrameClassicalAcceleration(model, data, f, world).linear, atol=1e-12
+            )
+            np.testing.assert_allclose(
+                state[0][j, n], pin.getFrameVelocity(model, data, f, world).angular, atol=1e-13
+            )
+            np.testing.assert_allclose(
+                state[1][j, n], pin.getFrameAcceleration(model, data, f, world).angular, atol=1e-12
+            )
+
+
+def torsion_bar() -> dict:
+    geometry = example("pushrod_rocker.yaml")
+    geometry["spring"] = {"type": "torsion_bar", "rate": 40, "preload": 150}  # N·m/deg, N·m
+    for point in ("strut_top", "strut_bottom"):
+        del geometry["hardpoints"][point]
+    return geometry
+
+
+@pytest.mark.parametrize(
+    "geometry",
+    [example("macpherson.yaml"), example("pushrod_rocker.yaml"), torsion_bar()],
+    ids=["macpherson strut", "pushrod coilover", "torsion bar"],
+)
+def test_spring_length_and_its_rates_at_once_equal_each_pose_alone(geometry):
+    """The spring's length (a torsion bar's wind-up), motion ratio and its rate — the
+    second-order closure solve — for every step at once, against Pinocchio's
+    forwardKinematics(q, v, a) one pose at a time (loads.SpringRates.derivatives)."""
+    from pin_susp.loads import SpringRates
+
+    corner = pin_susp.Corner(geometry, warn=False)
+    solutions = corner.solve_steps(long_sweep(corner, steps=61))
+    qs = [s.q for s in solutions]
+    qs[7] = None  # a step that did not converge: NaN
+    rates = SpringRates(corner)
+    at_once = np.array(rates.derivatives_at_once(qs))
+    assert np.isnan(at_once[:, 7]).all()
+    for i, q in enumerate(qs):
+        if q is not None:
+            expected = rates.derivatives(q)
+            np.testing.assert_allclose(at_once[:, i], expected, rtol=1e-12, atol=1e-15)
