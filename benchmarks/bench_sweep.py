@@ -206,9 +206,125 @@ def run(repeat: int, quick: bool) -> dict:
     pairs = {name: ref for name, ref in MECHANISMS.items() if ref is not None}
     for name, ratio in interleaved(pairs, max(3, repeat // 2)).items():
         report["corners"][name]["vs"] = {"corner": pairs[name], "ratio": ratio}
+    report["long"] = long_sweep(max(3, repeat // 8), 201 if quick else 2001, 21 if quick else 201)
+    report["cli"] = cli_marginal((201, 2001) if quick else (2001, 20001), 2 if quick else 5)
     report["axle"] = axle_vs_corner(max(3, repeat // 2))
     report["loads"] = loads_overhead(max(3, repeat // 4))
     return report
+
+
+def issue_sweep(steps: int) -> Sweep:
+    """The long sweep of issue 17 (open-kinematics' test corner): wheel centre
+    −40…120 mm with the rack −40…40 mm."""
+    return Sweep(
+        [
+            Target("wheel_center", "z", np.linspace(-40, 120, steps)),
+            Target("trackrod_inboard", "y", np.linspace(-40, 40, steps)),
+        ],
+        "bump+steer, long",
+    )
+
+
+def long_sweep(rounds: int, steps: int, baseline_steps: int) -> dict:
+    """The example corner's long sweep in process, per step, measured in alternation:
+    the solve alone, the solve with every column, and with the CSV's text and the Parquet
+    file too; the same solve + columns marched one step after another (the path before
+    issue 17); and the point-based baselines on the first ``baseline_steps`` steps."""
+    import tempfile
+
+    import pin_susp.corner
+    from pin_susp import solver
+    from pin_susp.export import csv_text, write_parquet
+
+    corner = pin_susp.Corner(EXAMPLES / "double_wishbone.yaml")
+    sweep = issue_sweep(steps)
+    march = solver.march
+
+    def step_by_step():
+        pin_susp.corner.march = lambda *a, **k: march(*a, **{**k, "bulk": False})
+        try:
+            return corner.run_sweep(sweep)
+        finally:
+            pin_susp.corner.march = march
+
+    folder = tempfile.TemporaryDirectory()
+    parquet = Path(folder.name) / "out.parquet"
+    jobs = {
+        "solve": lambda: corner.solve_steps(sweep, tangents=[]),
+        "solve + every column": lambda: corner.run_sweep(sweep),
+        "... + CSV text": lambda: csv_text(corner.run_sweep(sweep)),
+        "... + Parquet file": lambda: write_parquet(corner.run_sweep(sweep), parquet),
+        "step by step: solve + every column": step_by_step,
+    }
+    us = alternating(jobs, rounds, steps)
+    results = corner.run_sweep(sweep)
+    writes = {
+        "CSV text": lambda: csv_text(results),
+        "Parquet": lambda: write_parquet(results, parquet),
+    }
+    written = alternating(writes, rounds, steps)
+    folder.cleanup()
+    head = Sweep([replace_values(t, baseline_steps) for t in sweep.targets], "head")
+    base = {
+        "a_fd_jacobian": baseline(corner, head, "2-point", 1),
+        "b_analytic_jacobian": baseline(corner, head, "analytic", 1),
+    }
+    ours = us["solve + every column"]
+    return {
+        "steps": steps,
+        "columns": len(results.columns),
+        "us_per_step": us,
+        "writer_us_per_row": written,
+        "baselines": {k: v | {"ratio": v["time_us_per_step"] / ours} for k, v in base.items()},
+        "vs_step_by_step": us["step by step: solve + every column"] / ours,
+        "converged": bool(results["solver_converged"].all()),
+        "max_residual_mm": float(np.max(results["solver_max_residual"])),
+    }
+
+
+def replace_values(target: Target, n: int) -> Target:
+    from dataclasses import replace
+
+    return replace(target, values=target.values[:n])
+
+
+def cli_marginal(steps: tuple[int, int], rounds: int) -> dict:
+    """`pin-susp sweep` of the long sweep through the command line at two lengths, in
+    alternation: the wall time, and the marginal cost per step (solve, every column,
+    the CSV) as the difference over the extra steps."""
+    import shutil
+    import subprocess
+    import sys
+    import tempfile
+
+    exe = shutil.which("pin-susp") or str(Path(sys.executable).parent / "pin-susp")
+    folder = Path(tempfile.mkdtemp())
+    files = {}
+    for n in steps:
+        sweep = folder / f"sweep_{n}.yaml"
+        sweep.write_text(
+            f"version: 1\nsteps: {n}\ntargets:\n"
+            "  - {point: wheel_center, direction: {axis: z}, start: -40, stop: 120}\n"
+            "  - {point: trackrod_inboard, direction: {axis: y}, start: -40, stop: 40}\n"
+        )
+        files[n] = sweep
+    geometry = str(EXAMPLES / "double_wishbone.yaml")
+    times = {n: [] for n in steps}
+    for _ in range(rounds):
+        for n in steps:
+            started = time.perf_counter()
+            subprocess.run(
+                [exe, "sweep", geometry, str(files[n]), "-o", str(folder / "out.csv"), "-q"],
+                check=True,
+            )
+            times[n].append(time.perf_counter() - started)
+    shutil.rmtree(folder)
+    wall = {n: float(np.median(t)) for n, t in times.items()}
+    short, long = steps
+    return {
+        "wall_s": {str(n): t for n, t in wall.items()},
+        "marginal_us_per_step": (wall[long] - wall[short]) / (long - short) * 1e6,
+    }
 
 
 def loads_overhead(rounds: int, steps: int = 101) -> dict:
@@ -380,6 +496,36 @@ def show(report: dict) -> None:
             )
 
 
+def show_long(long: dict, cli: dict) -> None:
+    us, b = long["us_per_step"], long["baselines"]
+    print(
+        f"\nlong sweep (issue 17): double_wishbone.yaml, {long['steps']} steps, wheel centre "
+        f"-40...120 mm, rack -40...40 mm, {long['columns']} columns; per step, in alternation:"
+    )
+    for name, t in us.items():
+        print(f"  {name:38s} {t:8.1f} us")
+    print(
+        "  target: solve + every column <= 22 us; the same solved step by step is "
+        f"{long['vs_step_by_step']:.1f}x slower"
+    )
+    for name, t in long["writer_us_per_row"].items():
+        print(f"  writing the table alone, {name:14s} {t:8.1f} us per row")
+    print(
+        f"  baselines (point-based, scipy least_squares, warm-started) per step: "
+        f"(a) FD Jacobian {b['a_fd_jacobian']['time_us_per_step']:.0f} us = "
+        f"{b['a_fd_jacobian']['ratio']:.0f}x, (b) analytic Jacobian "
+        f"{b['b_analytic_jacobian']['time_us_per_step']:.0f} us = "
+        f"{b['b_analytic_jacobian']['ratio']:.0f}x solve + every column (target >= 50x)"
+    )
+    wall = ", ".join(f"{n} steps {t:.2f} s" for n, t in cli["wall_s"].items())
+    m = cli["marginal_us_per_step"]
+    print(
+        f"  through the CLI (pin-susp sweep to CSV): {wall}; marginal {m:.1f} us per step "
+        f"(target ~30 us; open-kinematics 0.4.1, measured outside this repository at "
+        f"8-10 ms per step, is {8000 / m:.0f}-{10000 / m:.0f}x that)"
+    )
+
+
 def show_axle(axle: dict) -> None:
     print("\naxle_front.yaml against its corner pushrod_rocker.yaml (bump + steer), per step,")
     print("measured in alternation (target <= 2.5x):")
@@ -407,6 +553,7 @@ def main() -> None:
     args = parser.parse_args()
     report = run(3 if args.quick else args.repeat, args.quick)
     show(report)
+    show_long(report["long"], report["cli"])
     show_axle(report["axle"])
     show_loads(report["loads"])
     if args.json:

@@ -36,7 +36,7 @@ from .closures import BallClosure, DistanceClosure, FramePoint, JointTarget, Poi
 
 # A sweep shorter than this is marched step by step (the coarse pass would be most of it).
 MIN_STEPS = 200
-COARSE_STEPS = 64  # about this many coarse steps, whatever the sweep's length
+COARSE_STEPS = 32  # about this many coarse steps, whatever the sweep's length
 MAX_ITERATIONS = 8
 
 

@@ -8,6 +8,8 @@ The model itself — URDF, Pinocchio model, points, closures — is the
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from . import setup
@@ -18,6 +20,8 @@ from .linkage import Linkage
 from .metrics import METRICS, TOE_LINK, Pose, metric_columns, point_columns
 from .solver import NewtonSolver, Solution, march
 from .sweep import Sweep, Target, load_sweep
+
+CHUNK = 10_000  # steps solved and written at a time by a streamed sweep
 
 
 class Corner(Linkage):
@@ -115,6 +119,37 @@ class Corner(Linkage):
         tangents = []
         solutions = self.solve_steps(sweep, progress, tangents=tangents)
         return Results.from_solutions(self, solutions, sweep, tangents or None)
+
+    def run_sweep_chunks(self, sweep: Sweep | str | dict, rows: int = CHUNK, progress=None):
+        """The sweep's Results ``rows`` steps at a time (each chunk's ``step_index``
+        counts from the sweep's first step): the same values as run_sweep, in memory
+        that does not grow with the sweep's length — for writing as it goes.
+
+        Each chunk starts from the last converged pose before it (the design state for
+        the first), as the sweep's march does.
+        """
+        if not isinstance(sweep, Sweep):
+            sweep = load_sweep(sweep)
+        self.solver_for(sweep.targets, sweep.source)  # the targets' errors before any work
+        q = None
+        for start in range(0, sweep.steps, rows):
+            part = Sweep(
+                [replace(t, values=t.values[start : start + rows]) for t in sweep.targets],
+                sweep.source,
+                sweep.sha256,
+                sweep.data,
+            )
+            done = None
+            if progress is not None:
+                done = lambda i, n, start=start: progress(start + i, sweep.steps)  # noqa: E731
+            tangents = []
+            solutions = self.solve_steps(part, done, q_start=q, tangents=tangents)
+            results = Results.from_solutions(self, solutions, part, tangents or None)
+            results.columns["step_index"] = results.columns["step_index"] + start
+            converged = [s for s in solutions if s.converged]
+            if converged:
+                q = converged[-1].q
+            yield results
 
     def solve_steps(
         self,

@@ -262,3 +262,19 @@ def test_spring_length_and_its_rates_at_once_equal_each_pose_alone(geometry):
         if q is not None:
             expected = rates.derivatives(q)
             np.testing.assert_allclose(at_once[:, i], expected, rtol=1e-12, atol=1e-15)
+
+
+def test_a_sweep_that_turns_back_and_holds_equals_the_march(monkeypatch):
+    """Bump up and back down (the apex inside a coarse segment), then held for 50 steps:
+    predictions off the segment's line, and segments of zero length."""
+    corner = build("double_wishbone.yaml")
+    up = np.linspace(-30.0, 50.0, 151)
+    bump = np.r_[up, up[::-1][1:], np.full(50, -30.0)]
+    rack = np.r_[np.linspace(0.0, 8.0, 151), np.linspace(8.0, -8.0, 150), np.full(50, -8.0)]
+    sweep = Sweep([Target("wheel_center", "z", bump), Target("trackrod_inboard", "y", rack)], "s")
+    ours = corner.run_sweep(sweep)
+    assert ours["solver_converged"].all()
+    step_by_step(monkeypatch)
+    reference = corner.run_sweep(sweep)
+    for key in ("camber", "roadwheel_angle", "deriv_camber_wrt_hub_z", "upper_wishbone_outboard_x"):
+        np.testing.assert_allclose(ours[key], reference[key], rtol=0, atol=1e-10, err_msg=key)
