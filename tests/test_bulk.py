@@ -278,3 +278,23 @@ def test_a_sweep_that_turns_back_and_holds_equals_the_march(monkeypatch):
     reference = corner.run_sweep(sweep)
     for key in ("camber", "roadwheel_angle", "deriv_camber_wrt_hub_z", "upper_wishbone_outboard_x"):
         np.testing.assert_allclose(ours[key], reference[key], rtol=0, atol=1e-10, err_msg=key)
+
+
+def test_chunks_of_a_sweep_equal_the_whole_sweep():
+    """run_sweep_chunks: the chunks, joined, are run_sweep's columns (step_index counted
+    from the sweep's start), each chunk from the last converged pose before it."""
+    corner = build("pushrod_rocker.yaml")
+    sweep = long_sweep(corner, steps=700)
+    whole = corner.run_sweep(sweep)
+    seen = []
+    parts = list(corner.run_sweep_chunks(sweep, rows=250, progress=lambda i, n: seen.append(i)))
+    assert [len(p) for p in parts] == [250, 250, 200]
+    assert seen[-1] == 700 and seen == sorted(seen)
+    for key, expected in whole.columns.items():
+        if key in ("solver_iterations", "solver_max_residual"):
+            continue
+        got = np.concatenate([p.columns[key] for p in parts])
+        if expected.dtype.kind != "f":
+            np.testing.assert_array_equal(got, expected, err_msg=key)
+        else:
+            np.testing.assert_allclose(got, expected, rtol=1e-9, atol=1e-9, err_msg=key)
