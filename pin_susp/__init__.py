@@ -19,14 +19,71 @@ is in SI units (m, rad).
 
 __version__ = "0.1.0"
 
-from .corner import Corner, Results  # noqa: E402
-from .errors import InputError, PinSuspError  # noqa: E402
-from .geometry import Geometry, load_geometry  # noqa: E402
-from .loads import LoadCase, load_cases, member_forces  # noqa: E402
-from .metrics import METRICS, Pose  # noqa: E402
-from .sensitivity import hardpoint_sensitivities  # noqa: E402
-from .setup import SetupModel, apply_setup, setup_sheet, solve_setup  # noqa: E402
-from .sweep import Sweep, Target, load_sweep  # noqa: E402
+import sys
+from typing import TYPE_CHECKING
+
+# Each public name and the submodule that defines it. They load on first use
+# (PEP 562), so that `import pin_susp` or a CLI command that needs only the
+# sweep does not pay for loads, sensitivities, studies and their libraries.
+_EXPORTS = {
+    "Corner": "corner",
+    "Results": "corner",
+    "InputError": "errors",
+    "PinSuspError": "errors",
+    "Geometry": "geometry",
+    "load_geometry": "geometry",
+    "LoadCase": "loads",
+    "load_cases": "loads",
+    "member_forces": "loads",
+    "METRICS": "metrics",
+    "Pose": "metrics",
+    "hardpoint_sensitivities": "sensitivity",
+    "SetupModel": "setup",
+    "apply_setup": "setup",
+    "setup_sheet": "setup",
+    "solve_setup": "setup",
+    "Sweep": "sweep",
+    "Target": "sweep",
+    "load_sweep": "sweep",
+}
+
+if TYPE_CHECKING:  # for type checkers and IDEs; at run time __getattr__ below
+    from .corner import Corner, Results
+    from .errors import InputError, PinSuspError
+    from .geometry import Geometry, load_geometry
+    from .loads import LoadCase, load_cases, member_forces
+    from .metrics import METRICS, Pose
+    from .sensitivity import hardpoint_sensitivities
+    from .setup import SetupModel, apply_setup, setup_sheet, solve_setup
+    from .sweep import Sweep, Target, load_sweep
+
+
+def __getattr__(name: str):
+    module = _EXPORTS.get(name)
+    if module is not None:
+        value = getattr(_submodule(module), name)
+        globals()[name] = value  # once: later look-ups skip this function
+        return value
+    if name.startswith("__"):  # probes such as __wrapped__: no submodule has such a name
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    try:  # a submodule not imported yet, as `import pin_susp` used to import them all
+        return _submodule(name)
+    except ModuleNotFoundError as exc:
+        if exc.name != f"{__name__}.{name}":
+            raise
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def _submodule(name: str):
+    # __import__ (not importlib.import_module): the import machinery's own path, which
+    # `python -X importtime` reports
+    __import__(f"{__name__}.{name}")
+    return sys.modules[f"{__name__}.{name}"]
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_EXPORTS))
+
 
 __all__ = [
     "METRICS",

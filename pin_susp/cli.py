@@ -4,13 +4,17 @@ Exit codes: 0 success; 1 the run finished but some steps did not converge
 (their rows are written, flagged ``solver_converged = False`` with empty
 metric cells); 2 a problem with the input (one line on stderr, nothing
 written).
+
+Start-up time: each command imports what it uses inside its own function
+(numpy, Pinocchio and the package's modules included), so that ``--help``
+costs no numpy and a sweep no plotting, loads or studies
+(tests/test_startup.py).
 """
 
 from __future__ import annotations
 
 import argparse
 import contextlib
-import hashlib
 import math
 import os
 import re
@@ -19,21 +23,16 @@ import stat
 import sys
 import threading
 import warnings
-from dataclasses import replace
-from importlib import resources
 from pathlib import Path
-
-import numpy as np
-import yaml
+from typing import TYPE_CHECKING
 
 from . import __version__
-from .corner import Corner, Results
 from .errors import PinSuspError, PlausibilityWarning
-from .export import all_or_none, check_output, csv_text, is_stream, write_text
-from .geometry import load_geometry
-from .metrics import METRIC_BY_NAME, METRICS
-from .sweep import load_sweep
-from .yamlio import MAX_LENGTH_MM
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from .corner import Results
 
 SHEET_METRICS = (  # column, unit, short heading
     ("camber", "deg", "camber"),
@@ -57,6 +56,8 @@ def main(argv: list[str] | None = None) -> int:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # --help, --version, or a usage error (one line, exit 2)
         return exc.code if isinstance(exc.code, int) else EXIT_INPUT
+    import numpy as np
+
     with (
         _terminate_as_exit(),
         warnings.catch_warnings(record=True) as caught,
@@ -162,6 +163,8 @@ def _geometry_argument(parser: argparse.ArgumentParser) -> None:
 
 def _numbers(text: str) -> list[float]:
     """Lengths in mm separated by commas: finite, within the 100 m limit of any car."""
+    from .yamlio import MAX_LENGTH_MM
+
     try:
         values = [float(x) for x in text.split(",")]
     except ValueError:
@@ -231,6 +234,10 @@ def _run_arguments(parser, output: str, plot: str, cases: bool = False) -> None:
 
 
 def _sweep(args) -> int:
+    from .corner import Corner
+    from .geometry import load_geometry
+    from .sweep import load_sweep
+
     _check_outputs(args, args.output, args.plot)
     if args.plot is not None:
         _check_image(args.plot)
@@ -252,6 +259,8 @@ def _sweep(args) -> int:
 def _write_results(args, results) -> bool:
     """The CSV (Parquet for an OUT ending .parquet) and, with --plot, the report: both or
     neither; whether it was drawn."""
+    from .export import all_or_none, csv_text, write_text
+
     plot = args.plot is not None and results["solver_converged"].any()
     text = csv_text(results)
     with all_or_none():
@@ -294,6 +303,8 @@ def _loads_command(sub) -> None:
 
 
 def _loads(args) -> int:
+    import numpy as np
+
     _check_outputs(args, args.output, args.plot)
     if args.plot is not None:
         _check_image(args.plot)
@@ -315,7 +326,10 @@ def _loads(args) -> int:
 def _load_inputs(geometry, sweep, cases):
     """A corner or an axle, its sweep and load cases, every input error said before any
     work."""
+    from .corner import Corner
+    from .geometry import load_geometry
     from .loads import Statics, load_cases
+    from .sweep import load_sweep
 
     if _is_axle(geometry):
         from .axle import axle_rows
@@ -336,6 +350,7 @@ def _load_inputs(geometry, sweep, cases):
 
 def _solve_forces(corner, sweep, cases, quiet: bool):
     """The sweep's results and, at every step and load case, the forces."""
+    from .corner import Corner, Results
     from .loads import member_forces
 
     if not isinstance(corner, Corner):  # an axle
@@ -365,6 +380,8 @@ def _chosen_case(path, cases, name: str | None) -> str:
 
 def _force_summary(forces) -> None:
     """The largest tension and compression of each member over the sweep, per case."""
+    import numpy as np
+
     names = [n for n in forces.columns if n.startswith(("force_", "torque_"))]
     print(f"  {'member':36s} {'case':18s} {'min':>12s} {'max':>12s}")
     for case in dict.fromkeys(forces["load_case"]):
@@ -396,7 +413,10 @@ def _axle_model(path):
 
 def _sweep_axle(args) -> int:
     """An axle's sweep: both corners' columns (suffixed by side) and the axle's."""
+    import numpy as np
+
     from .axle import axle_results, solve_axle_sweep
+    from .sweep import load_sweep
 
     model = _axle_model(args.geometry)
     sweep = load_sweep(args.sweep)
@@ -467,6 +487,10 @@ def _urdf_command(sub) -> None:
 
 
 def _urdf(args) -> int:
+    from .corner import Corner
+    from .export import all_or_none, is_stream, write_text
+    from .geometry import load_geometry
+
     if args.at is not None and args.output is None:
         raise PinSuspError("--at writes a sidecar beside the URDF: give -o OUT.urdf too")
     _check_outputs(args, args.output)
@@ -489,6 +513,8 @@ def _urdf(args) -> int:
     with all_or_none():
         write_text(corner.urdf, args.output)
         if pose is not None:
+            import yaml
+
             write_text(yaml.safe_dump(pose, sort_keys=False), sidecar)
     print(f"wrote {args.output}")
     if sidecar is not None:
@@ -498,6 +524,8 @@ def _urdf(args) -> int:
 
 def _pose_at(corner, at: str) -> dict:
     """Joint values of one solved sweep step, by joint name (rad, m)."""
+    from .sweep import load_sweep
+
     path, _, step = at.rpartition(":")
     if not path or not re.fullmatch(r"[0-9]{1,9}", step):
         raise PinSuspError(f"--at {at}: expected SWEEP.yaml:STEP, e.g. bump_steer.yaml:20")
@@ -538,6 +566,9 @@ def _mjcf_command(sub) -> None:
 
 
 def _mjcf(args) -> int:
+    from .corner import Corner
+    from .export import write_text
+    from .geometry import load_geometry
     from .mjcf import tree_to_mjcf
 
     _check_outputs(args, args.output)
@@ -598,6 +629,9 @@ def _validate_command(sub) -> None:
 
 
 def _validate(args) -> int:
+    from .corner import Corner
+    from .geometry import load_geometry
+    from .sweep import load_sweep
     from .validate import validate
 
     axle = _is_axle(args.geometry)
@@ -703,6 +737,17 @@ def _demo_command(sub) -> None:
 
 
 def _demo(args) -> int:
+    import hashlib
+    from dataclasses import replace
+    from importlib import resources
+
+    import yaml
+
+    from .corner import Corner
+    from .export import all_or_none, csv_text, write_text
+    from .geometry import load_geometry
+    from .sweep import load_sweep
+
     out = Path(args.output)
     if str(args.output).strip() == "" or (out.exists() and not out.is_dir()):
         raise PinSuspError(f"{args.output!r}: the demo writes several files: give a folder")
@@ -751,6 +796,7 @@ def _demo_pictures(corner, results, files, csv: str) -> None:
     import contextlib
     import io
 
+    from .export import write_text
     from .plots import ResultsFile, drawing_figure, report_figure, save_figure
     from .viz import CornerScene
 
@@ -775,6 +821,10 @@ TRANSMISSION_BAND = (30.0, 150.0)
 
 
 def _summary(results: Results, path) -> None:
+    import numpy as np
+
+    from .metrics import METRIC_BY_NAME, METRICS
+
     ok = results["solver_converged"]
     print(
         f"wrote {path}: {len(results)} steps, {int(ok.sum())} converged, "
@@ -820,6 +870,8 @@ def _summary(results: Results, path) -> None:
 def _warn_transmission(results: Results) -> None:
     """Name the steps where a rocker transmission angle leaves its band (an axle's
     per side), and where a rated spring's force goes below zero (it would unseat)."""
+    import numpy as np
+
     for suffix, side in (("", ""), ("_left", "left "), ("_right", "right ")):
         angle = results.columns.get(f"rocker_transmission_angle{suffix}")
         if angle is not None:
@@ -837,6 +889,8 @@ def _warn_transmission(results: Results) -> None:
 
 
 def _warn_band(angle: np.ndarray, side: str) -> None:
+    import numpy as np
+
     low, high = TRANSMISSION_BAND
     outside = np.flatnonzero((angle < low) | (angle > high))
     if len(outside):
@@ -854,6 +908,8 @@ def _report_failures(
     results: Results, consequence: str = "are flagged solver_converged=False with empty cells"
 ) -> int:
     """Name the steps that did not converge, and why, on stderr; the exit code."""
+    import numpy as np
+
     failed = results.failed_steps
     if len(failed) == 0:
         return 0
@@ -887,6 +943,7 @@ def _list(steps: list[int]) -> str:
 
 def _check_image(path) -> None:
     """An image output: a writable path with an extension matplotlib can write."""
+    from .export import check_output
     from .plots import check_image_path
 
     check_output(path, "image")
@@ -895,6 +952,8 @@ def _check_image(path) -> None:
 
 def _check_outputs(args, *paths) -> None:
     """Before any work: every output writable, each its own file, none of them an input."""
+    from .export import check_output
+
     inputs = [getattr(args, name, None) for name in ("geometry", "sweep", "mjcf", "cases")]
     inputs += list(getattr(args, "results", None) or ())
     at = getattr(args, "at", None)
@@ -1017,6 +1076,8 @@ def _setup_command(sub) -> None:
 
 def _setup(args) -> int:
     from . import setup
+    from .export import all_or_none
+    from .geometry import load_geometry
 
     _check_outputs(args, args.output, args.csv)
     targets = {
@@ -1064,8 +1125,11 @@ def _setup(args) -> int:
 def _setup_axle(args, targets: dict) -> int:
     """An axle: each side's sheet as its corner's (its own shim and adjusters), the axle's
     static columns of both sides together, or the inverse solve per side."""
+    import numpy as np
+
     from . import setup
     from .axle import SIDES, load_axle
+    from .export import all_or_none
 
     axle = load_axle(args.geometry)
     chosen = setup.set_sides(axle, args.side)
@@ -1142,6 +1206,10 @@ def _hit(targets: dict, iterations: int) -> None:
 
 def _write_setup(data: dict, name: str, path) -> None:
     """A geometry (corner or axle) file with the setup found."""
+    import yaml
+
+    from .export import write_text
+
     text = yaml.safe_dump(data, sort_keys=False, default_flow_style=None)
     write_text(f"# {name}: setup solved by pin-susp setup\n" + text, path)
 
@@ -1160,6 +1228,8 @@ def _link(geometry) -> str:
 
 
 def _sheet(rows, labels, link: str = "trackrod") -> None:
+    import numpy as np
+
     print(
         f"  {'':9}{'shim':>8}{link:>9}{'pushrod':>8}"
         + "".join(f"{head:>12}" for _, _, head in SHEET_METRICS)
@@ -1258,7 +1328,10 @@ def _sensitivity_command(sub) -> None:
 
 
 def _sensitivity(args) -> int:
+    from .corner import Corner
+    from .geometry import load_geometry
     from .sensitivity import hardpoint_sensitivities, select_points
+    from .sweep import load_sweep
 
     _check_outputs(args, args.output)
     if _is_axle(args.geometry):
@@ -1296,6 +1369,7 @@ def _sensitivity_axle(args) -> int:
         axle_sensitivities,
         select_points,
     )
+    from .sweep import load_sweep
 
     model = _axle_model(args.geometry)
     if model.axle is not None and model.axle.anti_roll_rigid:
@@ -1373,6 +1447,8 @@ def _sensitivity_report(
 def _sensitivity_table(s, names, top: int, points: set) -> None:
     """The ``top`` largest entries of each column in ``names`` among ``points``; then the
     columns these points do not move, and those undefined here."""
+    import numpy as np
+
     from .sensitivity import STEP, largest
 
     unmoved, undefined = [], []
@@ -1480,6 +1556,8 @@ def _draw_command(sub) -> None:
 
 
 def _draw(args) -> int:
+    from .corner import Corner
+    from .geometry import load_geometry
     from .plots import ResultsFile, axle_drawing_figure, axle_pose, drawing_figure, save_figure
 
     _check_outputs(args, args.output)
@@ -1531,6 +1609,10 @@ def _view(args) -> int:
     import io
     import time
 
+    from .corner import Corner
+    from .export import write_text
+    from .geometry import load_geometry
+    from .sweep import load_sweep
     from .viz import Scene, force_caption, force_key, roll_centres
 
     _check_outputs(args, args.html)

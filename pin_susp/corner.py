@@ -12,7 +12,6 @@ from dataclasses import replace
 
 import numpy as np
 
-from . import setup
 from .closures import PointTarget
 from .errors import InputError
 from .geometry import Geometry, load_geometry, warn_outside
@@ -44,7 +43,9 @@ class Corner(Linkage):
         variants skip it: their design's was shown); ``visuals``: the URDF's shapes."""
         if not isinstance(geometry, Geometry):
             geometry = load_geometry(geometry)
-        if apply_setup:  # shims and adjusters: the as-set state is the design state
+        if apply_setup and geometry.needs_setup:  # shims and adjusters: the as-set
+            from . import setup  # state is the design state
+
             geometry = setup.apply_setup(geometry)
         super().__init__(geometry, visuals)
         if warn:
@@ -271,12 +272,13 @@ class Results:
         metrics = metric_columns(corner.geometry, points, design, corner.spring_sense, only)
         for name, (values, column_unit) in metrics.items():
             columns[name], units[name] = values, column_unit
-        from .loads import RATE_COLUMNS, rate_columns
-
         qs = [s.q if s.converged else None for s in solutions]
-        if only is None or RATE_COLUMNS & set(only):
-            for name, (values, column_unit) in rate_columns(corner, qs).items():
-                columns[name], units[name] = values, column_unit
+        if corner.geometry.spring_rate is not None and corner.geometry.spring != "none":
+            from .loads import RATE_COLUMNS, rate_columns  # a rated spring's columns
+
+            if only is None or RATE_COLUMNS & set(only):
+                for name, (values, column_unit) in rate_columns(corner, qs).items():
+                    columns[name], units[name] = values, column_unit
         positions = {name: p.val for name, p in points.items()}
         for name, (values, column_unit) in point_columns(corner.point_names, positions).items():
             if only is None or name in only:

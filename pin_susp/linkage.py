@@ -118,10 +118,10 @@ class FrameMotion:
         ((len(Q), nv, k), or None): then every step is evaluated at once on the
         model's tree (bulk.Tree) instead of one Pinocchio call after another.
         """
-        if tangents is not None and self.kin.tree.supported:
-            solved = [i for i, q in enumerate(qs) if q is not None]
+        solved = [i for i, q in enumerate(qs) if q is not None]
+        if tangents is not None and self.kin.tree.supported and solved:
             Q = np.array([qs[i] for i in solved]).reshape(len(solved), self.kin.model.nq)
-            T = tangents(Q, solved) if solved else np.zeros((0, self.kin.model.nv, k))
+            T = tangents(Q, solved)
             if T is not None:
                 return self._at_once(len(qs), solved, Q, T, k)
         n, m = len(qs), len(self.names)

@@ -31,7 +31,6 @@ from .geometry import MM, Geometry, load_geometry
 from .jet import Dual
 from .linkage import Linkage
 from .metrics import METRIC_BY_NAME, STANDARD, PointSet
-from .shim import ShimAssembly
 from .solver import NewtonSolver
 
 PARAMETERS = ("shim_thickness", "trackrod_length", "pushrod_length")
@@ -52,6 +51,8 @@ def apply_setup(g) -> Geometry:
     hardpoints = dict(g.hardpoints)
     shim = g.camber_shim
     if shim is not None and shim.setup_thickness != shim.design_thickness:
+        from .shim import ShimAssembly  # a fitted shim only: a plain sweep needs none
+
         hardpoints.update(ShimAssembly(g).shimmed_hardpoints())
         _check_branches(g, hardpoints, PARAMETER_KEYS["shim_thickness"])
     as_set = replace(g, hardpoints=hardpoints, drawn=g)

@@ -7,6 +7,8 @@ reads like the format it accepts.
 
 from __future__ import annotations
 
+import copy
+import functools
 import hashlib
 import math
 import re
@@ -145,7 +147,7 @@ def load_yaml(source: str | Path | dict) -> tuple[dict, str, str | None]:
     except OSError as exc:
         raise InputError(str(path), "", f"cannot be read ({exc.strerror})") from None
     try:
-        data = yaml.load(raw, Loader=_Loader)  # _Loader is a SafeLoader: no arbitrary objects
+        data = copy.deepcopy(_parse(raw))  # a copy: the caller may change it
     except _Problem as exc:
         raise InputError(str(path), exc.key, exc.problem) from None
     except RecursionError:  # a safety net: MAX_DEPTH should stop it first
@@ -170,6 +172,13 @@ def load_yaml(source: str | Path | dict) -> tuple[dict, str, str | None]:
             f"expected a YAML mapping (key: value) at the top level, got {_kind(data)}",
         )
     return data, str(path), hashlib.sha256(raw).hexdigest()
+
+
+@functools.lru_cache(maxsize=8)
+def _parse(raw: bytes) -> Any:
+    """A file's YAML, parsed once per content: a command reads its geometry twice (the
+    CLI asks its scope, then loads it), and pure-Python YAML is the slow part of that."""
+    return yaml.load(raw, Loader=_Loader)  # _Loader is a SafeLoader: no arbitrary objects
 
 
 class Reader:

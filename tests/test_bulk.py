@@ -298,3 +298,15 @@ def test_chunks_of_a_sweep_equal_the_whole_sweep():
             np.testing.assert_array_equal(got, expected, err_msg=key)
         else:
             np.testing.assert_allclose(got, expected, rtol=1e-9, atol=1e-9, err_msg=key)
+
+
+def test_a_sweep_with_no_converged_step_gives_empty_cells():
+    """No configuration to evaluate at once: every cell of the step is blank (NaN)."""
+    corner = build("double_wishbone.yaml")
+    sweep = Sweep(
+        [Target("wheel_center", "z", [2000.0]), Target("trackrod_inboard", "y", [0.0])], "far"
+    )
+    results = corner.run_sweep(sweep)
+    assert not results["solver_converged"][0]
+    assert np.isnan(results["camber"][0]) and np.isnan(results["wheel_center_x"][0])
+    assert np.isnan(results["deriv_camber_wrt_hub_z"][0])

@@ -33,6 +33,7 @@ for trees and visuals are below.
 
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass, field
 from types import ModuleType
 
@@ -77,18 +78,20 @@ class Pointwise:
     rack: str | None = None
 
 
-def registry() -> dict[str, ModuleType]:
-    from . import double_wishbone, macpherson, multilink, trailing_arm
-
-    return {m.NAME: m for m in (double_wishbone, macpherson, multilink, trailing_arm)}
-
-
 NAMES = ("double_wishbone", "macpherson", "multilink", "trailing_arm")
 
 
+def registry() -> dict[str, ModuleType]:
+    return {name: get(name) for name in NAMES}
+
+
 def get(name: str) -> ModuleType:
-    """The mechanism module for a ``type:`` value."""
-    return registry()[name]
+    """The mechanism module for a ``type:`` value, imported when first asked for (a
+    double wishbone's sweep loads no other mechanism)."""
+    if name not in NAMES:
+        raise KeyError(name)
+    __import__(f"{__name__}.{name}")  # (not importlib's: -X importtime shows this one)
+    return sys.modules[f"{__name__}.{name}"]
 
 
 def pivot(name: str, front: str, rear: str, p: dict[str, np.ndarray]) -> Joint:

@@ -1,0 +1,214 @@
+"""Start-up: each command imports what it uses, and nothing heavier.
+
+`pin-susp sweep` of the 41-step example spends most of its wall time importing
+(benchmarks/bench_startup.py has the figures). These tests run a command in a
+new Python process and read which modules it imported: a plain sweep to CSV
+needs numpy, Pinocchio, PyYAML and the solver's modules, never scipy, pandas,
+pyarrow, Dask, matplotlib, meshcat, yourdfpy, nor pin_susp's loads,
+sensitivities, studies, validation, plots or 3D view. No timing is asserted.
+"""
+
+import csv
+import importlib
+import json
+import shutil
+import subprocess
+import sys
+
+import pytest
+import yaml
+from conftest import EXAMPLES
+
+import pin_susp
+
+# Libraries and pin_susp modules that no light command needs.
+HEAVY = (
+    "scipy",
+    "pandas",
+    "pyarrow",
+    "dask",
+    "distributed",
+    "matplotlib",
+    "meshcat",
+    "yourdfpy",
+    "mujoco",
+    "pydrake",
+    "pin_susp.loads",
+    "pin_susp.sensitivity",
+    "pin_susp.study",
+    "pin_susp.study_plots",
+    "pin_susp.validate",
+    "pin_susp.pointwise",
+    "pin_susp.plots",
+    "pin_susp.viz",
+    "pin_susp.axle",
+    # a double wishbone's corner loads no other mechanism
+    "pin_susp.mechanisms.macpherson",
+    "pin_susp.mechanisms.multilink",
+    "pin_susp.mechanisms.trailing_arm",
+)
+
+# Runs pin_susp.cli.main(argv) as the console script would, then writes the names of
+# every imported module (a command's own output stays on stdout).
+RUN = """
+import json, sys
+from pin_susp.cli import main
+code = main(sys.argv[2:])
+with open(sys.argv[1], "w") as f:
+    json.dump({"exit": code, "modules": sorted(sys.modules)}, f)
+"""
+
+
+def run_cli(tmp_path, *argv: str) -> tuple[int, set[str], subprocess.CompletedProcess]:
+    """One command in a new process, in tmp_path: its exit code and imported modules."""
+    report = tmp_path / "modules.json"
+    proc = subprocess.run(
+        [sys.executable, "-c", RUN, str(report), *argv],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert report.exists(), proc.stderr
+    data = json.loads(report.read_text())
+    return data["exit"], set(data["modules"]), proc
+
+
+def imported(modules: set[str], names) -> list[str]:
+    """Which of ``names`` were imported (a package counts with any of its submodules)."""
+    return sorted(n for n in names if any(m == n or m.startswith(n + ".") for m in modules))
+
+
+@pytest.fixture
+def inputs(tmp_path):
+    for name in ("double_wishbone.yaml", "bump_steer.yaml"):
+        shutil.copy(EXAMPLES / name, tmp_path / name)
+    return tmp_path
+
+
+def test_a_plain_sweep_to_csv_imports_nothing_heavy(inputs):
+    code, modules, proc = run_cli(
+        inputs, "sweep", "double_wishbone.yaml", "bump_steer.yaml", "-o", "out.csv", "-q"
+    )
+    assert code == 0, proc.stderr
+    assert imported(modules, HEAVY) == []
+    # what it does need, it has
+    assert {"numpy", "pinocchio", "yaml", "pin_susp.solver", "pin_susp.export"} <= modules
+    # the CSV is the sweep's: 41 rows, each camber the very float the API computes
+    lines = (inputs / "out.csv").read_text().splitlines()
+    rows = list(csv.DictReader(line for line in lines if not line.startswith("#")))
+    results = pin_susp.Corner(EXAMPLES / "double_wishbone.yaml").run_sweep(
+        EXAMPLES / "bump_steer.yaml"
+    )
+    assert len(rows) == 41
+    assert [float(r["camber"]) for r in rows] == list(results["camber"])
+    assert [float(r["roadwheel_angle"]) for r in rows] == list(results["roadwheel_angle"])
+
+
+@pytest.mark.parametrize(
+    "argv, output",
+    [
+        (("urdf", "double_wishbone.yaml", "-o", "out.urdf"), "out.urdf"),
+        (("mjcf", "double_wishbone.yaml", "-o", "out.xml"), "out.xml"),
+        (("setup", "double_wishbone.yaml", "--trackrod", "1", "--sensitivities"), None),
+    ],
+    ids=["urdf", "mjcf", "setup"],
+)
+def test_the_other_light_commands_import_nothing_heavy(inputs, argv, output):
+    code, modules, proc = run_cli(inputs, *argv)
+    assert code == 0, proc.stderr
+    assert imported(modules, HEAVY) == []
+    if output is not None:
+        assert (inputs / output).stat().st_size > 0
+    if argv[0] == "urdf":
+        corner = pin_susp.Corner(EXAMPLES / "double_wishbone.yaml")
+        assert (inputs / output).read_text() == corner.urdf
+
+
+def test_help_and_version_import_no_numerics(tmp_path):
+    for argv in (("--help",), ("--version",), ("sweep", "--help")):
+        code, modules, proc = run_cli(tmp_path, *argv)
+        assert code == 0, proc.stderr
+        assert "pin-susp" in proc.stdout or "pin_susp" in proc.stdout
+        assert imported(modules, ("numpy", "pinocchio", "yaml", *HEAVY)) == []
+        ours = {m for m in modules if m.startswith("pin_susp.")}
+        assert ours == {"pin_susp.cli", "pin_susp.errors"}
+
+
+def test_import_pin_susp_loads_no_submodule_until_a_name_is_used(tmp_path):
+    code = (
+        "import json, sys; import pin_susp; "
+        "before = sorted(m for m in sys.modules if m.startswith('pin_susp.')); "
+        "pin_susp.load_geometry; "
+        "after = sorted(m for m in sys.modules if m.startswith('pin_susp.')); "
+        "print(json.dumps([before, after]))"
+    )
+    proc = subprocess.run(
+        [sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True, timeout=120
+    )
+    assert proc.returncode == 0, proc.stderr
+    before, after = json.loads(proc.stdout)
+    assert before == []
+    assert "pin_susp.geometry" in after
+    assert imported(set(after), HEAVY) == []
+
+
+# Every public name and the module that defines it (as pin_susp/__init__.py imported
+# them all before they were loaded lazily).
+PUBLIC = {
+    "Corner": "corner",
+    "Results": "corner",
+    "InputError": "errors",
+    "PinSuspError": "errors",
+    "Geometry": "geometry",
+    "load_geometry": "geometry",
+    "LoadCase": "loads",
+    "load_cases": "loads",
+    "member_forces": "loads",
+    "METRICS": "metrics",
+    "Pose": "metrics",
+    "hardpoint_sensitivities": "sensitivity",
+    "SetupModel": "setup",
+    "apply_setup": "setup",
+    "setup_sheet": "setup",
+    "solve_setup": "setup",
+    "Sweep": "sweep",
+    "Target": "sweep",
+    "load_sweep": "sweep",
+}
+
+
+def test_every_public_name_still_resolves():
+    assert sorted(pin_susp.__all__) == sorted(PUBLIC)
+    for name, module in PUBLIC.items():
+        value = getattr(pin_susp, name)
+        assert value is getattr(importlib.import_module(f"pin_susp.{module}"), name), name
+        assert name in dir(pin_susp)
+    namespace = {}
+    exec("from pin_susp import *", namespace)
+    assert set(PUBLIC) <= set(namespace)
+    assert pin_susp.__version__ == "0.1.0"
+    # a submodule by attribute, as when `import pin_susp` imported them all
+    assert pin_susp.loads.load_cases is pin_susp.load_cases
+    with pytest.raises(AttributeError, match="no_such_name"):
+        pin_susp.no_such_name  # noqa: B018
+    assert not hasattr(pin_susp, "__wrapped__")
+
+
+def test_a_yaml_file_read_twice_gives_each_caller_its_own_copy(tmp_path):
+    """load_yaml parses a content once (the CLI reads a geometry's scope, then the
+    geometry): each caller still gets its own mapping, and a changed file is re-read."""
+    from pin_susp.yamlio import load_yaml
+
+    path = shutil.copy(EXAMPLES / "double_wishbone.yaml", tmp_path / "g.yaml")
+    expected = yaml.safe_load((EXAMPLES / "double_wishbone.yaml").read_text())
+    first, name, sha = load_yaml(path)
+    first["hardpoints"]["lower_wishbone_outboard"]["x"] = 1e3  # the caller's own change
+    first["name"] = "changed"
+    second, _, sha2 = load_yaml(path)
+    assert second == expected and sha2 == sha and name == str(path)
+    assert second["hardpoints"] is not first["hardpoints"]
+    text = (tmp_path / "g.yaml").read_text().replace("z: ", "z:  ", 1)  # the same mapping
+    (tmp_path / "g.yaml").write_text(text + "\nextra_note: 1\n")
+    third, _, sha3 = load_yaml(path)
+    assert sha3 != sha and third == {**expected, "extra_note": 1}
