@@ -24,15 +24,9 @@ import sys
 import threading
 import warnings
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 from . import __version__
 from .errors import PinSuspError, PlausibilityWarning
-
-if TYPE_CHECKING:
-    import numpy as np
-
-    from .corner import Results
 
 SHEET_METRICS = (  # column, unit, short heading
     ("camber", "deg", "camber"),
@@ -820,117 +814,190 @@ CENTRES = ("svic_x", "svic_z", "fvic_y", "fvic_z", "svsa_length", "fvsa_length")
 TRANSMISSION_BAND = (30.0, 150.0)
 
 
-def _summary(results: Results, path) -> None:
-    import numpy as np
+# Beyond the metrics, the columns the summary shows where a sweep has them.
+SUMMARY_EXTRA = (
+    "deriv_camber_wrt_hub_z",
+    "deriv_roadwheel_angle_wrt_hub_z",
+    "motion_ratio",
+    "spring_force",
+    "spring_torque",
+    "wheel_rate",
+    "ride_rate",
+)
+SIDES = (("", ""), ("_left", "left "), ("_right", "right "))
 
-    from .metrics import METRIC_BY_NAME, METRICS
 
-    ok = results["solver_converged"]
+class Digest:
+    """What the summary, the warnings and the failure report need from a sweep's
+    results, gathered a chunk at a time (``add``): a streamed sweep keeps no rows.
+    Steps are the results' ``step_index``."""
+
+    def __init__(self):
+        import numpy as np
+
+        self.steps = self.converged = 0
+        self.max_residual = np.nan
+        self.iterations = np.zeros(0, dtype=int)  # how many steps took each count
+        self.units: dict[str, str] = {}
+        self.stats: dict[str, list] = {}  # name → [first, last, min, max, far step, |far|]
+        self.failed: list[tuple[int, str, float]] = []  # (step, why, residual mm)
+        self.band: dict[str, list] = {}  # side → [steps outside, worst step, its angle]
+        self.unseat: dict[str, list] = {}  # side → [steps below zero, least force]
+
+    @classmethod
+    def of(cls, results) -> Digest:
+        if isinstance(results, Digest):
+            return results
+        digest = cls()
+        digest.add(results)
+        return digest
+
+    def add(self, results) -> None:
+        import numpy as np
+
+        from .metrics import METRICS
+
+        steps = np.asarray(results["step_index"])
+        ok = np.asarray(results["solver_converged"], dtype=bool)
+        residual = np.asarray(results["solver_max_residual"], dtype=float)
+        self.steps += len(steps)
+        self.converged += int(ok.sum())
+        if len(steps):
+            self.max_residual = np.nanmax(np.r_[self.max_residual, residual])
+        counts = np.bincount(np.asarray(results["solver_iterations"], dtype=int))
+        if len(counts) > len(self.iterations):
+            self.iterations = np.r_[self.iterations, np.zeros(len(counts) - len(self.iterations))]
+        self.iterations[: len(counts)] += counts.astype(int)
+        why = results.meta["why"]
+        self.failed += [(int(steps[i]), why[i], float(residual[i])) for i in np.flatnonzero(~ok)]
+        names = [m.name for m in METRICS if m.written] + list(SUMMARY_EXTRA)
+        for name in names:
+            if name in results.columns and len(steps):
+                self._column(name, np.asarray(results[name], dtype=float), steps)
+                self.units[name] = results.units[name]
+        low, high = TRANSMISSION_BAND
+        for suffix, side in SIDES:
+            angle = results.columns.get(f"rocker_transmission_angle{suffix}")
+            if angle is not None:
+                outside = np.flatnonzero((angle < low) | (angle > high))
+                if len(outside):
+                    worst = outside[np.argmax(np.abs(angle[outside] - 90.0))]
+                    band = self.band.setdefault(side, [[], None, 90.0])
+                    band[0] += steps[outside].tolist()
+                    if abs(angle[worst] - 90.0) > abs(band[2] - 90.0):
+                        band[1], band[2] = int(steps[worst]), float(angle[worst])
+            force = results.columns.get(f"spring_force{suffix}")
+            if force is not None and np.nanmin(force, initial=np.inf) < 0.0:
+                unseat = self.unseat.setdefault(side, [[], np.inf])
+                unseat[0] += steps[np.flatnonzero(force < 0.0)].tolist()
+                unseat[1] = min(unseat[1], float(np.nanmin(force)))
+
+    def _column(self, name: str, v, steps) -> None:
+        import numpy as np
+
+        stat = self.stats.get(name)
+        if stat is None:
+            stat = self.stats[name] = [v[0], v[-1], np.nan, np.nan, None, 0.0]
+        stat[1] = v[-1]
+        if not np.isnan(v).all():
+            stat[2] = np.nanmin(np.r_[stat[2], v])
+            stat[3] = np.nanmax(np.r_[stat[3], v])
+        far = np.flatnonzero(np.abs(v) > FAR)
+        if len(far):
+            i = far[np.argmax(np.abs(v[far]))]
+            if abs(v[i]) > stat[5]:
+                stat[4], stat[5] = int(steps[i]), abs(v[i])
+
+    @property
+    def iterations_median(self) -> float:
+        import numpy as np
+
+        total = np.cumsum(self.iterations)
+        n = int(total[-1]) if len(total) else 0
+        if not n:
+            return float("nan")
+        middle = np.searchsorted(total, [(n - 1) // 2 + 1, n // 2 + 1])
+        return float(np.mean(middle))
+
+
+def _summary(results, path) -> None:
+    from .metrics import METRIC_BY_NAME
+
+    d = Digest.of(results)
     print(
-        f"wrote {path}: {len(results)} steps, {int(ok.sum())} converged, "
-        f"max residual {np.nanmax(results['solver_max_residual']):.1e} mm, "
-        f"{np.median(results['solver_iterations']):g} iterations per step (median)"
+        f"wrote {path}: {d.steps} steps, {d.converged} converged, "
+        f"max residual {d.max_residual:.1e} mm, "
+        f"{d.iterations_median:g} iterations per step (median)"
     )
-    names = [m.name for m in METRICS if m.written and m.name in results.columns]
-    names += [
-        n
-        for n in (
-            "deriv_camber_wrt_hub_z",
-            "deriv_roadwheel_angle_wrt_hub_z",
-            "motion_ratio",
-            "spring_force",
-            "spring_torque",
-            "wheel_rate",
-            "ride_rate",
-        )
-        if n in results.columns
-    ]
     print(f"  {'metric':<32}{'unit':>7}{'first':>13}{'last':>13}{'min':>13}{'max':>13}")
     blank = []
-    for name in names:
-        v = results[name]
-        if np.all(np.isnan(v)):
+    for name, (first, last, low, high, far, _) in d.stats.items():
+        if low != low:  # NaN at every step
             blank.append(name)
             continue
-        line = f"  {name:<32}{results.units[name]:>7}{v[0]:>13.6g}{v[-1]:>13.6g}"
-        far = np.flatnonzero(np.abs(v) > FAR)
-        if name in CENTRES and len(far):
-            step = far[np.argmax(np.abs(v[far]))]
-            line += f"   at infinity (instant axis parallel to the view) near step {step}"
+        line = f"  {name:<32}{d.units[name]:>7}{first:>13.6g}{last:>13.6g}"
+        if name in CENTRES and far is not None:
+            line += f"   at infinity (instant axis parallel to the view) near step {far}"
         else:
-            line += f"{np.nanmin(v):>13.6g}{np.nanmax(v):>13.6g}"
+            line += f"{low:>13.6g}{high:>13.6g}"
         print(line)
     for name in blank:
         m = METRIC_BY_NAME.get(name)
         why = f"needs {m.needs}" if m is not None and m.needs else "undefined at every step"
-        print(f"  {name:<32}{results.units[name]:>7}   (blank: {why})")
+        print(f"  {name:<32}{d.units[name]:>7}   (blank: {why})")
     print("  (every column, derivatives included, is in the CSV)")
 
 
-def _warn_transmission(results: Results) -> None:
+def _warn_transmission(results) -> None:
     """Name the steps where a rocker transmission angle leaves its band (an axle's
     per side), and where a rated spring's force goes below zero (it would unseat)."""
-    import numpy as np
-
-    for suffix, side in (("", ""), ("_left", "left "), ("_right", "right ")):
-        angle = results.columns.get(f"rocker_transmission_angle{suffix}")
-        if angle is not None:
-            _warn_band(angle, side)
-        force = results.columns.get(f"spring_force{suffix}")
-        if force is not None and np.nanmin(force) < 0.0:
-            steps = np.flatnonzero(force < 0.0)
+    d = Digest.of(results)
+    low, high = TRANSMISSION_BAND
+    for _, side in SIDES:
+        if side in d.band:
+            steps, worst, angle = d.band[side]
             warnings.warn(
-                f"{side}spring force below zero at steps {_list([int(i) for i in steps])} "
-                f"(least {np.nanmin(force):.0f} N): the spring would unseat there — more "
+                f"{side}rocker transmission angle outside {low:g}…{high:g} deg at steps "
+                f"{_list(steps)} (worst {angle:.1f} deg at step {worst}): "
+                "the rocker nears over-centre, its motion ratio falls toward zero and flips",
+                PlausibilityWarning,
+                stacklevel=2,
+            )
+        if side in d.unseat:
+            steps, least = d.unseat[side]
+            warnings.warn(
+                f"{side}spring force below zero at steps {_list(steps)} "
+                f"(least {least:.0f} N): the spring would unseat there — more "
                 "preload, or less droop",
                 PlausibilityWarning,
                 stacklevel=2,
             )
 
 
-def _warn_band(angle: np.ndarray, side: str) -> None:
-    import numpy as np
-
-    low, high = TRANSMISSION_BAND
-    outside = np.flatnonzero((angle < low) | (angle > high))
-    if len(outside):
-        worst = outside[np.argmax(np.abs(angle[outside] - 90.0))]
-        warnings.warn(
-            f"{side}rocker transmission angle outside {low:g}…{high:g} deg at steps "
-            f"{_list([int(i) for i in outside])} (worst {angle[worst]:.1f} deg at step {worst}): "
-            "the rocker nears over-centre, its motion ratio falls toward zero and flips",
-            PlausibilityWarning,
-            stacklevel=2,
-        )
-
-
 def _report_failures(
-    results: Results, consequence: str = "are flagged solver_converged=False with empty cells"
+    results, consequence: str = "are flagged solver_converged=False with empty cells"
 ) -> int:
     """Name the steps that did not converge, and why, on stderr; the exit code."""
-    import numpy as np
-
-    failed = results.failed_steps
-    if len(failed) == 0:
+    d = Digest.of(results)
+    if not d.failed:
         return 0
-    why = results.meta["why"]
-    flipped = [int(i) for i in failed if "branch" in why[i]]
-    short = [int(i) for i in failed if "branch" not in why[i]]
+    flipped = [step for step, why, _ in d.failed if "branch" in why]
+    short = [(step, residual) for step, why, residual in d.failed if "branch" not in why]
     reasons = []
     if short:
-        worst = np.max(results["solver_max_residual"][short])
+        worst = max(residual for _, residual in short)
         reasons.append(
-            f"steps {_list(short)} out of the mechanism's reach or past a lock-up "
-            f"(residual up to {worst:.3g} mm)"
+            f"steps {_list([step for step, _ in short])} out of the mechanism's reach or past "
+            f"a lock-up (residual up to {worst:.3g} mm)"
         )
     if flipped:
-        loops = sorted({why[i].rpartition(" of ")[2] for i in flipped})
+        loops = sorted({why.rpartition(" of ")[2] for _, why, _ in d.failed if "branch" in why})
         reasons.append(
             f"steps {_list(flipped)} reach the targets only on another assembly branch "
             f"({', '.join(loops)} flipped over: not the design's mechanism)"
         )
     print(
-        f"pin-susp: warning: {len(failed)} of {len(results)} steps did not converge: "
+        f"pin-susp: warning: {len(d.failed)} of {d.steps} steps did not converge: "
         f"{'; '.join(reasons)}. Their rows {consequence}.",
         file=sys.stderr,
     )
