@@ -14,6 +14,11 @@ Every output goes through :func:`atomic_write`, the one place that renames:
 A command with several outputs writes them inside :func:`all_or_none`: each
 file goes to its temporary name, and the renames happen together at the end,
 so a failure part-way leaves none of them.
+
+Results go out as CSV (:func:`write_csv`, :func:`csv_text`) or Parquet
+(:func:`write_parquet`), whole, or a chunk of rows at a time through
+:class:`CsvStream` and :class:`ParquetStream` (the same bytes, memory bounded by
+a chunk), both through atomic_write.
 """
 
 from __future__ import annotations
@@ -25,7 +30,7 @@ import re
 import stat
 import sys
 import tempfile
-from contextlib import contextmanager
+from contextlib import ExitStack, contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -211,19 +216,118 @@ def format_cell(value) -> str:
     return "" if np.isnan(x) else repr(x)
 
 
+# -- CSV ---------------------------------------------------------------------------------
+#
+# Two text styles for the same values, one per file. Each float cell is the shortest text
+# that parses back to the same float64, so either style round-trips exactly:
+# - the repr style (numpy's str, = repr: ``1e-05``, ``100.0``), for small tables;
+# - the compiled style (pyarrow's cast to string: ``0.00001``, ``1e+15``; a whole number
+#   in fixed notation keeps ``.0`` so that a reader still sees a float: ``100.0``,
+#   ``-0.0``), six to ten times faster, for tables large enough to pay for importing
+#   pyarrow and pyarrow.compute (~0.1 s): FAST_CELLS cells (rows × columns) or more,
+#   1 000 rows of the 86-column corner table (benchmarks/bench_writer.py measures where
+#   the two meet: 500 to 1 000 rows of it). One thread: pyarrow lets go of the GIL, but
+#   two threads were no faster on the two-CPU machine measured.
+# Flags are True/False, integers integers, an undefined value (NaN) an empty cell, a name
+# quoted only where CSV needs it, lines end with \n.
+
+FAST_CELLS = 86_000
+_BLOCK_ROWS = 16_384  # rows formatted at once by the compiled style (bounded memory)
+
+
+def csv_header(units: dict, meta: dict, names) -> str:
+    """The ``#`` comment lines (version, sources, units) and the header row."""
+    lines = [f"# pin_susp {__version__}"]
+    for what in ("geometry", "sweep"):
+        source, sha = meta[what]
+        lines.append(f"# {what}: {source}" + (f" sha256={sha}" if sha else ""))
+    lines.append("# units: " + json.dumps(units))
+    lines.append(",".join(names))
+    return "\n".join(lines) + "\n"
+
+
+def fast_style(rows: int, columns: int) -> bool:
+    """Whether a table of this size is written in the compiled style."""
+    return rows * columns >= FAST_CELLS
+
+
 def csv_text(results) -> str:
     """Results as CSV text: ``#`` comment lines, one header row, one row per step."""
     names = list(results.columns)
     columns = [results.columns[n] for n in names]
-    lines = [f"# pin_susp {__version__}"]
-    for what in ("geometry", "sweep"):
-        source, sha = results.meta[what]
-        lines.append(f"# {what}: {source}" + (f" sha256={sha}" if sha else ""))
-    lines.append("# units: " + json.dumps(results.units))
-    lines.append(",".join(names))
+    head = csv_header(results.units, results.meta, names)
+    if not fast_style(_rows(results), len(names)):
+        return head + _repr_rows(columns)
+    return head + b"".join(_fast_rows(columns)).decode()
+
+
+def write_csv(results, path: str | Path) -> None:
+    """Results as a CSV file (the text of csv_text), whole or not at all."""
+    names = list(results.columns)
+    with CsvStream(path, results.units, results.meta, names, _rows(results)) as out:
+        out.write(results)
+
+
+def _rows(results) -> int:
+    return len(next(iter(results.columns.values()), ()))
+
+
+class CsvStream:
+    """A CSV file written a chunk of rows at a time, whole or not at all::
+
+        with CsvStream(path, results.units, results.meta, names, total_rows) as out:
+            for chunk in chunks:  # Results (or anything with .columns), these names
+                out.write(chunk)
+
+    The file is the one write_csv makes of all the rows at once, byte for byte: the
+    text style follows from ``total_rows``, the rows the file is to hold (one style
+    per file, however the chunks come). It is written to a temporary file beside
+    ``path`` and renamed into place on a normal exit (inside all_or_none: with the
+    others); an exception or interrupt leaves neither.
+    """
+
+    def __init__(self, path, units: dict, meta: dict, columns_order, total_rows: int):
+        self.path = path
+        self.names = list(columns_order)
+        self.head = csv_header(units, meta, self.names)
+        self.fast = fast_style(total_rows, len(self.names))
+        self.rows = 0
+        self._stack = None
+        self._file = None
+
+    def __enter__(self):
+        stack = ExitStack()
+        self._file = stack.enter_context(atomic_write(self.path, binary=True))
+        self._stack = stack
+        self._file.write(self.head.encode())
+        return self
+
+    def write(self, results) -> None:
+        """Append the rows of a chunk (its columns: this file's, in any order)."""
+        columns = _chunk_columns(results, self.names)
+        if self.fast:
+            for part in _fast_rows(columns):
+                self._file.write(part)
+        else:
+            self._file.write(_repr_rows(columns).encode())
+        self.rows += len(columns[0]) if columns else 0
+
+    def __exit__(self, *exc):
+        self._file = None
+        return self._stack.__exit__(*exc)
+
+
+def _chunk_columns(results, names: list) -> list:
+    if set(results.columns) != set(names):
+        odd = sorted(set(results.columns) ^ set(names))
+        raise ValueError(f"a chunk's columns differ from the file's: {odd}")
+    return [np.asarray(results.columns[n]) for n in names]
+
+
+def _repr_rows(columns: list) -> str:
+    """The rows in the repr style, a column formatted at a time."""
     cells = [_column_cells(c) for c in columns]
-    lines.extend(",".join(row) for row in zip(*cells, strict=True))
-    return "\n".join(lines) + "\n"
+    return "".join(",".join(row) + "\n" for row in zip(*cells, strict=True))
 
 
 def _column_cells(values) -> list[str]:
@@ -241,26 +345,177 @@ def _column_cells(values) -> list[str]:
     return [format_cell(x) for x in v]  # names and mixed columns, one by one
 
 
-def write_csv(results, path: str | Path) -> None:
-    """Results as a CSV file (csv_text), whole or not at all."""
-    write_text(csv_text(results), path)
+def _fast_rows(columns: list):
+    """The rows in the compiled style, as buffers to write in order: a block of rows at
+    a time, each made when the one before is written (the memory stays bounded)."""
+    rows = len(columns[0]) if columns else 0
+    for i in range(0, rows, _BLOCK_ROWS):
+        yield _arrow_rows([c[i : i + _BLOCK_ROWS] for c in columns])
+
+
+def _arrow_rows(columns: list):
+    """Rows of CSV text (a pyarrow buffer: cells joined by commas, each row ending in \n).
+
+    Every float column's values are formatted in one call, end to end; a column whose
+    every value is the same (a fixed point of the chassis) by its one value."""
+    import pyarrow as pa
+    import pyarrow.compute as pc
+
+    rows = len(columns[0])
+    cells: list = [None] * len(columns)
+    where = []  # the float columns
+    for i, v in enumerate(columns):
+        kind = v.dtype.kind
+        if kind == "f":
+            where.append(i)
+        elif kind == "b":
+            cells[i] = pc.if_else(pa.array(v), "True", "False")
+        elif kind in "iu":
+            cells[i] = pc.cast(pa.array(v), pa.string())
+        else:  # names and mixed columns, one by one
+            cells[i] = pa.array([format_cell(x) for x in v], pa.string())
+    if where:
+        floats = np.array([columns[i] for i in where], dtype=float)  # a column a row
+        bits = floats.view(np.uint64)
+        same = (bits == bits[:, :1]).all(axis=1)  # by bits: -0.0 is not 0.0
+        values = np.concatenate([floats[~same].ravel(), floats[same, 0]])
+        text = pc.cast(pa.array(values, from_pandas=True), pa.string())
+        whole = np.isfinite(values) & (values == np.trunc(values))
+        care = whole | np.isnan(values)  # the cells _float_cells changes
+        varying = np.array(where)[~same]
+        cut = len(varying) * rows
+        changed = care[:cut].reshape(len(varying), rows).any(axis=1)
+        for k, i in enumerate(varying):
+            part = text.slice(k * rows, rows)
+            cells[i] = (
+                _float_cells(part, whole[k * rows : (k + 1) * rows], pa, pc) if changed[k] else part
+            )
+        tail = _float_cells(text.slice(cut), whole[cut:], pa, pc).to_pylist()
+        for k, i in enumerate(np.array(where)[same]):
+            cells[i] = tail[k]
+    parts = []  # the columns' cells; neighbouring fixed cells as one text
+    for c in cells:
+        if isinstance(c, str) and parts and isinstance(parts[-1], str):
+            parts[-1] += "," + c
+        else:
+            parts.append(c)
+    if isinstance(parts[-1], str):
+        parts[-1] += "\n"
+    else:
+        parts[-1] = pc.binary_join_element_wise(parts[-1], "\n", "")
+    if isinstance(parts[0], str) and len(parts) == 1:  # every column the same all along
+        parts = [pa.repeat(pa.scalar(parts[0]), rows)]
+    args = [pa.scalar(c) if isinstance(c, str) else c for c in parts]
+    joined = pc.binary_join_element_wise(*args, ",")
+    offsets = np.frombuffer(joined.buffers()[1], np.int32, len(joined) + 1, 4 * joined.offset)
+    return joined.buffers()[2][offsets[0] : offsets[-1]]
+
+
+def _float_cells(text, whole: np.ndarray, pa, pc):
+    """pyarrow's text of floats (its shortest round-trip text) as cells: an undefined
+    value (NaN, a null) is an empty cell; a whole number (``whole``) in fixed notation
+    gets ``.0`` (``100.0``, ``-0.0``: a reader still sees a float)."""
+    if whole.any():
+        plain = pc.and_(pa.array(whole), pc.invert(pc.match_substring(text, "e")))  # 1e+16
+        text = pc.if_else(plain, pc.binary_join_element_wise(text, ".0", ""), text)
+    return pc.fill_null(text, "") if text.null_count else text
+
+
+# -- Parquet -----------------------------------------------------------------------------
+
+ROW_GROUP = 65_536  # rows per Parquet row group: what a ParquetStream holds at most
 
 
 def write_parquet(results, path: str | Path) -> None:
     """Results as a Parquet file (pyarrow), whole or not at all: the CSV's columns, an
     undefined value (a blank CSV cell) as a null, the units, the sources and the
-    pin_susp version in the schema's metadata."""
-    import pyarrow as pa
-    import pyarrow.parquet as pq
+    pin_susp version in the schema's metadata; row groups of ROW_GROUP rows."""
+    with ParquetStream(path, results.units, results.meta, list(results.columns)) as out:
+        out.write(results)
 
-    columns = arrow_columns(results)
-    meta = {"pin_susp": __version__, "units": json.dumps(results.units)}
+
+def parquet_metadata(units: dict, meta: dict) -> dict:
+    """The schema's metadata: pin_susp's version, the units, the sources."""
+    out = {"pin_susp": __version__, "units": json.dumps(units)}
     for what in ("geometry", "sweep"):
-        source, sha = results.meta[what]
-        meta[what] = json.dumps({"source": str(source), "sha256": sha})
-    table = pa.table(columns).replace_schema_metadata(meta)
-    with atomic_write(path, binary=True) as f:
-        pq.write_table(table, f)
+        source, sha = meta[what]
+        out[what] = json.dumps({"source": str(source), "sha256": sha})
+    return out
+
+
+class ParquetStream:
+    """A Parquet file written a chunk of rows at a time, whole or not at all (as
+    CsvStream): rows are held until a row group of ROW_GROUP is full, so the file is
+    the one write_parquet makes of all the rows at once, byte for byte. ``total_rows``
+    is accepted for CsvStream's signature; Parquet does not need it."""
+
+    def __init__(self, path, units: dict, meta: dict, columns_order, total_rows=None):
+        self.path = path
+        self.names = list(columns_order)
+        self.metadata = parquet_metadata(units, meta)
+        self.rows = 0
+        self._held = []  # tables not yet written: fewer than ROW_GROUP rows in all
+        self._held_rows = 0
+        self._schema = None
+        self._writer = None
+        self._stack = None
+        self._file = None
+
+    def __enter__(self):
+        import pyarrow.parquet  # noqa: F401  (before the file appears: an import error leaves none)
+
+        stack = ExitStack()
+        self._file = stack.enter_context(atomic_write(self.path, binary=True))
+        self._stack = stack
+        return self
+
+    def write(self, results) -> None:
+        """Append the rows of a chunk (its columns: this file's, in any order)."""
+        import pyarrow as pa
+
+        _chunk_columns(results, self.names)
+        table = pa.table({n: arrow_column(results.columns[n]) for n in self.names})
+        table = table.replace_schema_metadata(self.metadata)
+        if self._schema is None:
+            self._schema = table.schema
+        elif not table.schema.equals(self._schema):
+            table = table.cast(self._schema)
+        self._held.append(table)
+        self._held_rows += len(table)
+        self.rows += len(table)
+        if self._held_rows >= ROW_GROUP:
+            held = pa.concat_tables(self._held)
+            while len(held) >= ROW_GROUP:
+                self._group(held.slice(0, ROW_GROUP))
+                held = held.slice(ROW_GROUP)
+            self._held, self._held_rows = [held], len(held)
+
+    def _group(self, table) -> None:
+        """One row group, from one layout of the rows however the chunks cut them."""
+        import pyarrow.parquet as pq
+
+        if self._writer is None:
+            self._writer = pq.ParquetWriter(self._file, self._schema)
+        self._writer.write_table(table.combine_chunks(), row_group_size=ROW_GROUP)
+
+    def __exit__(self, kind, exc, tb):
+        if kind is not None:  # no file: the temporary goes
+            if self._writer is not None:
+                try:
+                    self._writer.close()
+                except Exception:
+                    pass
+            return self._stack.__exit__(kind, exc, tb)
+        with self._stack:  # an error finishing the file also leaves none
+            import pyarrow as pa
+
+            if self._schema is None:  # no chunk came: the columns, without rows or types
+                self._schema = pa.schema([(n, pa.null()) for n in self.names], self.metadata)
+            if self._held_rows or self._writer is None:
+                held = self._held or [self._schema.empty_table()]
+                self._group(pa.concat_tables(held))
+            self._writer.close()
+        return False
 
 
 def arrow_column(values):
