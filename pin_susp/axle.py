@@ -24,6 +24,7 @@ from .geometry import DERIVED_POINTS, MM, Geometry, unit
 from .linkage import Built, FrameMotion, Linkage, closure_row
 from .mechanisms import axis_foot, xml_name
 from .solver import NewtonSolver, march
+from .sweep import check_held
 from .urdf import Body, Closure, Joint, Tree, Visual
 from .yamlio import Reader, load_yaml
 
@@ -820,6 +821,7 @@ def solve_axle_sweep(model: AxleModel, sweep, source: str | None = None, progres
     the targets must fix the pose (as many as the axle's freedoms, independent).
     ``progress(done, total)`` is called after each step."""
     source = source or sweep.source
+    check_held(sweep)
     rows = axle_rows(model, sweep.targets, source)
     rigid = model.axle is not None and model.axle.anti_roll_rigid
     for i, t in enumerate(sweep.targets):

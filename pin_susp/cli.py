@@ -240,6 +240,8 @@ def _sweep(args) -> int:
     corner = Corner(load_geometry(args.geometry))
     sweep = load_sweep(args.sweep)
     corner.solver_for(sweep.targets, sweep.source)  # target errors before any work
+    if sweep.steps > STREAM_STEPS and args.plot is None:
+        return _sweep_streamed(args, corner, sweep)
     results = corner.run_sweep(sweep, progress=_progress_bar(sweep.steps, args.quiet))
     _warn_transmission(results)
     plot = _write_results(args, results)
@@ -250,18 +252,42 @@ def _sweep(args) -> int:
     return _report_failures(results)
 
 
+def _sweep_streamed(args, corner, sweep) -> int:
+    """A long sweep written as it is solved, a chunk of steps at a time: its memory does
+    not grow with its length (the same rows as run_sweep's, to the solver's tolerance)."""
+    from .export import CsvStream, ParquetStream
+
+    parts = corner.run_sweep_chunks(sweep, progress=_progress_bar(sweep.steps, args.quiet))
+    first = next(parts)
+    digest = Digest.of(first)
+    kind = ParquetStream if str(args.output).endswith(".parquet") else CsvStream
+    with kind(args.output, first.units, first.meta, list(first.columns), sweep.steps) as out:
+        out.write(first)
+        del first
+        for part in parts:
+            out.write(part)
+            digest.add(part)
+            del part  # before the next chunk is solved: one chunk held at a time
+    _warn_transmission(digest)
+    if not args.quiet:
+        _summary(digest, args.output)
+    return _report_failures(digest)
+
+
 def _write_results(args, results) -> bool:
     """The CSV (Parquet for an OUT ending .parquet) and, with --plot, the report: both or
     neither; whether it was drawn."""
-    from .export import all_or_none, csv_text, write_text
+    from .export import all_or_none, csv_text, write_csv, write_text
 
     plot = args.plot is not None and results["solver_converged"].any()
-    text = csv_text(results)
+    text = csv_text(results) if plot else None  # the report reads the CSV's text
     with all_or_none():
         if str(args.output).endswith(".parquet"):
             from .export import write_parquet
 
             write_parquet(results, args.output)
+        elif text is None:
+            write_csv(results, args.output)
         else:
             write_text(text, args.output)
         if plot:  # drawn from the CSV's text: the output may be a stream
@@ -814,6 +840,8 @@ CENTRES = ("svic_x", "svic_z", "fvic_y", "fvic_z", "svsa_length", "fvsa_length")
 TRANSMISSION_BAND = (30.0, 150.0)
 
 
+# A corner's sweep longer than this (steps) is streamed to its file, a chunk at a time.
+STREAM_STEPS = 10_000
 # Beyond the metrics, the columns the summary shows where a sweep has them.
 SUMMARY_EXTRA = (
     "deriv_camber_wrt_hub_z",

@@ -18,7 +18,7 @@ from .geometry import Geometry, load_geometry, warn_outside
 from .linkage import Linkage
 from .metrics import METRICS, TOE_LINK, Pose, metric_columns, point_columns
 from .solver import NewtonSolver, Solution, march
-from .sweep import Sweep, Target, load_sweep
+from .sweep import Sweep, Target, check_held, load_sweep
 
 CHUNK = 10_000  # steps solved and written at a time by a streamed sweep
 
@@ -150,7 +150,9 @@ class Corner(Linkage):
             converged = [s for s in solutions if s.converged]
             if converged:
                 q = converged[-1].q
+            del solutions, tangents, converged
             yield results
+            del results  # before the next chunk is solved: one chunk held at a time
 
     def solve_steps(
         self,
@@ -168,6 +170,7 @@ class Corner(Linkage):
         receives the exact drivers' tangent of each step, when the sweep's
         targets are the drivers (wheel-centre z, rack) — it stays empty otherwise.
         """
+        check_held(sweep)
         solver = self.solver_for(sweep.targets, sweep.source)
         order = self.drive_order(sweep.targets) if tangents is not None else None
         solver.keep_jacobian = order is not None

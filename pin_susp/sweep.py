@@ -13,12 +13,16 @@ from pathlib import Path
 
 import numpy as np
 
+from .errors import InputError
 from .geometry import direction
 from .yamlio import Reader, _short, load_yaml
 
-# Memory a solved step holds while a sweep runs (configuration, tangents, every
-# column, the CSV's text), bytes: measured 12.5 KB on a 200 000-step sweep.
+# Memory a solved step holds while a sweep is held whole (configuration, tangents,
+# every column, the CSV's text), bytes: measured 12.5 KB on a 200 000-step sweep.
 BYTES_PER_STEP = 12_500
+# A streamed sweep (pin-susp sweep to a file, Corner.run_sweep_chunks) holds only its
+# targets' values and what its summary needs, per step.
+STREAMED_BYTES_PER_STEP = 100
 
 AXES = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
 QUANTITIES = ("heave", "roll")  # an axle's own targets: heave mm, roll deg
@@ -152,15 +156,34 @@ def _values(t: dict, key: str, steps: int | None, r: Reader):
 
 
 def _check_memory(steps: int, r: Reader) -> None:
-    """Refuse a sweep whose results cannot fit in memory, before allocating any."""
-    need = float(min(steps, 10**30)) * BYTES_PER_STEP
-    have = _available_memory()
-    if need > 0.5 * have:
-        r.fail(
+    """Refuse a sweep that cannot be run even streamed, before allocating any."""
+    problem = _too_big(steps, STREAMED_BYTES_PER_STEP)
+    if problem:
+        r.fail("steps", problem + ": split the sweep into several files")
+
+
+def check_held(sweep: Sweep) -> None:
+    """Refuse a sweep whose results cannot be held whole in memory (one clear message
+    instead of running out of memory part-way): a long one is streamed instead."""
+    problem = _too_big(sweep.steps, BYTES_PER_STEP)
+    if problem:
+        raise InputError(
+            sweep.source,
             "steps",
-            f"{steps} steps need about {_bytes(need)} of memory, more than half of the "
-            f"{_bytes(have)} available here: split the sweep into several files",
+            f"{problem} to hold every step at once: write it with `pin-susp sweep` without "
+            "--plot (streamed to the file), or split the sweep into several files",
         )
+
+
+def _too_big(steps: int, per_step: int) -> str:
+    need = float(min(steps, 10**30)) * per_step
+    have = _available_memory()
+    if need <= 0.5 * have:
+        return ""
+    return (
+        f"{steps} steps need about {_bytes(need)} of memory, more than half of the "
+        f"{_bytes(have)} available here"
+    )
 
 
 def _available_memory() -> int:
