@@ -338,7 +338,7 @@ def solve_sweep(solver, values: np.ndarray, q: np.ndarray, previous: np.ndarray,
     its design branches; None when the solver's rows or the model are not of the
     kinds handled here, the sweep is short, or any step fails here.
     """
-    from .solver import ACCEPT, TOLERANCE, Solution, march
+    from .solver import TOLERANCE, Solution, march
 
     n = values.shape[0]
     if n < MIN_STEPS or not getattr(solver, "bulk", None) or not solver.bulk.supported:
@@ -369,7 +369,7 @@ def solve_sweep(solver, values: np.ndarray, q: np.ndarray, previous: np.ndarray,
     T0 = np.stack([start_tangent, *tangents])  # (m + 1, nv, k)
     segment = np.searchsorted(coarse, np.arange(n))  # step i lies in (coarse[s-1], coarse[s]]
     guess = _hermite(q0, v0, T0, segment, values)
-    qs, T, iterations, error = _newton(rows, guess, values, ACCEPT, TOLERANCE)
+    qs, T, iterations, error = _newton(rows, guess, values, TOLERANCE)
     if qs is None:
         return None
     if not _on_branches(solver, qs):
@@ -412,7 +412,7 @@ def _hermite(q0, v0, T0, segment, values) -> np.ndarray:
     return guess + np.einsum("nvk,nk->nv", near, off)
 
 
-def _newton(rows: Rows, q: np.ndarray, values: np.ndarray, accept: float, tolerance: float):
+def _newton(rows: Rows, q: np.ndarray, values: np.ndarray, tolerance: float):
     """Newton iterations for every step at once: (q, tangents, iterations, max |r|) or
     (None, ...) if any step does not converge to ``tolerance`` (or takes a wild step)."""
     from .solver import MAX_STEP
