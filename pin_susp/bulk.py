@@ -33,6 +33,7 @@ import numpy as np
 import pinocchio as pin
 
 from .closures import BallClosure, DistanceClosure, FramePoint, JointTarget, PointTarget
+from .jet import cross
 
 # A sweep shorter than this is marched step by step (the coarse pass would be most of it).
 MIN_STEPS = 200
@@ -197,13 +198,6 @@ def _times(A: np.ndarray, B: np.ndarray) -> np.ndarray:
 def _apply(A: np.ndarray, x: np.ndarray) -> np.ndarray:
     """A·x for stacked A (n, 3, 3) and one vector x (3,): (n, 3)."""
     return (A.reshape(-1, 3) @ x).reshape(A.shape[:-1])
-
-
-def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """a × b over the last axis, written out (np.cross costs more on these shapes)."""
-    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
-    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
-    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
 
 
 def _skew(axis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

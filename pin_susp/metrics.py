@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .geometry import Geometry, unit
-from .jet import Dual, value
+from .jet import Dual, cross, value
 from .jet import rate as jet_rate
 
 STEERING_AXIS_FLAT = 1e-6  # |k_z| below this: the axis never meets the ground
@@ -133,22 +133,18 @@ class PointSet:
     def _twist(self, driver: int):
         names = self.geometry.mechanism.upright_points(self.geometry)
         pts = [self[n] for n in names]
-        vel = [jet_rate(self[n], driver) for n in names]
-        c = sum(pts[1:], pts[0]) * (1.0 / len(pts))
-        vc = sum(vel[1:], vel[0]) * (1.0 / len(vel))
-        m = [0.0, 0.0, 0.0]  # columns of M
-        b = 0.0
-        for p, v in zip(pts, vel, strict=True):
-            r = p - c
-            rr = np.sum(r * r, axis=-1)[..., None]
-            for j in range(3):
-                m[j] = m[j] + rr * EYE[j] - r * r[..., j][..., None]
-            b = b + np.cross(r, v - vc)
-        rows = (np.cross(m[1], m[2]), np.cross(m[2], m[0]), np.cross(m[0], m[1]))
-        det = np.sum(m[0] * rows[0], axis=-1)[..., None]
-        w = sum(np.sum(rows[j] * b, axis=-1)[..., None] * EYE[j] for j in range(3)) / det
-        v_wc = vc + np.cross(w, self["wheel_center"] - c)
-        return w, v_wc
+        first = pts[0]
+        if isinstance(first, Dual) and not isinstance(first.val, Dual):
+            # a sweep's points: the rates' own rates are not known (NaN), so the twist's
+            # are NaN too — computed on the plain values (the same numbers, half the work)
+            rates = first.der.shape[0]
+            vel = [jet_rate(p, driver).val for p in pts]
+            wc = self["wheel_center"].val
+            unknown = np.full((rates, *np.shape(wc)), np.nan)
+            w, v_wc = _rigid_twist([p.val for p in pts], vel, wc)
+            return Dual(w, unknown), Dual(v_wc, unknown)
+        vel = [jet_rate(p, driver) for p in pts]
+        return _rigid_twist(pts, vel, self["wheel_center"])
 
     def _pole(self, axis: int):
         """Front view (axis X): FVIC = (WC_y − v_z/ω_x, WC_z + v_y/ω_x); side view:
@@ -176,6 +172,27 @@ class PointSet:
             return k, np.cross(w, v0) / ww[..., None], np.sum(w * v0, axis=-1) / ww
 
         return self._cached("screw", screw)
+
+
+def _rigid_twist(pts: list, vel: list, wc):
+    """A rigid body's twist (ω, v at WC) from its points and their velocities, in the
+    least-squares sense: v_i − v_c = ω × (p_i − p_c), with the 3×3 matrix
+    M = Σ(|r|²I − r rᵀ) inverted by its adjugate (plain arrays or jet.Duals alike)."""
+    c = sum(pts[1:], pts[0]) * (1.0 / len(pts))
+    vc = sum(vel[1:], vel[0]) * (1.0 / len(vel))
+    m = [0.0, 0.0, 0.0]  # columns of M
+    b = 0.0
+    for p, v in zip(pts, vel, strict=True):
+        r = p - c
+        rr = np.sum(r * r, axis=-1)[..., None]
+        for j in range(3):
+            m[j] = m[j] + rr * EYE[j] - r * r[..., j][..., None]
+        b = b + cross(r, v - vc)
+    rows = (cross(m[1], m[2]), cross(m[2], m[0]), cross(m[0], m[1]))
+    det = np.sum(m[0] * rows[0], axis=-1)[..., None]
+    w = sum(np.sum(rows[j] * b, axis=-1)[..., None] * EYE[j] for j in range(3)) / det
+    v_wc = vc + cross(w, wc - c)
+    return w, v_wc
 
 
 def camber(ps: PointSet):
