@@ -254,20 +254,29 @@ def _sweep(args) -> int:
 
 def _sweep_streamed(args, corner, sweep) -> int:
     """A long sweep written as it is solved, a chunk of steps at a time: its memory does
-    not grow with its length (the same rows as run_sweep's, to the solver's tolerance)."""
+    not grow with its length (the same rows as run_sweep's, to the solver's tolerance).
+    A chunk is written by a second thread while the next one is solved (pyarrow's
+    formatting and numpy leave the GIL): two chunks alive at most."""
     from .export import CsvStream, ParquetStream
 
     parts = corner.run_sweep_chunks(sweep, progress=_progress_bar(sweep.steps, args.quiet))
     first = next(parts)
     digest = Digest.of(first)
     kind = ParquetStream if str(args.output).endswith(".parquet") else CsvStream
-    with kind(args.output, first.units, first.meta, list(first.columns), sweep.steps) as out:
-        out.write(first)
+    from concurrent.futures import ThreadPoolExecutor
+
+    with (
+        kind(args.output, first.units, first.meta, list(first.columns), sweep.steps) as out,
+        ThreadPoolExecutor(1) as writer,
+    ):
+        pending = writer.submit(out.write, first)
         del first
         for part in parts:
-            out.write(part)
+            pending.result()
+            pending = writer.submit(out.write, part)
             digest.add(part)
-            del part  # before the next chunk is solved: one chunk held at a time
+            del part
+        pending.result()
     _warn_transmission(digest)
     if not args.quiet:
         _summary(digest, args.output)

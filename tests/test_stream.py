@@ -119,9 +119,10 @@ def test_an_interrupt_part_way_leaves_no_file(tmp_path, monkeypatch, small_chunk
     assert set(tmp_path.iterdir()) == before
 
 
-def test_one_chunk_at_a_time_is_alive(tmp_path, monkeypatch, small_chunks):
-    """What keeps memory flat: when a chunk starts solving, the chunks written before it
-    are gone (garbage), so a sweep of any length holds one chunk of rows at most."""
+def test_no_more_than_two_chunks_are_alive(tmp_path, monkeypatch, small_chunks):
+    """What keeps memory flat: when a chunk starts solving, the chunks before it are
+    gone (garbage) but the one being written, so a sweep of any length holds two chunks
+    of rows at most."""
     chunks = pin_susp.corner.Corner.run_sweep_chunks
     solve = pin_susp.corner.Corner.solve_steps
     refs, alive = [], []
@@ -141,7 +142,7 @@ def test_one_chunk_at_a_time_is_alive(tmp_path, monkeypatch, small_chunks):
     monkeypatch.setattr(pin_susp.corner.Corner, "solve_steps", solving)
     sweep = sweep_file(tmp_path, 2000)
     assert main(["sweep", str(GEOMETRY), str(sweep), "-o", str(tmp_path / "o.csv"), "-q"]) == 0
-    assert len(refs) == 8 and max(alive) == 0, alive
+    assert len(refs) == 8 and max(alive) <= 1, alive
 
 
 def test_a_sweep_too_long_to_hold_is_refused_where_it_would_be_held(tmp_path, capsys, monkeypatch):
