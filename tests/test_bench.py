@@ -51,6 +51,11 @@ def test_benchmark_quick_mode_runs_with_few_iterations_and_tiny_residuals(tmp_pa
         assert report["corners"][name]["vs"]["ratio"] > 0  # measured, never asserted
     grid = report["corners"]["double_wishbone.yaml"]["grid"]
     assert grid["converged"] == grid["points"] and grid["max_residual_mm"] <= 1e-9
+    long = report["long"]  # issue 17's sweep: every column, solved at once
+    assert long["converged"] and long["max_residual_mm"] <= 1e-9 and long["columns"] >= 80
+    for baseline in long["baselines"].values():
+        assert baseline["max_residual_mm"] <= 1e-9
+    assert [sorted(pair["wall_s"]) for pair in report["cli"]] == [["2001", "201"]]
 
 
 def test_study_benchmark_runs_a_small_slice(tmp_path):
