@@ -272,7 +272,25 @@ def _rows(results) -> int:
     return len(next(iter(results.columns.values()), ()))
 
 
-class CsvStream:
+class _Stream:
+    """A file written a chunk of rows at a time through atomic_write (whole or not at
+    all); ``names``: its columns, in order."""
+
+    def __init__(self, path, columns_order):
+        self.path = path
+        self.names = list(columns_order)
+        self.rows = 0
+        self._stack = None
+        self._file = None
+
+    def _open(self):
+        stack = ExitStack()
+        self._file = stack.enter_context(atomic_write(self.path, binary=True))
+        self._stack = stack
+        return self._file
+
+
+class CsvStream(_Stream):
     """A CSV file written a chunk of rows at a time, whole or not at all::
 
         with CsvStream(path, results.units, results.meta, names, total_rows) as out:
@@ -287,19 +305,12 @@ class CsvStream:
     """
 
     def __init__(self, path, units: dict, meta: dict, columns_order, total_rows: int):
-        self.path = path
-        self.names = list(columns_order)
+        super().__init__(path, columns_order)
         self.head = csv_header(units, meta, self.names)
         self.fast = fast_style(total_rows, len(self.names))
-        self.rows = 0
-        self._stack = None
-        self._file = None
 
     def __enter__(self):
-        stack = ExitStack()
-        self._file = stack.enter_context(atomic_write(self.path, binary=True))
-        self._stack = stack
-        self._file.write(self.head.encode())
+        self._open().write(self.head.encode())
         return self
 
     def write(self, results) -> None:
@@ -443,30 +454,24 @@ def parquet_metadata(units: dict, meta: dict) -> dict:
     return out
 
 
-class ParquetStream:
+class ParquetStream(_Stream):
     """A Parquet file written a chunk of rows at a time, whole or not at all (as
     CsvStream): rows are held until a row group of ROW_GROUP is full, so the file is
     the one write_parquet makes of all the rows at once, byte for byte. ``total_rows``
     is accepted for CsvStream's signature; Parquet does not need it."""
 
     def __init__(self, path, units: dict, meta: dict, columns_order, total_rows=None):
-        self.path = path
-        self.names = list(columns_order)
+        super().__init__(path, columns_order)
         self.metadata = parquet_metadata(units, meta)
-        self.rows = 0
         self._held = []  # tables not yet written: fewer than ROW_GROUP rows in all
         self._held_rows = 0
         self._schema = None
         self._writer = None
-        self._stack = None
-        self._file = None
 
     def __enter__(self):
         import pyarrow.parquet  # noqa: F401  (before the file appears: an import error leaves none)
 
-        stack = ExitStack()
-        self._file = stack.enter_context(atomic_write(self.path, binary=True))
-        self._stack = stack
+        self._open()
         return self
 
     def write(self, results) -> None:

@@ -24,6 +24,15 @@ def mirrored(geometry: dict) -> dict:
     return g
 
 
+def torsion_bar() -> dict:
+    """The pushrod-rocker example with a torsion bar on its rocker for a spring."""
+    geometry = example("pushrod_rocker.yaml")
+    geometry["spring"] = {"type": "torsion_bar", "rate": 40, "preload": 150}  # N·m/deg, N·m
+    for point in ("strut_top", "strut_bottom"):
+        del geometry["hardpoints"][point]
+    return geometry
+
+
 def translated(geometry: dict, v) -> dict:
     """Every hardpoint moved by the vector v (mm)."""
     g = copy.deepcopy(geometry)

@@ -4,7 +4,7 @@ the step-by-step march, and the independent point-based formulation."""
 import numpy as np
 import pinocchio as pin
 import pytest
-from conftest import EXAMPLES, example
+from conftest import EXAMPLES, example, torsion_bar
 from pointwise import PointwiseCorner
 
 import pin_susp
@@ -230,14 +230,6 @@ def test_tree_velocities_and_accelerations_match_pinocchio(name):
             np.testing.assert_allclose(
                 state[1][j, n], pin.getFrameAcceleration(model, data, f, world).angular, atol=1e-12
             )
-
-
-def torsion_bar() -> dict:
-    geometry = example("pushrod_rocker.yaml")
-    geometry["spring"] = {"type": "torsion_bar", "rate": 40, "preload": 150}  # N·m/deg, N·m
-    for point in ("strut_top", "strut_bottom"):
-        del geometry["hardpoints"][point]
-    return geometry
 
 
 @pytest.mark.parametrize(

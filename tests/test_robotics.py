@@ -16,7 +16,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 import yourdfpy
-from conftest import EXAMPLES, ROOT, example, mirrored
+from conftest import EXAMPLES, ROOT, example, mirrored, torsion_bar
 
 import pin_susp
 from pin_susp.cli import main
@@ -353,20 +353,12 @@ def drop_test():
     return module
 
 
-def torsion_bar_corner() -> dict:
-    geometry = example("pushrod_rocker.yaml")
-    geometry["spring"] = {"type": "torsion_bar", "rate": 40, "preload": 150}  # N·m/deg, N·m
-    for point in ("strut_top", "strut_bottom"):
-        del geometry["hardpoints"][point]
-    return geometry
-
-
 @pytest.mark.parametrize(
     ("geometry", "load", "travel"),
     [
         (EXAMPLES / "pushrod_rocker.yaml", 1500.0, 14.57),
         (EXAMPLES / "macpherson.yaml", 3000.0, 7.69),
-        (torsion_bar_corner(), 500.0, -4.41),
+        (torsion_bar(), 500.0, -4.41),
     ],
     ids=["pushrod coilover", "macpherson strut", "torsion bar"],
 )
