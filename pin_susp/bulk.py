@@ -351,8 +351,6 @@ def solve_sweep(solver, values: np.ndarray, q: np.ndarray, previous: np.ndarray,
         solver.keep_jacobian = keep
     if not all(s.converged for s in marched):
         return None
-    if progress is not None:
-        progress(len(coarse), n)
     # the predictions: cubic Hermite between coarse neighbours (the design state, or the
     # given start, before the first)
     q0 = np.vstack([q[None], np.array([s.q for s in marched])])

@@ -72,11 +72,23 @@ def main(argv: list[str] | None = None) -> int:
             return EXIT_INPUT
         except (KeyboardInterrupt, _Terminated) as exc:
             signal_number = exc.signal if isinstance(exc, _Terminated) else signal.SIGINT
-            print("pin-susp: interrupted, nothing written", file=sys.stderr)
+            print(f"pin-susp: interrupted, {_unwritten(args)}", file=sys.stderr)
             return 128 + signal_number
         except BrokenPipeError:  # output piped into `head` and the like
             sys.stderr.close()
             return 0
+
+
+def _unwritten(args) -> str:
+    """What an interrupt leaves: no file; but what went into a stream (-o /dev/stdout, a
+    pipe) is out, and a streamed sweep may have sent some of its rows."""
+    output = getattr(args, "output", None)
+    if isinstance(output, str) and output:
+        from .export import is_stream
+
+        if is_stream(Path(output)):
+            return f"{output} is a stream: what was already sent to it is incomplete"
+    return "nothing written"
 
 
 def _print_warnings(args) -> None:
@@ -228,13 +240,13 @@ def _run_arguments(parser, output: str, plot: str, cases: bool = False) -> None:
 
 
 def _sweep(args) -> int:
+    _check_outputs(args, args.output, args.plot)  # before the numerics are imported
+    if args.plot is not None:
+        _check_image(args.plot)
     from .corner import Corner
     from .geometry import load_geometry
     from .sweep import load_sweep
 
-    _check_outputs(args, args.output, args.plot)
-    if args.plot is not None:
-        _check_image(args.plot)
     if _is_axle(args.geometry):
         return _sweep_axle(args)
     corner = Corner(load_geometry(args.geometry))
@@ -864,6 +876,29 @@ SUMMARY_EXTRA = (
 SIDES = (("", ""), ("_left", "left "), ("_right", "right "))
 
 
+class Steps:
+    """Step numbers as a report names them: the first few, and how many in all (a sweep
+    of millions of steps keeps no more)."""
+
+    SHOWN = 10
+
+    def __init__(self):
+        self.first: list[int] = []
+        self.count = 0
+
+    def add(self, steps) -> None:
+        room = self.SHOWN + 1 - len(self.first)  # one more than shown: "..." follows
+        if room > 0:
+            self.first += [int(i) for i in steps[:room]]
+        self.count += len(steps)
+
+    def __str__(self) -> str:
+        return _list(self.first)
+
+    def __eq__(self, other) -> bool:
+        return isinstance(other, Steps) and (self.first, self.count) == (other.first, other.count)
+
+
 class Digest:
     """What the summary, the warnings and the failure report need from a sweep's
     results, gathered a chunk at a time (``add``): a streamed sweep keeps no rows.
@@ -877,9 +912,13 @@ class Digest:
         self.iterations = np.zeros(0, dtype=int)  # how many steps took each count
         self.units: dict[str, str] = {}
         self.stats: dict[str, list] = {}  # name → [first, last, min, max, far step, |far|]
-        self.failed: list[tuple[int, str, float]] = []  # (step, why, residual mm)
-        self.band: dict[str, list] = {}  # side → [steps outside, worst step, its angle]
-        self.unseat: dict[str, list] = {}  # side → [steps below zero, least force]
+        # Steps are kept as Steps: the first few, and how many (a report names no more).
+        self.short = Steps()  # out of reach or past a lock-up
+        self.worst_short = 0.0  # their largest residual, mm
+        self.flipped = Steps()  # on another assembly branch
+        self.loops: set[str] = set()  # the loops that flipped
+        self.band: dict[str, list] = {}  # side → [Steps outside, worst step, its angle]
+        self.unseat: dict[str, list] = {}  # side → [Steps below zero, least force]
 
     @classmethod
     def of(cls, results) -> Digest:
@@ -906,7 +945,13 @@ class Digest:
             self.iterations = np.r_[self.iterations, np.zeros(len(counts) - len(self.iterations))]
         self.iterations[: len(counts)] += counts.astype(int)
         why = results.meta["why"]
-        self.failed += [(int(steps[i]), why[i], float(residual[i])) for i in np.flatnonzero(~ok)]
+        for i in np.flatnonzero(~ok):
+            if "branch" in why[i]:
+                self.flipped.add([int(steps[i])])
+                self.loops.add(why[i].rpartition(" of ")[2])
+            else:
+                self.short.add([int(steps[i])])
+                self.worst_short = max(self.worst_short, float(residual[i]))
         names = [m.name for m in METRICS if m.written] + list(SUMMARY_EXTRA)
         for name in names:
             if name in results.columns and len(steps):
@@ -919,14 +964,14 @@ class Digest:
                 outside = np.flatnonzero((angle < low) | (angle > high))
                 if len(outside):
                     worst = outside[np.argmax(np.abs(angle[outside] - 90.0))]
-                    band = self.band.setdefault(side, [[], None, 90.0])
-                    band[0] += steps[outside].tolist()
+                    band = self.band.setdefault(side, [Steps(), None, 90.0])
+                    band[0].add(steps[outside])
                     if abs(angle[worst] - 90.0) > abs(band[2] - 90.0):
                         band[1], band[2] = int(steps[worst]), float(angle[worst])
             force = results.columns.get(f"spring_force{suffix}")
             if force is not None and np.nanmin(force, initial=np.inf) < 0.0:
-                unseat = self.unseat.setdefault(side, [[], np.inf])
-                unseat[0] += steps[np.flatnonzero(force < 0.0)].tolist()
+                unseat = self.unseat.setdefault(side, [Steps(), np.inf])
+                unseat[0].add(steps[np.flatnonzero(force < 0.0)])
                 unseat[1] = min(unseat[1], float(np.nanmin(force)))
 
     def _column(self, name: str, v, steps) -> None:
@@ -944,6 +989,10 @@ class Digest:
             i = far[np.argmax(np.abs(v[far]))]
             if abs(v[i]) > stat[5]:
                 stat[4], stat[5] = int(steps[i]), abs(v[i])
+
+    @property
+    def failed(self) -> int:
+        return self.short.count + self.flipped.count
 
     @property
     def iterations_median(self) -> float:
@@ -995,7 +1044,7 @@ def _warn_transmission(results) -> None:
             steps, worst, angle = d.band[side]
             warnings.warn(
                 f"{side}rocker transmission angle outside {low:g}…{high:g} deg at steps "
-                f"{_list(steps)} (worst {angle:.1f} deg at step {worst}): "
+                f"{steps} (worst {angle:.1f} deg at step {worst}): "
                 "the rocker nears over-centre, its motion ratio falls toward zero and flips",
                 PlausibilityWarning,
                 stacklevel=2,
@@ -1003,7 +1052,7 @@ def _warn_transmission(results) -> None:
         if side in d.unseat:
             steps, least = d.unseat[side]
             warnings.warn(
-                f"{side}spring force below zero at steps {_list(steps)} "
+                f"{side}spring force below zero at steps {steps} "
                 f"(least {least:.0f} N): the spring would unseat there — more "
                 "preload, or less droop",
                 PlausibilityWarning,
@@ -1018,23 +1067,19 @@ def _report_failures(
     d = Digest.of(results)
     if not d.failed:
         return 0
-    flipped = [step for step, why, _ in d.failed if "branch" in why]
-    short = [(step, residual) for step, why, residual in d.failed if "branch" not in why]
     reasons = []
-    if short:
-        worst = max(residual for _, residual in short)
+    if d.short.count:
         reasons.append(
-            f"steps {_list([step for step, _ in short])} out of the mechanism's reach or past "
-            f"a lock-up (residual up to {worst:.3g} mm)"
+            f"steps {d.short} out of the mechanism's reach or past a lock-up "
+            f"(residual up to {d.worst_short:.3g} mm)"
         )
-    if flipped:
-        loops = sorted({why.rpartition(" of ")[2] for _, why, _ in d.failed if "branch" in why})
+    if d.flipped.count:
         reasons.append(
-            f"steps {_list(flipped)} reach the targets only on another assembly branch "
-            f"({', '.join(loops)} flipped over: not the design's mechanism)"
+            f"steps {d.flipped} reach the targets only on another assembly branch "
+            f"({', '.join(sorted(d.loops))} flipped over: not the design's mechanism)"
         )
     print(
-        f"pin-susp: warning: {len(d.failed)} of {d.steps} steps did not converge: "
+        f"pin-susp: warning: {d.failed} of {d.steps} steps did not converge: "
         f"{'; '.join(reasons)}. Their rows {consequence}.",
         file=sys.stderr,
     )

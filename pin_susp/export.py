@@ -24,6 +24,7 @@ a chunk), both through atomic_write.
 from __future__ import annotations
 
 import contextvars
+import errno
 import json
 import os
 import re
@@ -121,6 +122,10 @@ def _name_max(folder: Path) -> int:
         return 255
 
 
+# A write that fails for want of room: the disk, a quota, a file-size limit.
+_FULL = {errno.ENOSPC, errno.EFBIG, errno.EDQUOT}
+
+
 @contextmanager
 def atomic_write(path: str | Path, binary: bool = False):
     """Open a file for writing that appears at ``path`` only when complete."""
@@ -139,6 +144,10 @@ def atomic_write(path: str | Path, binary: bool = False):
                 yield f
         except BrokenPipeError:
             raise PinSuspError(f"{path}: the reader closed it before the end") from None
+        except OSError as exc:
+            if exc.errno not in _FULL:
+                raise
+            raise PinSuspError(f"{path}: cannot be written ({exc.strerror})") from None
         return
     try:
         target.parent.mkdir(parents=True, exist_ok=True)
@@ -150,8 +159,12 @@ def atomic_write(path: str | Path, binary: bool = False):
         with os.fdopen(fd, mode, newline=newline) as f:
             yield f
         os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes it private; outputs are not
-    except BaseException:
+    except BaseException as exc:
         os.unlink(tmp)
+        if isinstance(exc, OSError) and exc.errno in _FULL:  # the disk, a quota, ulimit -f
+            raise PinSuspError(
+                f"{path}: cannot be written ({exc.strerror}): nothing written"
+            ) from None
         raise
     pending = _PENDING.get()
     if pending is None:
@@ -310,7 +323,12 @@ class CsvStream(_Stream):
         self.fast = fast_style(total_rows, len(self.names))
 
     def __enter__(self):
-        self._open().write(self.head.encode())
+        head = self._open()
+        try:
+            head.write(self.head.encode())
+        except BaseException:  # the file (or its temporary) is left as atomic_write leaves it
+            self._stack.__exit__(*sys.exc_info())
+            raise
         return self
 
     def write(self, results) -> None:

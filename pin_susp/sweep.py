@@ -170,8 +170,8 @@ def check_held(sweep: Sweep) -> None:
         raise InputError(
             sweep.source,
             "steps",
-            f"{problem} to hold every step at once: write it with `pin-susp sweep` without "
-            "--plot (streamed to the file), or split the sweep into several files",
+            f"{problem} to hold every step at once: split the sweep into several files "
+            "(a corner's `pin-susp sweep` without --plot writes it as it goes)",
         )
 
 

@@ -580,3 +580,44 @@ def test_a_reader_that_closes_early_is_an_error_and_nothing_else_is_written(tmp_
     reader.join(timeout=30)
     assert code == 2 and len(err) == 1 and "closed it before the end" in err[0]
     assert files(tmp_path) == {"p.csv", "s.yaml"}
+
+
+@pytest.mark.parametrize("steps", [41, 12_000], ids=["held", "streamed"])
+def test_a_full_disk_is_one_line_and_leaves_nothing(tmp_path, steps):
+    """A write that runs out of room (here a file-size limit, as a full disk or a quota
+    would): one line naming the file, exit 2, no file and no temporary left."""
+    import resource
+
+    sweep = example("bump_steer.yaml")
+    sweep["steps"] = steps
+    path = tmp_path / "s.yaml"
+    path.write_text(yaml.safe_dump(sweep))
+
+    def limit():  # Python ignores SIGXFSZ: the write raises EFBIG
+        resource.setrlimit(resource.RLIMIT_FSIZE, (20_000, 20_000))
+
+    proc = subprocess.run(
+        [sys.executable, "-m", "pin_susp.cli", "sweep", GEOMETRY, str(path), "-o", "r.csv", "-q"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        preexec_fn=limit,
+        timeout=300,
+    )
+    assert proc.returncode == 2, proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and "r.csv: cannot be written (File too large)" in lines[0], lines
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.yaml"]
+
+
+def test_an_interrupt_says_a_stream_output_is_incomplete(tmp_path):
+    """-o onto a pipe: what was sent before an interrupt is out, and the message says so."""
+    from argparse import Namespace
+
+    from pin_susp.cli import _unwritten
+
+    pipe = tmp_path / "pipe"
+    os.mkfifo(pipe)
+    assert "is a stream" in _unwritten(Namespace(output=str(pipe)))
+    assert _unwritten(Namespace(output=str(tmp_path / "r.csv"))) == "nothing written"
+    assert _unwritten(Namespace()) == "nothing written"

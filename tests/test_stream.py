@@ -198,8 +198,11 @@ def test_a_digest_gathered_in_chunks_equals_the_whole():
             np.nanmax(columns["camber"]),
         ]
         assert d.stats["fvic_y"][4] == np.argmax(np.abs(columns["fvic_y"]))
-        assert [s for s, _, _ in d.failed] == list(np.flatnonzero(~columns["solver_converged"]))
+        failed = np.flatnonzero(~columns["solver_converged"])
+        assert d.short.first == list(failed[:11]) and d.short.count == d.failed == len(failed)
+        assert d.worst_short == columns["solver_max_residual"][failed].max()
         angle = columns["rocker_transmission_angle"]
-        assert d.band[""][0] == list(np.flatnonzero((angle < 30) | (angle > 150)))
+        outside = np.flatnonzero((angle < 30) | (angle > 150))
+        assert d.band[""][0].first == list(outside[:11]) and d.band[""][0].count == len(outside)
         assert d.unseat[""][1] == columns["spring_force"].min()
     assert str(parts.stats) == str(whole.stats) and parts.band == whole.band
