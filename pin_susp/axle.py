@@ -940,7 +940,7 @@ def _side_rates(model: AxleModel, plain: dict, qs: list) -> dict:
     rack = model.model.existJointName("rack_slide")
     index = model.model.joints[model.model.getJointId("rack_slide")].idx_q if rack else None
     for side, g in model.geometries.items():
-        if g.spring_rate is None or g.spring == "none":
+        if not g.rated_spring:
             continue
         corner = Linkage(g)
         targets = [PointTarget(corner.points["wheel_center"], Z)]

@@ -50,7 +50,6 @@ class Tree:
     def __init__(self, model: pin.Model):
         self.model = model
         self.nq, self.nv = model.nq, model.nv
-        self.nframes = model.nframes
         self.supported = model.nq == model.nv
         self.joints = []  # (parent, revolute?, axis (3,), placement R, placement p, idx)
         for i in range(1, model.njoints):
@@ -216,9 +215,10 @@ class Frames:
         self.joint = [model.frames[f].parentJoint for f in self.ids]
         self.offset = [model.frames[f].placement.translation.copy() for f in self.ids]
 
-    def evaluate(self, q: np.ndarray, jacobians: bool = True):
-        """Positions (list of (n, 3)) and Jacobians (list of (n, 3, nv), or None)."""
-        R, o = self.tree.placements(q)
+    def evaluate(self, q: np.ndarray, jacobians: bool = True, placed=None):
+        """Positions (list of (n, 3)) and Jacobians (list of (n, 3, nv), or None);
+        ``placed``: Tree.placements(q) when the caller has it already."""
+        R, o = self.tree.placements(q) if placed is None else placed
         P = self.positions(R, o)
         if not jacobians:
             return P, None
@@ -267,11 +267,12 @@ class Rows:
         self.first_target = i - ntargets
         self.frames = Frames(tree, frames)
 
-    def evaluate(self, q: np.ndarray, values: np.ndarray, jacobian: bool = True):
+    def evaluate(self, q: np.ndarray, values: np.ndarray, jacobian: bool = True, placed=None):
         """Residuals (n, nrows) and Jacobians (n, nrows, nv) at q (n, nq) with the target
-        values (n, ntargets); a target row's value is its column of ``values``."""
+        values (n, ntargets); a target row's value is its column of ``values``;
+        ``placed``: Tree.placements(q) when the caller has it already."""
         n = q.shape[0]
-        P, Jf = self.frames.evaluate(q, jacobian)
+        P, Jf = self.frames.evaluate(q, jacobian, placed)
         r = np.empty((n, self.nrows))
         J = np.zeros((n, self.nrows, self.tree.nv)) if jacobian else None
         for kind, i, a, b, extra in self.items:
@@ -305,20 +306,23 @@ class Rows:
         for kind, i, a, b, extra in self.items:
             if kind == "ball":
                 out[:, i : i + 3] = A[b] - A[a]
-            elif kind == "distance":  # |d|″ = u·d″ + (|d′|² − (u·d′)²)/|d|
-                d, dv = P[b] - P[a], V[b] - V[a]
-                length = np.sqrt(np.einsum("ni,ni->n", d, d))
-                u = d / length[:, None]
-                along = np.einsum("ni,ni->n", u, dv)
-                out[:, i] = (
-                    np.einsum("ni,ni->n", u, A[b] - A[a])
-                    + (np.einsum("ni,ni->n", dv, dv) - along * along) / length
-                )
+            elif kind == "distance":
+                out[:, i] = length_rates(P[b] - P[a], V[b] - V[a], A[b] - A[a])[2]
             elif kind == "target":
                 out[:, i] = A[a] @ extra
             else:
                 out[:, i] = qdd[:, b]
         return out
+
+
+def length_rates(d: np.ndarray, dv: np.ndarray, da: np.ndarray) -> tuple:
+    """|d| and its first and second time derivatives (each (n,)) from d, d′, d″ (n, 3):
+    |d|′ = u·d′ and |d|″ = u·d″ + (|d′|² − (u·d′)²)/|d|, u = d/|d|."""
+    length = np.sqrt(np.einsum("ni,ni->n", d, d))
+    u = d / length[:, None]
+    along = np.einsum("ni,ni->n", u, dv)
+    second = np.einsum("ni,ni->n", u, da) + (np.einsum("ni,ni->n", dv, dv) - along * along) / length
+    return length, along, second
 
 
 def _framed(*points) -> bool:
@@ -474,7 +478,7 @@ def _on_branches(solver, qs: np.ndarray) -> bool:
 def chirality(a, b, c, d) -> np.ndarray:
     """closures.chirality for arrays of points (n, 3)."""
     u, v, w = b - a, c - a, d - a
-    det = np.einsum("ni,ni->n", u, np.cross(v, w))
+    det = np.einsum("ni,ni->n", u, cross(v, w))
     scale = np.sqrt(
         np.einsum("ni,ni->n", u, u) * np.einsum("ni,ni->n", v, v) * np.einsum("ni,ni->n", w, w)
     )

@@ -255,13 +255,14 @@ def _sweep(args) -> int:
     if sweep.steps > STREAM_STEPS and args.plot is None:
         return _sweep_streamed(args, corner, sweep)
     results = corner.run_sweep(sweep, progress=_progress_bar(sweep.steps, args.quiet))
-    _warn_transmission(results)
+    digest = Digest.of(results)
+    _warn_transmission(digest)
     plot = _write_results(args, results)
     if not args.quiet:
-        _summary(results, args.output)
+        _summary(digest, args.output)
         if plot:
             print(f"wrote {args.plot}")
-    return _report_failures(results)
+    return _report_failures(digest)
 
 
 def _sweep_streamed(args, corner, sweep) -> int:
@@ -269,14 +270,14 @@ def _sweep_streamed(args, corner, sweep) -> int:
     not grow with its length (the same rows as run_sweep's, to the solver's tolerance).
     A chunk is written by a second thread while the next one is solved (pyarrow's
     formatting and numpy leave the GIL): two chunks alive at most."""
+    from concurrent.futures import ThreadPoolExecutor
+
     from .export import CsvStream, ParquetStream
 
     parts = corner.run_sweep_chunks(sweep, progress=_progress_bar(sweep.steps, args.quiet))
     first = next(parts)
     digest = Digest.of(first)
     kind = ParquetStream if str(args.output).endswith(".parquet") else CsvStream
-    from concurrent.futures import ThreadPoolExecutor
-
     with (
         kind(args.output, first.units, first.meta, list(first.columns), sweep.steps) as out,
         ThreadPoolExecutor(1) as writer,
@@ -463,7 +464,8 @@ def _sweep_axle(args) -> int:
     sweep = load_sweep(args.sweep)
     solutions = solve_axle_sweep(model, sweep, progress=_progress_bar(sweep.steps, args.quiet))
     results = axle_results(model, sweep, solutions)
-    _warn_transmission(results)
+    digest = Digest.of(results)
+    _warn_transmission(digest)
     plot = _write_results(args, results)
     if not args.quiet:
         ok = results["solver_converged"]
@@ -482,7 +484,7 @@ def _sweep_axle(args) -> int:
         print("  (every column of both corners, suffixed _left/_right, is in the CSV)")
         if plot:
             print(f"wrote {args.plot}")
-    return _report_failures(results)
+    return _report_failures(digest)
 
 
 AXLE_SUMMARY = (
@@ -814,7 +816,8 @@ def _demo(args) -> int:
     )
     corner = Corner(geometry)
     results = corner.run_sweep(sweep, progress=_progress_bar(sweep.steps, False))
-    _warn_transmission(results)
+    digest = Digest.of(results)
+    _warn_transmission(digest)
     with all_or_none():
         for name, text in inputs.items():
             write_text(text, out / name)
@@ -823,14 +826,14 @@ def _demo(args) -> int:
         write_text(text, files["results"])
         _demo_pictures(corner, results, files, text)
     print(f"pin_susp demo: {corner.geometry.name}, {sweep.steps}-step bump + steer sweep")
-    _summary(results, files["results"])
+    _summary(digest, files["results"])
     for what, path in [("geometry", geometry_path), ("sweep", sweep_path), *files.items()]:
         print(f"  {what:<10} {path}")
     print(
         f"open {files['3D replay']} in a browser to see the corner move; "
         f"{files['plots']} has the standard plots"
     )
-    return _report_failures(results)
+    return _report_failures(digest)
 
 
 def _demo_pictures(corner, results, files, csv: str) -> None:
@@ -905,11 +908,9 @@ class Digest:
     Steps are the results' ``step_index``."""
 
     def __init__(self):
-        import numpy as np
-
         self.steps = self.converged = 0
-        self.max_residual = np.nan
-        self.iterations = np.zeros(0, dtype=int)  # how many steps took each count
+        self.max_residual = math.nan
+        self.iterations = []  # how many steps took each count of iterations
         self.units: dict[str, str] = {}
         self.stats: dict[str, list] = {}  # name → [first, last, min, max, far step, |far|]
         # Steps are kept as Steps: the first few, and how many (a report names no more).
@@ -940,10 +941,10 @@ class Digest:
         self.converged += int(ok.sum())
         if len(steps):
             self.max_residual = np.nanmax(np.r_[self.max_residual, residual])
-        counts = np.bincount(np.asarray(results["solver_iterations"], dtype=int))
-        if len(counts) > len(self.iterations):
-            self.iterations = np.r_[self.iterations, np.zeros(len(counts) - len(self.iterations))]
-        self.iterations[: len(counts)] += counts.astype(int)
+        counts = np.bincount(np.asarray(results["solver_iterations"], dtype=int)).tolist()
+        self.iterations += [0] * (len(counts) - len(self.iterations))
+        for i, count in enumerate(counts):
+            self.iterations[i] += count
         why = results.meta["why"]
         for i in np.flatnonzero(~ok):
             if "branch" in why[i]:

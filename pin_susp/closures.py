@@ -27,7 +27,7 @@ class Kinematics:
     @property
     def tree(self):
         """The model's tree as arrays, for many configurations at once (bulk.Tree)."""
-        if self._tree is None or self._tree.nframes != self.model.nframes:
+        if self._tree is None:
             from .bulk import Tree
 
             self._tree = Tree(self.model)

@@ -276,7 +276,7 @@ class Results:
         for name, (values, column_unit) in metrics.items():
             columns[name], units[name] = values, column_unit
         qs = [s.q if s.converged else None for s in solutions]
-        if corner.geometry.spring_rate is not None and corner.geometry.spring != "none":
+        if corner.geometry.rated_spring:
             from .loads import RATE_COLUMNS, rate_columns  # a rated spring's columns
 
             if only is None or RATE_COLUMNS & set(only):

@@ -148,6 +148,11 @@ class Geometry:
         return self.actuation == "pushrod_rocker"
 
     @property
+    def rated_spring(self) -> bool:
+        """A spring with its rate given: its force and the wheel and ride rates exist."""
+        return self.spring_rate is not None and self.spring != "none"
+
+    @property
     def needs_setup(self) -> bool:
         """True when shims or adjusters move the corner away from its drawn state."""
         shim = self.camber_shim

@@ -114,16 +114,18 @@ class FrameMotion:
         configurations; ``tangent_at(i, q)`` updates the kinematics (Jacobians too) at
         q and returns dq per driver (nv × k). A None configuration gives NaN.
 
-        ``tangents(Q, steps)``: dq per driver at every solved configuration at once
-        ((len(Q), nv, k), or None): then every step is evaluated at once on the
-        model's tree (bulk.Tree) instead of one Pinocchio call after another.
+        ``tangents(Q, steps, placed)``: dq per driver at every solved configuration at
+        once ((len(Q), nv, k), or None; ``placed``: the tree's placements at Q): then
+        every step is evaluated at once on the model's tree (bulk.Tree) instead of one
+        Pinocchio call after another.
         """
         solved = [i for i, q in enumerate(qs) if q is not None]
         if tangents is not None and self.kin.tree.supported and solved:
             Q = np.array([qs[i] for i in solved]).reshape(len(solved), self.kin.model.nq)
-            T = tangents(Q, solved)
+            placed = self.kin.tree.placements(Q)
+            T = tangents(Q, solved, placed)
             if T is not None:
-                return self._at_once(len(qs), solved, Q, T, k)
+                return self._at_once(len(qs), solved, placed, T, k)
         n, m = len(qs), len(self.names)
         pos = np.full((n, m, 3), np.nan)
         rates = np.full((k, n, m, 3), np.nan)
@@ -160,12 +162,13 @@ class FrameMotion:
         rates[:, unsolved] = np.nan
         return pos, rates
 
-    def _at_once(self, n: int, solved: list, Q: np.ndarray, T: np.ndarray, k: int):
-        """__call__ for every solved configuration Q at once (T: their tangents)."""
+    def _at_once(self, n: int, solved: list, placed: tuple, T: np.ndarray, k: int):
+        """__call__ for every solved configuration at once (``placed``: the tree's
+        placements there, T: their tangents)."""
         tree = self.kin.tree
-        R, o = tree.placements(Q)
+        R, o = placed
         a = tree.axes(R)
-        count = len(Q)
+        count = len(T)
         pos = np.empty((count, len(self.names), 3))
         rates = np.empty((k, count, len(self.names), 3))
         for j, index, local in self.groups:
@@ -291,13 +294,14 @@ class Linkage:
             self._drive.evaluate(q)
             return self._drive.tangent(self.drive_rhs)
 
-        def at_once(Q: np.ndarray, steps: list) -> np.ndarray | None:
+        def at_once(Q: np.ndarray, steps: list, placed: tuple) -> np.ndarray | None:
             if tangents is not None and all(tangents[i] is not None for i in steps):
                 return np.array([tangents[i] for i in steps])
             rows = self._drive.bulk
             if not rows.supported or rows.nrows != self.model.nv:
                 return None
-            _, J = rows.evaluate(Q, np.zeros((len(Q), len(self._drive.targets))))
+            zero = np.zeros((len(Q), len(self._drive.targets)))
+            _, J = rows.evaluate(Q, zero, placed=placed)
             return solve_all(J, self.drive_rhs)
 
         pos, rates = self._frame_motion(qs, tangent_at, len(self.drivers), at_once)

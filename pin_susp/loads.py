@@ -765,7 +765,7 @@ class SpringRates:
         """``derivatives`` for every configuration at once, on the model's tree (bulk.py):
         arrays (x, ẋ, ẍ) with NaN where q is None; None where the tree or the rows are
         not of the kinds handled there (then each is computed by ``derivatives``)."""
-        from .bulk import Frames, solve_all
+        from .bulk import Frames, length_rates, solve_all
 
         tree, rows = self.corner.kin.tree, self.solver.bulk
         if not (tree.supported and rows.supported and rows.nrows == self.model.nv):
@@ -777,7 +777,7 @@ class SpringRates:
         Q = np.array([qs[i] for i in solved])
         R, o = tree.placements(Q)
         a = tree.axes(R)
-        _, J = rows.evaluate(Q, np.zeros((n, len(self.solver.targets))))
+        _, J = rows.evaluate(Q, np.zeros((n, len(self.solver.targets))), placed=(R, o))
         T = solve_all(J, self.solver._unit_rhs)
         if T is None:
             return None
@@ -809,15 +809,7 @@ class SpringRates:
         frames = Frames(tree, [self.top.frame_id, self.bottom.frame_id])
         P = frames.positions(R, o)
         V, A = frames.motion(P, o, state)
-        d, dv = P[1] - P[0], V[1] - V[0]
-        length = np.linalg.norm(d, axis=1)
-        u = d / length[:, None]
-        along = np.einsum("ni,ni->n", u, dv)
-        second = (
-            np.einsum("ni,ni->n", u, A[1] - A[0])
-            + (np.einsum("ni,ni->n", dv, dv) - along * along) / length
-        )
-        out[:, solved] = length, along, second
+        out[:, solved] = length_rates(P[1] - P[0], V[1] - V[0], A[1] - A[0])
         return tuple(out)
 
     def columns(self, qs: list) -> dict:
@@ -871,6 +863,6 @@ RATE_COLUMNS = {"spring_force", "spring_torque", "wheel_rate", "ride_rate"}
 def rate_columns(corner, qs: list) -> dict:
     """The spring's force and the wheel and ride rates, where the geometry gives the
     spring's rate (else nothing)."""
-    if corner.geometry.spring_rate is None or corner.geometry.spring == "none":
+    if not corner.geometry.rated_spring:
         return {}
     return SpringRates(corner).columns(qs)
