@@ -338,6 +338,18 @@ def pointwise_points(subject, sweep) -> list[dict | None]:
     return out
 
 
+def _target_rows(engine, p, targets) -> tuple[list, list]:
+    """Each target's residual at the positions ``p`` and its row (the chain rule through
+    the engine's sites' Jacobians): one rule for the MuJoCo and the Drake engines."""
+    errors, rows = [], []
+    for t in map(as_target, targets):
+        errors.append(t.error(p))
+        rows.append(
+            sum(g @ engine.sites[name].jacobian(engine) for name, g in t.gradient(p).items())
+        )
+    return errors, rows
+
+
 class MujocoCorner:
     """The exported MJCF (a corner's or an axle's) in MuJoCo, solved to targets by
     Newton on its own Jacobians.
@@ -365,13 +377,7 @@ class MujocoCorner:
         """Each target's residual and its row of d residual / dv (chain rule through
         the sites' Jacobians)."""
         p = {name: site.position(self) for name, site in self.sites.items()}
-        errors, rows = [], []
-        for t in map(as_target, targets):
-            errors.append(t.error(p))
-            rows.append(
-                sum(g @ self.sites[name].jacobian(self) for name, g in t.gradient(p).items())
-            )
-        return errors, rows
+        return _target_rows(self, p, targets)
 
     def solve(self, targets, iterations: int = 30) -> dict | None:
         """Newton from the design state to the targets."""
@@ -666,14 +672,7 @@ class DrakeCorner:
     def _rows(self, targets) -> tuple[list, list]:
         """Each target's residual and its row of d residual / dq (chain rule through
         the points' Jacobians), at the context's pose."""
-        p = _Positions(self)
-        errors, rows = [], []
-        for t in map(as_target, targets):
-            errors.append(t.error(p))
-            rows.append(
-                sum(g @ self.sites[name].jacobian(self) for name, g in t.gradient(p).items())
-            )
-        return errors, rows
+        return _target_rows(self, _Positions(self), targets)
 
     def _closure_residuals(self) -> np.ndarray:
         out = []

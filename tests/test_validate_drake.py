@@ -422,16 +422,18 @@ def test_unknown_engine(dw):
 # -- --engine all, and without Drake ----------------------------------------------------
 
 
+# every engine on the fixed-toe-link corner's bump sweep
+ALL_ENGINES = [
+    "validate",
+    str(EXAMPLES / "fixed_toe_link.yaml"),
+    str(EXAMPLES / "bump.yaml"),
+    "--engine",
+    "all",
+]
+
+
 def test_engine_all_runs_the_three_engines(tmp_path, capsys):
-    code = main(
-        [
-            "validate",
-            str(EXAMPLES / "fixed_toe_link.yaml"),
-            str(EXAMPLES / "bump.yaml"),
-            "--engine",
-            "all",
-        ]
-    )
+    code = main(ALL_ENGINES)
     out = capsys.readouterr().out
     assert code == 0
     header = out.splitlines()[1].split()
@@ -450,15 +452,7 @@ def test_without_drake_says_how_to_install_and_runs_the_rest(monkeypatch, capsys
     for name in [n for n in sys.modules if n == "pydrake" or n.startswith("pydrake.")]:
         monkeypatch.setitem(sys.modules, name, None)
     monkeypatch.setitem(sys.modules, "pydrake", None)
-    code = main(
-        [
-            "validate",
-            str(EXAMPLES / "fixed_toe_link.yaml"),
-            str(EXAMPLES / "bump.yaml"),
-            "--engine",
-            "all",
-        ]
-    )
+    code = main(ALL_ENGINES)
     out = capsys.readouterr().out
     assert code == 0
     assert (
