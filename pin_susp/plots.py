@@ -3,12 +3,22 @@
 ``report_figure`` draws one panel per metric against what the sweep moved:
 wheel travel for a bump sweep, rack travel from centre (the
 ``rack_displacement`` column) for a steer sweep, several results files as
-several lines; labels and units come from the metric registry and the CSV's
+several lines (a colour per file, the same on every panel, and one legend of
+the files); labels and units come from the metric registry and the CSV's
 own units. Results of older versions have no ``rack_displacement``: they are
 plotted against the absolute ``trackrod_inboard_y`` and the axis says so.
+What moved is read from the results (an input held, like a rack at centre,
+did not move). A sweep that moved two inputs (bump and steer together) has no
+one x: every panel is drawn against the step, the inputs first as panels of
+their own, and a note under the title says what moved over what range.
 Files whose sweeps moved different things (a bump sweep and a steer sweep)
 are refused with an :class:`InputError` naming both: their lines cannot share
 an x axis, and two reports say more than one squeezed figure.
+
+A panel's y axis spans at least its unit's MIN_SPAN (0.5 mm, 0.05°, ...):
+solver noise and variations too small to matter are drawn flat, not blown up to
+the panel's height; a column constant to 1 % of that span is labelled with its
+value. A cell beyond ±1e300 (no axis can span it) is refused as it is read.
 
 ``drawing_figure`` draws the corner in front and side view at its design
 state, with the instant-centre construction of the as-set corner: front view,
@@ -22,9 +32,9 @@ tyre is its silhouette: the two rim-edge circles, projected, cut at the road.
 ``labels=True`` names every hardpoint and adds a legend of the colours.
 
 An axle's results (per-side columns, ``roll``, ``heave``) give the axle report
-(``axle_panels``): a line per side (the right dashed) against roll, else
-heave, else rack travel — the first the sweep varied — and Ackermann against
-the mean steer angle when the rack moved. ``axle_drawing_figure`` draws the
+(``axle_panels``): a line per side (the right dashed) against roll, heave or
+rack travel — what the sweep varied, the step when it varied several — and
+Ackermann against the mean steer angle when the rack moved. ``axle_drawing_figure`` draws the
 axle in front view at design or at a pose (``axle_pose``: a step of its
 results), with each side's FVIC construction and the roll centre where the
 two contact-patch lines cross.

@@ -5,6 +5,7 @@ with what pin_susp computed: the instant centres by solving the two wishbone
 planes and the view plane with numpy, the rack travel from the sweep file.
 """
 
+import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 import yaml
@@ -16,6 +17,12 @@ from pin_susp.errors import InputError
 from pin_susp.plots import PARALLEL, ResultsFile, drawing_figure, report_figure
 
 ARMS = ("upper_wishbone", "lower_wishbone")
+
+
+@pytest.fixture(autouse=True)
+def _close_figures():
+    yield
+    plt.close("all")
 
 
 def sweep_file(tmp_path, name: str, wheel: float, rack: float, steps: int = 11) -> str:
