@@ -1647,15 +1647,19 @@ def _plot_command(sub) -> None:
     pl = sub.add_parser(
         "plot",
         help="standard kinematics report from results CSVs (one panel per metric)",
-        description="Camber, toe, caster, KPI, scrub, trail, half track (and instant centres, "
-        "anti geometry, motion ratio, camber gain and bump steer where present) against wheel "
-        "travel, or rack travel from centre for a steer sweep. Several CSVs compare designs "
-        "(of the same kind of sweep: a bump and a steer sweep cannot share one figure). An "
-        "axle's CSV gives the axle report: camber (to the chassis and to the ground), toe, "
-        "steer angle, roll centre height and lateral position, bar twist, per side, against "
-        "roll (else heave, else rack), and Ackermann against the mean steer angle. A forces "
-        "CSV (pin-susp loads) gives the force report: each member's force and each joint's "
-        "load, a line per load case, a toggle's steps left as gaps.",
+        description="Camber, toe, caster, KPI, scrub, trail, half track (and instant-centre "
+        "heights, anti geometry, rocker, motion ratio, spring force, wheel and ride rate, "
+        "camber gain and bump steer where present) against wheel travel, or rack travel from "
+        "centre for a steer sweep; a sweep that moved both (bump + steer) against the step, "
+        "its inputs drawn as the first panels. Several CSVs compare designs, a colour per "
+        "file (of the same kind of sweep: a bump and a steer sweep cannot share one figure). "
+        "An axle's CSV gives the axle report: camber (to the chassis and to the ground), toe, "
+        "steer angle, roll centre, bar twist, IC heights, rates, per side, against roll, "
+        "heave or rack (the step when several moved), and Ackermann against the mean steer "
+        "angle. A forces CSV (pin-susp loads) gives the force report: each member's force and "
+        "each joint's load, a line per load case, a toggle's steps left as gaps. A column "
+        "that varies less than its unit's smallest span (0.5 mm, 0.05 deg, ...) is drawn "
+        "flat, and labelled when constant.",
     )
     pl.add_argument(
         "results", nargs="+", metavar="RESULTS.csv", help="pin-susp sweep (or loads) output"

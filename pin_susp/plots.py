@@ -3,12 +3,22 @@
 ``report_figure`` draws one panel per metric against what the sweep moved:
 wheel travel for a bump sweep, rack travel from centre (the
 ``rack_displacement`` column) for a steer sweep, several results files as
-several lines; labels and units come from the metric registry and the CSV's
+several lines (a colour per file, the same on every panel, and one legend of
+the files); labels and units come from the metric registry and the CSV's
 own units. Results of older versions have no ``rack_displacement``: they are
 plotted against the absolute ``trackrod_inboard_y`` and the axis says so.
+What moved is read from the results (an input held, like a rack at centre,
+did not move). A sweep that moved two inputs (bump and steer together) has no
+one x: every panel is drawn against the step, the inputs first as panels of
+their own, and a note under the title says what moved over what range.
 Files whose sweeps moved different things (a bump sweep and a steer sweep)
 are refused with an :class:`InputError` naming both: their lines cannot share
 an x axis, and two reports say more than one squeezed figure.
+
+A panel's y axis spans at least its unit's MIN_SPAN (0.5 mm, 0.05°, ...):
+solver noise and variations too small to matter are drawn flat, not blown up to
+the panel's height; a column constant to 1 % of that span is labelled with its
+value. A cell beyond ±1e300 (no axis can span it) is refused as it is read.
 
 ``drawing_figure`` draws the corner in front and side view at its design
 state, with the instant-centre construction of the as-set corner: front view,
@@ -22,9 +32,9 @@ tyre is its silhouette: the two rim-edge circles, projected, cut at the road.
 ``labels=True`` names every hardpoint and adds a legend of the colours.
 
 An axle's results (per-side columns, ``roll``, ``heave``) give the axle report
-(``axle_panels``): a line per side (the right dashed) against roll, else
-heave, else rack travel — the first the sweep varied — and Ackermann against
-the mean steer angle when the rack moved. ``axle_drawing_figure`` draws the
+(``axle_panels``): a line per side (the right dashed) against roll, heave or
+rack travel — what the sweep varied, the step when it varied several — and
+Ackermann against the mean steer angle when the rack moved. ``axle_drawing_figure`` draws the
 axle in front view at design or at a pose (``axle_pose``: a step of its
 results), with each side's FVIC construction and the roll centre where the
 two contact-patch lines cross.
@@ -72,11 +82,21 @@ EXTRA = (
     "anti_lift",
     "anti_squat",
     "rocker_angle",
+    "rocker_transmission_angle",
     "damper_length",
     "motion_ratio",
+    # the spring's, where the geometry gives its rate (docs/results.md)
+    "spring_force",
+    "spring_torque",
+    "wheel_rate",
+    "ride_rate",
 )
 DERIVED = ("camber", "roadwheel_angle")  # their derivative columns get panels
 TEXT = ("load_case",)  # columns of names, not numbers
+# beyond this a value cannot be drawn: an axis spanning it overflows a float in
+# matplotlib's tick arithmetic (±8e307 already does); pin_susp's own columns stay far
+# below (an instant centre is blank, not huge, when the arms are parallel)
+DRAWABLE = 1e300
 
 
 class ResultsFile:
@@ -150,6 +170,15 @@ class ResultsFile:
                 self.columns[name] = np.array([_cell(row[j]) for _, row in body])
             except ValueError:
                 raise InputError(source, name, "has a cell that is not a number") from None
+            column = self.columns[name]
+            big = np.flatnonzero(np.isfinite(column) & (np.abs(column) > DRAWABLE))
+            if big.size:
+                raise InputError(
+                    source,
+                    f"{name}: line {body[big[0]][0]}",
+                    f"{column[big[0]]:.3g}: beyond ±{DRAWABLE:.0e} no plot axis can hold it "
+                    "(pin_susp writes nothing that large: a damaged or hand-edited file)",
+                )
         # forces (pin-susp loads): a row per step and load case, the sweep's columns after
         self.forces = "load_case" in self.columns
         # an axle's results: every corner column per side, and the axle's own
@@ -195,12 +224,21 @@ def _units(source: str, text: str) -> dict[str, str]:
     return units
 
 
+LABELS = {  # columns the registry does not hold
+    "motion_ratio": "Motion ratio",
+    "spring_force": "Spring force (compression +)",
+    "spring_torque": "Torsion bar torque (+ resisting bump)",
+    "wheel_rate": "Wheel rate",
+    "ride_rate": "Ride rate (wheel and tyre)",
+}
+
+
 def label(name: str) -> str:
     """Human label of a column, from the registry."""
     if name in METRIC_BY_NAME:
         return METRIC_BY_NAME[name].label
-    if name == "motion_ratio":
-        return "Motion ratio"
+    if name in LABELS:
+        return LABELS[name]
     if name.startswith("deriv_"):
         metric, driver = name.removeprefix("deriv_").split("_wrt_")
         return Derivative(METRIC_BY_NAME[metric], driver).label
@@ -219,43 +257,67 @@ AXLE_X = {
 }
 
 
-def sweeps(results: ResultsFile) -> str | None:
-    """What the sweep moved: 'wheel travel', 'rack travel', or None (nothing: one step);
-    an axle's: 'roll', else 'heave', else 'rack travel'."""
+# a sweep that moved two inputs or more (a combined bump + steer, a roll at a steer):
+# no one input is its x, so every panel is drawn against the step and the inputs
+# are panels of their own, at the top
+STEP_X = ("step_index", "Step ({} move together)")
+
+
+def moved(results: ResultsFile) -> list[str]:
+    """What the sweep moved, in order: a corner's 'wheel travel', 'rack travel'; an
+    axle's 'roll', 'heave', 'rack travel'. Read from the results: an input held (a
+    rack held at centre, a roll at a fixed heave) is not moved."""
     if results.axle:
-        moved = (k for k, (x, _) in AXLE_X.items() if x in results.columns and _varies(results[x]))
-        return next(moved, None)
-    if _varies(results["wheel_travel"]):
-        return "wheel travel"
-    for name in ("rack_displacement", "trackrod_inboard_y"):
-        if name in results.columns and _varies(results[name]):
-            return "rack travel"
-    return None
+        return [k for k, (x, _) in AXLE_X.items() if x in results.columns and _varies(results[x])]
+    out = ["wheel travel"] if _varies(results["wheel_travel"]) else []
+    if any(
+        n in results.columns and _varies(results[n])
+        for n in ("rack_displacement", RACK_ABSOLUTE_X[0])
+    ):
+        out.append("rack travel")
+    return out
+
+
+def sweeps(results: ResultsFile) -> str | None:
+    """What the sweep moved: 'wheel travel', 'rack travel', several joined by 'and'
+    (a combined sweep), or None (nothing: one step); an axle's: 'roll', 'heave',
+    'rack travel'."""
+    return " and ".join(moved(results)) or None
+
+
+def input_column(results: list[ResultsFile], kind: str) -> tuple[str, str]:
+    """The column (and its axis label) that records an input ('wheel travel', 'roll',
+    ...) in these files: the rack from centre, or the absolute rack of old files."""
+    if results[0].axle:
+        return AXLE_X[kind]
+    if kind == "wheel travel":
+        return WHEEL_X
+    if all("rack_displacement" in r.columns for r in results):
+        return RACK_X
+    return RACK_ABSOLUTE_X  # one old file: all absolute, so the lines stay comparable
 
 
 def x_axis(results: ResultsFile | list[ResultsFile]) -> tuple[str, str]:
-    """The x column and label: wheel travel, or rack travel for a steer sweep.
+    """The x column and label: what the sweep moved (wheel travel, rack travel from
+    centre; an axle's roll, heave, rack), or the step when it moved several inputs.
 
     Several files must have moved the same thing, else an InputError naming
     two that differ (a file where nothing moved goes with any).
     """
     files = [results] if isinstance(results, ResultsFile) else results
-    moved = [(r, kind) for r in files if (kind := sweeps(r)) is not None]
-    first, first_kind = moved[0] if moved else (None, None)
-    for r, kind in moved[1:]:
+    moving = [(r, kind) for r in files if (kind := sweeps(r)) is not None]
+    first, first_kind = moving[0] if moving else (None, None)
+    for r, kind in moving[1:]:
         if kind != first_kind:
             raise InputError(
                 r.source,
                 "",
                 f"x is {kind} but {first.source}'s is {first_kind}: plot them separately",
             )
-    if files[0].axle:
-        return AXLE_X[first_kind or "roll"]
-    if first_kind in (None, "wheel travel"):
-        return WHEEL_X
-    if all("rack_displacement" in r.columns for r in files):
-        return RACK_X
-    return RACK_ABSOLUTE_X  # one old file: all absolute, so the lines stay comparable
+    if first is not None and len(moved(first)) > 1:
+        return STEP_X[0], STEP_X[1].format(first_kind)
+    default = "roll" if files[0].axle else "wheel travel"
+    return input_column(files, first_kind or default)
 
 
 def _varies(column: np.ndarray) -> bool:
@@ -264,15 +326,19 @@ def _varies(column: np.ndarray) -> bool:
 
 
 def panels(results: list[ResultsFile], xname: str) -> list[str]:
-    driver = HUB_Z if xname == "wheel_travel" else RACK
+    """The corner report's metric columns with a value in some file, in order: the
+    standard metrics, EXTRA, and the derivatives of DERIVED along what the sweep moved
+    (bump and steer both for a combined sweep, drawn against the step)."""
+    drivers = {"wheel_travel": (HUB_Z,), STEP_X[0]: (HUB_Z, RACK)}.get(xname, (RACK,))
     names = list(STANDARD) + list(EXTRA)
-    names += [f"deriv_{m}_wrt_{driver}" for m in DERIVED]
-    return [n for n in names if any(n in r.columns and np.any(np.isfinite(r[n])) for r in results)]
+    names += [f"deriv_{m}_wrt_{d}" for d in drivers for m in DERIVED]
+    return [n for n in names if any(_has(r, n) for r in results)]
 
 
 def report_figure(results: list[ResultsFile]):
-    """One panel per metric against wheel travel (or rack), one line per results file;
-    an axle's results: the axle report (``axle_panels``)."""
+    """One panel per metric against what the sweep moved, one line (and one colour) per
+    results file, a legend of the files; a sweep that moved several inputs against the
+    step, its inputs drawn first. An axle's results: the axle report (``axle_panels``)."""
     if not results:
         raise PinSuspError("no results file to plot")
     if _all_of(results, "forces", "a sweep's results", "holds forces (pin-susp loads)"):
@@ -296,12 +362,97 @@ def report_figure(results: list[ResultsFile]):
     if not drawn:
         files = ", ".join(r.source for r in results)
         raise InputError(files, "", "no metric column has a value to plot")
+    drawn = input_panels(results, xname) + drawn
     fig = _grid(drawn)
-    if not axle and len(results) > 1:
-        fig.axes[0].legend(fontsize=8)
-    fig.suptitle(title + ", ".join(r.label for r in results), fontsize=12)
-    fig.tight_layout()
+    handles = []
+    if not axle and len(results) > 1:  # the axle's panels name file and side themselves
+        from matplotlib.lines import Line2D
+
+        handles = [
+            Line2D([], [], color=_colour(k), lw=1.6, label=r.label) for k, r in enumerate(results)
+        ]
+    _header(
+        fig, title + ", ".join(r.label for r in results), combined_note(results, xname), handles
+    )
     return fig
+
+
+def combined_note(results: list[ResultsFile], xname: str) -> str:
+    """What the figure says of a sweep that moved several inputs ('' for one input):
+    which moved, over what range, and that the panels are against the step."""
+    if xname != STEP_X[0]:
+        return ""
+    r = next(r for r in results if len(moved(r)) > 1)
+    parts = []
+    for kind in moved(r):
+        column = input_column(results, kind)[0]
+        unit = r.units.get(column, "")
+        finite = r[column][np.isfinite(r[column])]
+        parts.append(f"{kind} {finite[0]:.4g} → {finite[-1]:.4g} {unit}".rstrip())
+    return (
+        f"A combined sweep: {' and '.join(parts)} move together. Every panel is drawn "
+        "against the step (the inputs first): a curve shows what both inputs do at once, "
+        "not a gain along one."
+    )
+
+
+def _header(fig, title: str, note: str, handles: list, bottom: float = 0.0) -> None:
+    """The figure's title, a note under it (a combined sweep's) and a legend of
+    ``handles`` (the files, or the load cases) under that; the panels below, above
+    ``bottom`` inches (room for a note under them)."""
+    height = fig.get_figheight()  # inches: the title, the note and the legend get their room
+    fig.suptitle(title, fontsize=12, y=1.0 - 0.12 / height, va="top")
+    used = 0.4
+    if note:
+        fig.text(
+            0.5, 1.0 - used / height, note, ha="center", va="top", fontsize=9, gid="combined_note"
+        )
+        used += 0.22
+    if handles:
+        ncol = min(len(handles), 6)
+        fig.legend(
+            handles=handles,
+            loc="upper center",
+            bbox_to_anchor=(0.5, 1.0 - (used - 0.05) / height),
+            ncol=ncol,
+            fontsize=9,
+        )
+        used += 0.05 + 0.25 * -(-len(handles) // ncol)
+    fig.tight_layout(rect=(0, bottom / height, 1, 1.0 - (used + 0.05) / height))
+
+
+def input_panels(results: list[ResultsFile], xname: str) -> list[Panel]:
+    """A sweep that moved several inputs: a panel per input against the step (for a
+    forces file, the rows of its first load case: the steps once)."""
+    if xname != STEP_X[0]:
+        return []
+    r0 = next(r for r in results if len(moved(r)) > 1)
+    out = []
+    for kind in moved(r0):
+        column, axis = input_column(results, kind)
+        unit = r0.units.get(column, "")
+        panel = Panel(
+            f"Input: {axis.rpartition(' [')[0]}",
+            f"{column} [{unit}]" if unit else column,
+            STEP_X[1].format(sweeps(r0)),
+            unit=unit,
+        )
+        for k, r in enumerate(results):
+            if not _has(r, column):
+                continue
+            rows = slice(None)
+            if r.forces:
+                rows = r["load_case"] == r["load_case"][0]
+            who = r.label if len(results) > 1 and not r.forces else "_nolegend_"
+            x, y = r[xname][rows], r[column][rows]
+            panel.lines.append((x, y, who, "-", "0.25" if r.forces else _colour(k), _lone(y)))
+        out.append(panel)
+    return out
+
+
+def _colour(k: int) -> str:
+    """The colour of the k-th results file, the same on every panel."""
+    return f"C{k % 10}"
 
 
 def _all_of(results: list[ResultsFile], kind: str, other: str, which: str) -> bool:
@@ -319,7 +470,8 @@ def _all_of(results: list[ResultsFile], kind: str, other: str, which: str) -> bo
 @dataclass
 class Panel:
     """One panel of a report: its lines (x, y, legend label, line style, colour, marker);
-    ``marks``: x values to mark with a vertical line (a force report's toggles)."""
+    ``marks``: x values to mark with a vertical line (a force report's toggles);
+    ``unit``: its y unit, which sets the smallest span drawn (MIN_SPAN)."""
 
     title: str
     ylabel: str
@@ -327,15 +479,83 @@ class Panel:
     lines: list = field(default_factory=list)
     legend: bool = False
     marks: list = field(default_factory=list)
+    unit: str = ""
 
 
 def _corner_panel(results: list[ResultsFile], name: str, xname: str, xlabel: str) -> Panel:
     unit = next((r.units.get(name, "") for r in results if name in r.columns), "")
-    panel = Panel(label(name), f"{name} [{unit}]" if unit else name, xlabel)
-    for r in results:
-        if name in r.columns:
-            panel.lines.append((r[xname], r[name], r.label, "-", None, _marker(r, name)))
+    panel = Panel(label(name), f"{name} [{unit}]" if unit else name, xlabel, unit=unit)
+    for k, r in enumerate(results):
+        if name in r.columns:  # a file's colour by its place in the list, on every panel
+            panel.lines.append((r[xname], r[name], r.label, "-", _colour(k), _marker(r, name)))
     return panel
+
+
+# The smallest span of a panel's y axis, by unit: a column that varies by less is
+# drawn in this span about its mean, so solver noise (1e-12 mm, 1e-14 deg) and
+# variations too small to matter on a car are drawn flat instead of being blown up to
+# the full height. Each is a step an engineer could set or measure on the car:
+MIN_SPAN = {
+    "mm": 0.5,  # half a millimetre: a hardpoint's build tolerance, a shim's thinnest
+    "deg": 0.05,  # 3 arc minutes: about the finest toe or camber step a setup sheet gives
+    "%": 1.0,  # anti-dive, -lift, -squat: a percent
+    "mm/mm": 0.01,  # a motion ratio, a track change per bump
+    "deg/mm": 0.001,  # camber gain, bump steer: 0.05° over 50 mm of travel
+    "deg/deg": 0.01,  # camber per degree of roll
+    "mm/deg": 0.5,  # roll-centre migration per degree of roll
+    "mm/rad": 1.0,  # the steer screw's pitch
+    "N": 10.0,  # a spring's force, a member's load: a kilogram
+    "N/mm": 1.0,  # wheel, ride and spring rates
+    "N·m": 1.0,  # a torsion bar's or the anti-roll bar's torque
+    "N·m/deg": 1.0,  # roll stiffness
+}
+RELATIVE_SPAN = 1e-6  # a unit not listed: a millionth of the values' size (at least 1e-9)
+# a column whose values span less than this share of its panel's smallest span is
+# constant, to the drawing's resolution (under 2 pixels of a panel's ~200): drawn
+# flat and labelled with its value
+CONSTANT_SHARE = 0.01
+
+
+def min_span(unit: str, values: np.ndarray) -> float:
+    """The smallest y span a panel of this unit shows (MIN_SPAN)."""
+    if unit in MIN_SPAN:
+        return MIN_SPAN[unit]
+    return max(RELATIVE_SPAN * float(np.max(np.abs(values))), 1e-9)
+
+
+def _fit_y(ax, panel: Panel) -> None:
+    """Widen the y axis to the panel's smallest span when its lines vary less; a
+    constant column (to CONSTANT_SHARE of that) is labelled with its value."""
+    ys = [np.asarray(y, dtype=float) for _, y, *_ in panel.lines]
+    ys = np.concatenate([y[np.isfinite(y)] for y in ys]) if ys else np.array([])
+    if ys.size == 0:
+        return
+    lo, hi = float(ys.min()), float(ys.max())
+    span, least = hi - lo, min_span(panel.unit, ys)
+    if span >= least:
+        return
+    middle = 0.5 * (lo + hi)
+    half = 0.55 * least  # matplotlib's own 5 % margin each side
+    ax.set_ylim(middle - half, middle + half)
+    if span <= CONSTANT_SHARE * least:
+        digits = max(0, int(np.ceil(-np.log10(least / 10.0))))
+        value = np.round(middle, digits) + 0.0  # not -0.00
+        text = (
+            f"constant {value:.{digits}f} {panel.unit}"
+            if panel.unit in MIN_SPAN
+            else f"constant {middle:.6g} {panel.unit}"
+        )
+        ax.text(
+            0.5,
+            0.62,
+            text.rstrip(),
+            transform=ax.transAxes,
+            ha="center",
+            va="bottom",
+            fontsize=9,
+            color="0.25",
+            gid="constant_note",
+        )
 
 
 def _grid(drawn: list[Panel]):
@@ -347,6 +567,7 @@ def _grid(drawn: list[Panel]):
         for x, y, name, style, colour, marker in panel.lines:
             # a lone point (one row, or one step between failed ones) shows as a dot
             ax.plot(x, y, style, label=name, linewidth=1.6, color=colour, marker=marker)
+        _fit_y(ax, panel)
         ax.set_title(panel.title, fontsize=10)
         ax.set_ylabel(panel.ylabel, fontsize=8)
         ax.set_xlabel(panel.xlabel, fontsize=8)
@@ -374,6 +595,21 @@ AXLE_PANELS = (
     ("Track", ("track",)),
     ("Ride height change (+ body up)", ("ride_height_change",)),
     ("Heave link length", ("heave_link_length",)),
+    (
+        "Roll steer: toe change per roll",
+        ("deriv_roadwheel_angle_wrt_roll_left", "deriv_roadwheel_angle_wrt_roll_right"),
+    ),
+    ("Roll centre height change per roll", ("deriv_roll_center_z_wrt_roll",)),
+    ("Roll centre lateral migration per roll", ("deriv_roll_center_y_wrt_roll",)),
+    ("Front-view IC height", ("fvic_z_left", "fvic_z_right")),
+    ("Side-view IC height", ("svic_z_left", "svic_z_right")),
+    ("Motion ratio", ("motion_ratio_left", "motion_ratio_right")),
+    ("Spring force (compression +)", ("spring_force_left", "spring_force_right")),
+    ("Torsion bar torque", ("spring_torque_left", "spring_torque_right")),
+    ("Wheel rate", ("wheel_rate_left", "wheel_rate_right")),
+    ("Ride rate (wheel and tyre)", ("ride_rate_left", "ride_rate_right")),
+    ("Roll stiffness", ("roll_stiffness",)),
+    ("Anti-roll bar wheel rate", ("arb_wheel_rate",)),
 )
 # Ackermann is read against the steer, whatever else the sweep moved
 ACKERMANN = ("ackermann", "Ackermann", "Mean steer angle ½(left + right) (ISO yaw, + left) [deg]")
@@ -407,7 +643,7 @@ def _axle_panel(results, title: str, names: tuple, xlabel: str, x) -> Panel:
     first = next(r for r in results if any(n in r.columns for n in names))
     unit = next(first.units.get(n, "") for n in names if n in first.columns)
     shown = names[0].removesuffix("_left") + ("_<side>" if len(names) > 1 else "")
-    panel = Panel(title, f"{shown} [{unit}]" if unit else shown, xlabel)
+    panel = Panel(title, f"{shown} [{unit}]" if unit else shown, xlabel, unit=unit)
     for k, r in enumerate(results):
         for name in names:
             if name not in r.columns:
@@ -416,7 +652,7 @@ def _axle_panel(results, title: str, names: tuple, xlabel: str, x) -> Panel:
             who = " ".join(w for w in (r.label if len(results) > 1 else "", side) if w)
             style = "--" if side == "right" else "-"
             panel.lines.append(
-                (x(r), r[name], who or "_nolegend_", style, f"C{k}", _marker(r, name))
+                (x(r), r[name], who or "_nolegend_", style, _colour(k), _marker(r, name))
             )
     panel.legend = len(panel.lines) > 1
     return panel
@@ -442,30 +678,20 @@ def force_figure(results: list[ResultsFile]):
     """The force report of forces CSVs (``pin-susp loads``): ``force_panels`` on the
     report's grid, a legend of the load cases, and a note of the steps at a toggle."""
     xname, xlabel = x_axis(results)
-    drawn = force_panels(results, xname, xlabel)
+    drawn = input_panels(results, xname) + force_panels(results, xname, xlabel)
     fig = _grid(drawn)
     handles = {}
     for ax in fig.axes:
         for line in ax.get_lines():
             if not line.get_label().startswith("_"):
                 handles.setdefault(line.get_label(), line)
-    height = fig.get_figheight()  # inches: the legend and the note get their room
-    ncol = min(len(handles), 6) or 1
-    fig.legend(
-        handles.values(),
-        handles.keys(),
-        loc="upper center",
-        bbox_to_anchor=(0.5, 1.0 - 0.42 / height),
-        ncol=ncol,
-        fontsize=9,
-    )
     notes = [n for n in (toggle_note(r, xname) for r in results) if n]
     if notes:
         fig.text(0.01, 0.01, "\n".join(notes), fontsize=8, va="bottom", gid="toggle_note")
     sign = "members: tension +, spring: compression +, joints: magnitude of the load"
-    fig.suptitle(f"pin_susp forces ({sign}): " + ", ".join(r.label for r in results), fontsize=12)
-    top = 1.0 - (0.5 + 0.25 * -(-len(handles) // ncol)) / height
-    fig.tight_layout(rect=(0, (0.16 * len(notes) + 0.1) / height if notes else 0, 1, top))
+    title = f"pin_susp forces ({sign}): " + ", ".join(r.label for r in results)
+    bottom = (0.16 * len(notes) + 0.1) if notes else 0.0
+    _header(fig, title, combined_note(results, xname), list(handles.values()), bottom=bottom)
     return fig
 
 
@@ -486,7 +712,7 @@ def force_panels(results: list[ResultsFile], xname: str, xlabel: str) -> list[Pa
             ylabel = f"|load_{name}| [{unit}]"
         else:
             title, ylabel = _member_title(name), f"{name} [{unit}]" if unit else name
-        panel = Panel(title, ylabel, xlabel, marks=marks)
+        panel = Panel(title, ylabel, xlabel, marks=marks, unit=unit)
         for k, r in enumerate(results):
             y_all = joint_load(r, name) if name in joints else r.columns.get(name)
             if y_all is None:

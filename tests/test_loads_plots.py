@@ -121,9 +121,16 @@ def test_each_panel_draws_its_csv_column_per_load_case(forces):
     columns = read_csv(path)
     fig = report_figure([ResultsFile(path)])
     drawn, expected = panel_lines(fig), expected_panels(columns)
-    assert set(drawn) == set(expected)
-    assert len(drawn) == 16  # 6 members, spring, rack; 2 ball joints, 6 bushings
-    travel = numbers(columns["wheel_travel"])
+    # bump_steer moves the wheel and the rack: against the step, the two inputs first
+    inputs = {"wheel_travel [mm]": "wheel_travel", "rack_displacement [mm]": "rack_displacement"}
+    assert set(drawn) == set(expected) | set(inputs)
+    assert len(drawn) == 16 + 2  # 6 members, spring, rack; 2 ball joints, 6 bushings; inputs
+    travel = numbers(columns["step_index"])
+    first = case_rows(columns, CASE_NAMES[0])
+    for ylabel, column in inputs.items():
+        (xy,) = drawn[ylabel].values()  # the steps once, not once per case
+        expected_xy = np.column_stack([travel, numbers(columns[column])])[first]
+        np.testing.assert_array_equal(xy, expected_xy)
     for ylabel, values in expected.items():
         assert set(drawn[ylabel]) == set(CASE_NAMES), ylabel
         for case in CASE_NAMES:

@@ -5,6 +5,7 @@ with what pin_susp computed: the instant centres by solving the two wishbone
 planes and the view plane with numpy, the rack travel from the sweep file.
 """
 
+import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 import yaml
@@ -16,6 +17,12 @@ from pin_susp.errors import InputError
 from pin_susp.plots import PARALLEL, ResultsFile, drawing_figure, report_figure
 
 ARMS = ("upper_wishbone", "lower_wishbone")
+
+
+@pytest.fixture(autouse=True)
+def _close_figures():
+    yield
+    plt.close("all")
 
 
 def sweep_file(tmp_path, name: str, wheel: float, rack: float, steps: int = 11) -> str:
@@ -274,3 +281,233 @@ def test_a_cambered_tyre_stays_on_the_road(tmp_path, side):
         assert z.min() >= ground - 1e-6  # nothing under the road
         assert z.min() == pytest.approx(ground, abs=1e-6)  # and it stands on it
         assert np.ptp(x) > across - 1.0  # the whole tyre, not a sliver
+
+
+# --- what the report reads as (issue 24: colours, combined sweeps, noise, columns) ---------------
+
+
+def swept(tmp_path, geometry: str, targets: str, name: str, steps: int = 5) -> str:
+    """`pin-susp sweep` of an example with these target lines (YAML); the CSV's path."""
+    sweep = tmp_path / name.replace(".csv", ".yaml")
+    sweep.write_text(f"steps: {steps}\ntargets:\n{targets}")
+    out = tmp_path / name
+    assert main(["sweep", str(EXAMPLES / geometry), str(sweep), "-o", str(out), "-q"]) == 0
+    return str(out)
+
+
+def bump(wheel=(-30, 30), rack=(0, 0)) -> str:
+    lines = (
+        f"  - {{point: wheel_center, direction: {{axis: z}}, "
+        f"start: {wheel[0]}, stop: {wheel[1]}}}\n"
+    )
+    if rack is not None:
+        lines += (
+            f"  - {{point: trackrod_inboard, direction: {{axis: y}}, "
+            f"start: {rack[0]}, stop: {rack[1]}}}\n"
+        )
+    return lines
+
+
+def read_columns(path) -> dict[str, np.ndarray]:
+    """A results CSV read with the csv module: columns of floats (empty → NaN)."""
+    import csv
+
+    with open(path) as f:
+        rows = list(csv.DictReader(line for line in f if not line.startswith("#")))
+    cell = lambda c: {"": np.nan, "True": 1.0, "False": 0.0}.get(c, None)  # noqa: E731
+    return {
+        k: np.array([float(r[k]) if cell(r[k]) is None else cell(r[k]) for r in rows])
+        for k in rows[0]
+    }
+
+
+def visible(fig) -> list:
+    return [ax for ax in fig.axes if ax.get_visible()]
+
+
+def test_each_file_keeps_one_colour_on_every_panel_and_one_legend_entry(tmp_path):
+    files = [
+        swept(tmp_path, "double_wishbone.yaml", bump(), "a.csv"),
+        swept(tmp_path, "multilink_rear.yaml", bump(rack=None), "multilink_rear.csv"),
+        swept(tmp_path, "pushrod_rocker.yaml", bump(), "rocker.csv"),
+    ]
+    fig = report_figure([ResultsFile(f) for f in files])
+    colours: dict[str, set] = {}
+    for ax in visible(fig):
+        for line in ax.get_lines():
+            colours.setdefault(line.get_label(), set()).add(line.get_color())
+    assert set(colours) == {"a", "multilink_rear", "rocker"}
+    assert all(len(c) == 1 for c in colours.values()), colours  # one colour each, everywhere
+    assert len({c for cs in colours.values() for c in cs}) == 3  # and three of them
+    rocker = next(ax for ax in visible(fig) if ax.get_title() == "Rocker angle")
+    (line,) = rocker.get_lines()  # only rocker.csv has a rocker: in rocker's colour, not a's
+    assert line.get_label() == "rocker" and {line.get_color()} == colours["rocker"]
+    (legend,) = fig.legends  # one legend of the files, each once, in its colour
+    assert [t.get_text() for t in legend.get_texts()] == ["a", "multilink_rear", "rocker"]
+    for text, handle in zip(legend.get_texts(), legend.legend_handles, strict=True):
+        assert {handle.get_color()} == colours[text.get_text()]
+
+
+def test_a_combined_sweep_is_drawn_against_the_step_with_its_inputs(tmp_path, capsys):
+    path = swept(tmp_path, "double_wishbone.yaml", bump((-40, 60), (-10, 10)), "both.csv")
+    fig = report_figure([ResultsFile(path)])
+    axes = visible(fig)
+    steps = np.arange(5.0)
+    # the inputs first, as the sweep file moved them (linear in the step)
+    wheel, rack = axes[:2]
+    assert wheel.get_title() == "Input: Wheel travel (+ bump)"
+    assert rack.get_title() == "Input: Rack position from centre (+ left)"
+    for ax, (start, stop) in ((wheel, (-40, 60)), (rack, (-10, 10))):
+        (line,) = ax.get_lines()
+        np.testing.assert_allclose(line.get_xdata(), steps)
+        np.testing.assert_allclose(line.get_ydata(), np.linspace(start, stop, 5), atol=1e-9)
+    for ax in axes:  # every panel against the step, none against wheel travel
+        assert ax.get_xlabel() == "Step (wheel travel and rack travel move together)"
+        for line in ax.get_lines():
+            np.testing.assert_array_equal(line.get_xdata(), steps)
+    titles = [ax.get_title() for ax in axes]
+    assert "Camber" in titles
+    assert {"d Camber / d hub z", "d Camber / d rack"} <= set(titles)  # gains along each
+    (note,) = [t.get_text() for t in fig.texts if t.get_gid() == "combined_note"]
+    assert note.startswith(
+        "A combined sweep: wheel travel -40 → 60 mm and rack travel -10 → 10 mm move together"
+    )
+    # a pure bump (the rack held) stays against wheel travel, with no input panel
+    held = report_figure([ResultsFile(swept(tmp_path, "double_wishbone.yaml", bump(), "b.csv"))])
+    assert visible(held)[0].get_title() == "Camber"
+    assert {ax.get_xlabel() for ax in visible(held)} == {"Wheel travel (+ bump) [mm]"}
+    assert not [t for t in held.texts if t.get_gid() == "combined_note"]
+    # a combined and a pure bump sweep do not share an x axis
+    assert main(["plot", path, str(tmp_path / "b.csv"), "-o", str(tmp_path / "x.png")]) == 2
+    err = capsys.readouterr().err
+    assert err == (
+        f"pin-susp: error: {tmp_path / 'b.csv'}: x is wheel travel but {path}'s is "
+        "wheel travel and rack travel: plot them separately\n"
+    )
+
+
+def test_an_axle_rolled_while_it_steers_is_drawn_against_the_step(tmp_path):
+    targets = (
+        "  - {quantity: roll, start: -2, stop: 2}\n"
+        "  - {quantity: heave, start: 0, stop: 0}\n"
+        "  - {point: trackrod_inboard, side: left, direction: {axis: y}, start: -20, stop: 20}\n"
+    )
+    fig = report_figure([ResultsFile(swept(tmp_path, "axle_front.yaml", targets, "rs.csv"))])
+    axes = visible(fig)
+    assert [ax.get_title() for ax in axes[:2]] == [
+        "Input: Roll (+ left wheel up relative to the chassis)",
+        "Input: Rack position from centre (+ left)",
+    ]
+    np.testing.assert_allclose(axes[0].get_lines()[0].get_ydata(), np.linspace(-2, 2, 5))
+    for ax in axes:
+        if ax.get_title() != "Ackermann":  # read against the mean steer angle, as ever
+            assert ax.get_xlabel() == "Step (roll and rack travel move together)"
+
+
+def test_noise_is_drawn_flat_and_a_constant_column_is_labelled(tmp_path):
+    """A heave of a mirrored axle: the roll centre stays on the centreline and the bar
+    does not twist, to rounding; drawn flat about the value, not blown up."""
+    targets = (
+        "  - {quantity: roll, start: 0, stop: 0}\n"
+        "  - {quantity: heave, start: -20, stop: 20}\n"
+        "  - {point: trackrod_inboard, side: left, direction: {axis: y}, start: 0, stop: 0}\n"
+    )
+    path = swept(tmp_path, "axle_front.yaml", targets, "heave.csv")
+    columns = read_columns(path)
+    by_title = {ax.get_title(): ax for ax in visible(report_figure([ResultsFile(path)]))}
+    for title, name, unit, least in (
+        ("Roll centre lateral position (+ left)", "roll_center_y", "mm", 0.5),
+        ("Anti-roll bar twist (left − right arm)", "arb_twist", "deg", 0.05),
+    ):
+        values = columns[name][np.isfinite(columns[name])]
+        assert 0 < np.ptp(values) < 1e-9 and abs(values).max() < 1e-9  # noise about zero
+        ax = by_title[title]
+        lo, hi = ax.get_ylim()
+        assert hi - lo >= least and lo < values.min() and values.max() < hi
+        assert abs(0.5 * (lo + hi)) < 1e-9  # centred on the value
+        notes = [t.get_text() for t in ax.texts if t.get_gid() == "constant_note"]
+        decimals = {"mm": 2, "deg": 3}[unit]
+        assert notes == [f"constant {0:.{decimals}f} {unit}"]
+    # a column that varies, a little (0.05 mm) or a lot: drawn as it is, not labelled
+    results = ResultsFile(swept(tmp_path, "double_wishbone.yaml", bump(), "bump.csv"))
+    wiggle = -39.5 + 0.025 * np.sin(np.arange(5.0) * 2.0)
+    results.columns["scrub_radius"] = wiggle
+    by_title = {ax.get_title(): ax for ax in visible(report_figure([results]))}
+    scrub = by_title["Scrub radius"]
+    lo, hi = scrub.get_ylim()
+    assert hi - lo == pytest.approx(0.55) and 0.5 * (lo + hi) == pytest.approx(
+        np.mean([wiggle.min(), wiggle.max()])
+    )
+    np.testing.assert_array_equal(scrub.get_lines()[0].get_ydata(), wiggle)
+    assert not [t for t in scrub.texts if t.get_gid() == "constant_note"]
+    camber = by_title["Camber"]
+    span = np.ptp(results["camber"])
+    assert span > 0.05 and np.ptp(camber.get_ylim()) < 1.2 * span  # autoscaled to the data
+
+
+def test_the_report_draws_the_rates_and_ic_heights_the_results_hold(tmp_path):
+    path = swept(tmp_path, "pushrod_rocker.yaml", bump(), "rocker.csv")
+    columns = read_columns(path)
+    by_ylabel = {ax.get_ylabel(): ax for ax in visible(report_figure([ResultsFile(path)]))}
+    for name, unit in (
+        ("spring_force", "N"),
+        ("wheel_rate", "N/mm"),
+        ("ride_rate", "N/mm"),
+        ("fvic_z", "mm"),
+        ("svic_z", "mm"),
+        ("motion_ratio", "mm/mm"),
+    ):
+        assert np.any(np.isfinite(columns[name])), name  # the results hold it
+        (line,) = by_ylabel[f"{name} [{unit}]"].get_lines()
+        np.testing.assert_array_equal(line.get_ydata(), columns[name])
+    # an axle with its rates: per side, and the axle's own
+    g = example("axle_front.yaml")
+    g["axle_config"]["spring"] = {"type": "coilover", "rate": 100, "preload": 2000}
+    g["axle_config"]["anti_roll"]["stiffness"] = 300
+    geometry = geometry_file(tmp_path, g, "axle.yaml")
+    sweep = tmp_path / "roll.yaml"
+    sweep.write_text(
+        "steps: 5\ntargets:\n  - {quantity: roll, start: -2, stop: 2}\n"
+        "  - {quantity: heave, start: 0, stop: 0}\n"
+        "  - {point: trackrod_inboard, side: left, direction: {axis: y}, start: 0, stop: 0}\n"
+    )
+    out = tmp_path / "axle.csv"
+    assert main(["sweep", geometry, str(sweep), "-o", str(out), "-q"]) == 0
+    columns = read_columns(out)
+    panels = {ax.get_title(): ax for ax in visible(report_figure([ResultsFile(out)]))}
+    for title, names in (
+        ("Roll centre height", ["roll_center_z"]),
+        ("Front-view IC height", ["fvic_z_left", "fvic_z_right"]),
+        ("Side-view IC height", ["svic_z_left", "svic_z_right"]),
+        ("Spring force (compression +)", ["spring_force_left", "spring_force_right"]),
+        ("Wheel rate", ["wheel_rate_left", "wheel_rate_right"]),
+        ("Roll stiffness", ["roll_stiffness"]),
+        ("Anti-roll bar wheel rate", ["arb_wheel_rate"]),
+    ):
+        lines = panels[title].get_lines()
+        assert len(lines) == len(names), title
+        for line, name in zip(lines, names, strict=True):
+            assert np.any(np.isfinite(columns[name])), name
+            np.testing.assert_array_equal(line.get_ydata(), columns[name])
+
+
+@pytest.mark.parametrize("where", ["camber", "wheel_travel"])
+def test_a_cell_no_axis_can_hold_is_one_line(tmp_path, capsys, where):
+    path = swept(tmp_path, "double_wishbone.yaml", bump(), "r.csv")
+    lines = open(path).read().splitlines()
+    header = next(ln for ln in lines if not ln.startswith("#")).split(",")
+    k, first = header.index(where), lines.index(",".join(header)) + 1
+    for i in range(first, len(lines)):  # ±1e308, alternating: a span past the float range
+        cells = lines[i].split(",")
+        cells[k] = "1e308" if i % 2 else "-1e308"
+        lines[i] = ",".join(cells)
+    open(path, "w").write("\n".join(lines) + "\n")
+    png = tmp_path / "o.png"
+    assert main(["plot", path, "-o", str(png)]) == 2
+    out, err = capsys.readouterr()
+    sign = "1e+308" if first % 2 else "-1e+308"
+    assert err == (
+        f"pin-susp: error: {path}: {where}: line {first + 1}: {sign}: beyond ±1e+300 no plot "
+        "axis can hold it (pin_susp writes nothing that large: a damaged or hand-edited file)\n"
+    )
+    assert out == "" and not png.exists()

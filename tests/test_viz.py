@@ -112,8 +112,9 @@ def test_view_command_serves_and_stops_on_ctrl_c():
 
 
 def test_report_has_one_labelled_panel_per_metric_and_a_line_per_file(tmp_path):
-    a = ResultsFile(sweep_csv(tmp_path, "double_wishbone.yaml", "bump_steer.yaml", "a.csv"))
-    b = ResultsFile(sweep_csv(tmp_path, "pushrod_rocker.yaml", "bump_steer.yaml", "b.csv"))
+    # pure bump (the rack held): a combined sweep is drawn against the step (test_plots.py)
+    a = ResultsFile(sweep_csv(tmp_path, "double_wishbone.yaml", "bump_rack_held.yaml", "a.csv"))
+    b = ResultsFile(sweep_csv(tmp_path, "pushrod_rocker.yaml", "bump_rack_held.yaml", "b.csv"))
     fig = report_figure([a, b])
     axes = [ax for ax in fig.axes if ax.get_visible()]
     titles = [ax.get_title() for ax in axes]
