@@ -918,7 +918,10 @@ class Digest:
         self.worst_short = 0.0  # their largest residual, mm
         self.flipped = Steps()  # on another assembly branch
         self.loops: set[str] = set()  # the loops that flipped
-        self.band: dict[str, list] = {}  # side → [Steps outside, worst step, its angle]
+        # side → [Steps outside, worst step, its angle, |motion ratio| there, the best
+        # step's angle, |motion ratio| there]: which way the ratio goes near over-centre
+        self.band: dict[str, list] = {}
+        self.dead: list = []  # the links near dead centre at design (deadcentre.Transmission)
         self.unseat: dict[str, list] = {}  # side → [Steps below zero, least force]
 
     @classmethod
@@ -946,6 +949,8 @@ class Digest:
         for i, count in enumerate(counts):
             self.iterations[i] += count
         why = results.meta["why"]
+        if not self.dead:
+            self.dead = list(results.meta.get("dead_centres", ()))
         for i in np.flatnonzero(~ok):
             if "branch" in why[i]:
                 self.flipped.add([int(steps[i])])
@@ -962,13 +967,20 @@ class Digest:
         for suffix, side in SIDES:
             angle = results.columns.get(f"rocker_transmission_angle{suffix}")
             if angle is not None:
+                ratio = results.columns.get(f"motion_ratio{suffix}")
+                ratio = np.full(len(angle), np.nan) if ratio is None else np.abs(ratio)
+                off = np.abs(angle - 90.0)
+                solved = np.flatnonzero(~np.isnan(off))
                 outside = np.flatnonzero((angle < low) | (angle > high))
                 if len(outside):
-                    worst = outside[np.argmax(np.abs(angle[outside] - 90.0))]
-                    band = self.band.setdefault(side, [Steps(), None, 90.0])
+                    worst = outside[np.argmax(off[outside])]
+                    best = solved[np.argmin(off[solved])]
+                    band = self.band.setdefault(side, [Steps(), None, 90.0, np.nan, None, np.nan])
                     band[0].add(steps[outside])
-                    if abs(angle[worst] - 90.0) > abs(band[2] - 90.0):
-                        band[1], band[2] = int(steps[worst]), float(angle[worst])
+                    if off[worst] > abs(band[2] - 90.0):
+                        band[1:4] = int(steps[worst]), float(angle[worst]), float(ratio[worst])
+                    if band[4] is None or off[best] < abs(band[4] - 90.0):
+                        band[4:6] = float(angle[best]), float(ratio[best])
             force = results.columns.get(f"spring_force{suffix}")
             if force is not None and np.nanmin(force, initial=np.inf) < 0.0:
                 unseat = self.unseat.setdefault(side, [Steps(), np.inf])
@@ -1042,11 +1054,11 @@ def _warn_transmission(results) -> None:
     low, high = TRANSMISSION_BAND
     for _, side in SIDES:
         if side in d.band:
-            steps, worst, angle = d.band[side]
+            steps, worst, angle, ratio, best, best_ratio = d.band[side]
             warnings.warn(
                 f"{side}rocker transmission angle outside {low:g}…{high:g} deg at steps "
-                f"{steps} (worst {angle:.1f} deg at step {worst}): "
-                "the rocker nears over-centre, its motion ratio falls toward zero and flips",
+                f"{steps} (worst {angle:.1f} deg at step {worst}): the rocker nears "
+                f"over-centre, {_ratio_trend(ratio, best, best_ratio)}",
                 PlausibilityWarning,
                 stacklevel=2,
             )
@@ -1059,6 +1071,30 @@ def _warn_transmission(results) -> None:
                 PlausibilityWarning,
                 stacklevel=2,
             )
+
+
+def _ratio_trend(ratio: float, best: float | None, best_ratio: float) -> str:
+    """Which way the motion ratio goes as the pushrod nears the rocker's dead centre, by
+    the numbers: |ratio| at the worst step against it where the angle is nearest 90°.
+    Without a motion ratio (no spring), as the geometry says: the rocker turns ever
+    faster per mm of pushrod travel, so the ratio to it rises toward infinity."""
+    if ratio != ratio or best_ratio != best_ratio:  # NaN: no motion ratio column
+        return "the rocker turns ever faster per mm of wheel travel and can flip over"
+    way = "rises toward infinity" if ratio > best_ratio else "falls toward zero"
+    return (
+        f"its motion ratio {way} (|{ratio:.3g}| there, |{best_ratio:.3g}| at "
+        f"{best:.0f} deg) and can flip"
+    )
+
+
+def _dead_centre_cause(d: Digest) -> str:
+    """The failure report's cause for steps out of reach or on another branch: a link
+    that drives its body near dead centre at design (its warning is printed too)."""
+    driven = [t for t in d.dead if t.driven]
+    if not driven:
+        return ""
+    said = ", ".join(f"{t.flow} {t.margin:.1f}° from dead centre" for t in driven)
+    return f" — the mechanism is at a dead centre at design ({said}: see the dead-centre warning)"
 
 
 def _report_failures(
@@ -1081,7 +1117,7 @@ def _report_failures(
         )
     print(
         f"pin-susp: warning: {d.failed} of {d.steps} steps did not converge: "
-        f"{'; '.join(reasons)}. Their rows {consequence}.",
+        f"{'; '.join(reasons)}{_dead_centre_cause(d)}. Their rows {consequence}.",
         file=sys.stderr,
     )
     return EXIT_NOT_CONVERGED
