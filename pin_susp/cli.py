@@ -736,7 +736,9 @@ def _validate(args) -> int:
             print(f"  {r.engine}: skipped — {r.note}")
             continue
         if r.failed_steps:
-            print(f"  {r.engine}: did not converge at steps {r.failed_steps}")
+            print(f"  {r.engine}: did not converge at steps {_list(r.failed_steps)}")
+        if r.branch_steps or r.other_branch:
+            print(f"  {r.engine}: {_other_branch(r, corner)}")
         if r.not_compared:
             print(
                 f"  {r.engine}: {', '.join(sorted(r.not_compared))} not compared (they need the "
@@ -749,13 +751,48 @@ def _validate(args) -> int:
                 "; the roll centre of its size times max(1, |RC|/track)" if axle else ""
             )
             print(f"  {r.engine}: agrees within {args.tolerance:g} mm/deg ({centres})")
-        else:
+        elif r.disagree:
             ok = False
+            print(f"  {r.engine}: DISAGREES on {', '.join(sorted(r.disagree))} (marked !)")
+        elif r.failed_steps or r.branch_steps:
+            ok = False
+            unsolved = [
+                f"{len(steps)} step(s) {what}"
+                for steps, what in (
+                    (r.failed_steps, "it did not solve"),
+                    (r.branch_steps, "on another assembly branch"),
+                )
+                if steps
+            ]
             print(
-                f"  {r.engine}: DISAGREES on {', '.join(sorted(r.disagree)) or 'solving'} "
-                "(marked !)"
+                f"  {r.engine}: agrees where it solved on pin_susp's branch, but leaves "
+                f"{' and '.join(unsolved)} unconfirmed (nothing marked)"
             )
     return 0 if ok else 1
+
+
+def _other_branch(r, subject) -> str:
+    """An engine's steps on another assembly branch than pin_susp's, said as such: where
+    pin_susp solved them (a difference of assembly, not of kinematics) and where it
+    found no pose either; a dead centre at design is the likely cause."""
+    said = []
+    if r.branch_steps:
+        said.append(
+            f"lands on another assembly branch at steps {_list(r.branch_steps)} "
+            f"({', '.join(sorted(r.flipped))}), where pin_susp keeps the design's: "
+            "those steps are not compared"
+        )
+    if r.other_branch:
+        said.append(
+            f"{'and ' if said else 'lands on another assembly branch '}at steps "
+            f"{_list(r.other_branch)}, which pin_susp reaches on no branch of the design's"
+            + ("" if r.branch_steps else f" ({', '.join(sorted(r.flipped))})")
+        )
+    dead = [t for t in getattr(subject, "dead_centres", ()) if t.driven]
+    if dead:
+        near = ", ".join(f"{t.flow} {t.margin:.1f}° from dead centre" for t in dead)
+        said.append(f"near the dead centre at design ({near}: see the dead-centre warning)")
+    return "; ".join(said)
 
 
 def _demo_command(sub) -> None:
