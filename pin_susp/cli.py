@@ -955,9 +955,11 @@ class Digest:
         self.worst_short = 0.0  # their largest residual, mm
         self.flipped = Steps()  # on another assembly branch
         self.loops: set[str] = set()  # the loops that flipped
-        # side → [Steps outside, worst step, its angle, |motion ratio| there, the best
-        # step's angle, |motion ratio| there]: which way the ratio goes near over-centre
+        # side → [Steps outside, worst step, its angle, |motion ratio| there (None: no
+        # ratio)]; side → [the angle nearest 90°, |motion ratio| there]: which way the
+        # ratio goes as the rocker nears over-centre
         self.band: dict[str, list] = {}
+        self.nearest: dict[str, list] = {}
         self.dead: list = []  # the links near dead centre at design (deadcentre.Transmission)
         self.unseat: dict[str, list] = {}  # side → [Steps below zero, least force]
 
@@ -1005,19 +1007,24 @@ class Digest:
             angle = results.columns.get(f"rocker_transmission_angle{suffix}")
             if angle is not None:
                 ratio = results.columns.get(f"motion_ratio{suffix}")
-                ratio = np.full(len(angle), np.nan) if ratio is None else np.abs(ratio)
+
+                def at(i, ratio=ratio):
+                    return None if ratio is None or np.isnan(ratio[i]) else abs(float(ratio[i]))
+
                 off = np.abs(angle - 90.0)
                 solved = np.flatnonzero(~np.isnan(off))
+                if len(solved):
+                    best = solved[np.argmin(off[solved])]
+                    near = self.nearest.get(side)
+                    if near is None or off[best] < abs(near[0] - 90.0):
+                        self.nearest[side] = [float(angle[best]), at(best)]
                 outside = np.flatnonzero((angle < low) | (angle > high))
                 if len(outside):
                     worst = outside[np.argmax(off[outside])]
-                    best = solved[np.argmin(off[solved])]
-                    band = self.band.setdefault(side, [Steps(), None, 90.0, np.nan, None, np.nan])
+                    band = self.band.setdefault(side, [Steps(), None, 90.0, None])
                     band[0].add(steps[outside])
                     if off[worst] > abs(band[2] - 90.0):
-                        band[1:4] = int(steps[worst]), float(angle[worst]), float(ratio[worst])
-                    if band[4] is None or off[best] < abs(band[4] - 90.0):
-                        band[4:6] = float(angle[best]), float(ratio[best])
+                        band[1:4] = int(steps[worst]), float(angle[worst]), at(worst)
             force = results.columns.get(f"spring_force{suffix}")
             if force is not None and np.nanmin(force, initial=np.inf) < 0.0:
                 unseat = self.unseat.setdefault(side, [Steps(), np.inf])
@@ -1091,7 +1098,8 @@ def _warn_transmission(results) -> None:
     low, high = TRANSMISSION_BAND
     for _, side in SIDES:
         if side in d.band:
-            steps, worst, angle, ratio, best, best_ratio = d.band[side]
+            steps, worst, angle, ratio = d.band[side]
+            best, best_ratio = d.nearest[side]
             warnings.warn(
                 f"{side}rocker transmission angle outside {low:g}…{high:g} deg at steps "
                 f"{steps} (worst {angle:.1f} deg at step {worst}): the rocker nears "
@@ -1110,12 +1118,13 @@ def _warn_transmission(results) -> None:
             )
 
 
-def _ratio_trend(ratio: float, best: float | None, best_ratio: float) -> str:
+def _ratio_trend(ratio: float | None, best: float, best_ratio: float | None) -> str:
     """Which way the motion ratio goes as the pushrod nears the rocker's dead centre, by
-    the numbers: |ratio| at the worst step against it where the angle is nearest 90°.
-    Without a motion ratio (no spring), as the geometry says: the rocker turns ever
-    faster per mm of pushrod travel, so the ratio to it rises toward infinity."""
-    if ratio != ratio or best_ratio != best_ratio:  # NaN: no motion ratio column
+    the numbers: |ratio| at the worst step against it where the angle is nearest 90°
+    (as the geometry says, it rises: the rocker turns ever faster per mm of pushrod
+    travel — unless the spring's side of the rocker nears its own dead centre too).
+    Without a motion ratio (no spring), the geometry's word alone."""
+    if ratio is None or best_ratio is None:
         return "the rocker turns ever faster per mm of wheel travel and can flip over"
     way = "rises toward infinity" if ratio > best_ratio else "falls toward zero"
     return (
