@@ -349,3 +349,38 @@ def test_axle_droplink_near_the_bars_dead_centre_warns_once(tmp_path):
         f"passes {miss:.2f} mm from the left arb arm axis arb_u_bar_axis_a–arb_u_bar_axis_b" in line
     )
     assert "rises toward infinity" in line and line.endswith("(the mirrored right side likewise)")
+
+
+def test_mujoco_landing_on_the_other_rocker_branch_is_said_so(tmp_path):
+    """The issue's MuJoCo: from the design state, near the rocker's dead centre, its
+    Newton lands some steps on the pushrod loop's other assembly. Those steps are the
+    ones whose MuJoCo points have the pushrod loop's chirality (rocker axis, pushrod
+    ends: signed volume) opposite to the design's; none of them is compared."""
+    pytest.importorskip("mujoco")
+    from pin_susp import Corner
+    from pin_susp.mjcf import tree_to_mjcf
+    from pin_susp.sweep import load_sweep
+    from pin_susp.validate import mujoco_points, validate
+
+    g = near_dead_centre(0.6, 38.6)
+    corner = Corner(write(tmp_path / "g.yaml", g))
+    sweep = load_sweep(EXAMPLES / "bump_rack_held.yaml")
+    results, (report,) = validate(corner, sweep, engines=("mujoco",))
+    assert report.branch_steps and report.flipped == {"the pushrod loop"}
+    assert not report.disagree and not report.agrees
+    names = ("rocker_axis_a", "rocker_axis_b", "pushrod_outboard", "pushrod_inboard")
+
+    def volume(p):
+        a, b, c, d = (np.asarray(p[n], dtype=float) for n in names)
+        return np.linalg.det(np.array([b - a, c - a, d - a]))
+
+    design = np.sign(volume({n: xyz(g["hardpoints"][n]) for n in names}))
+    points = mujoco_points(corner, sweep, tree_to_mjcf(corner.tree))
+    other = [
+        i
+        for i, at in enumerate(points)
+        if at is not None
+        and results["solver_converged"][i]
+        and np.sign(volume({n: at[n].val[0] for n in names})) != design
+    ]
+    assert other == report.branch_steps
