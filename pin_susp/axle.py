@@ -19,6 +19,7 @@ import pinocchio as pin
 from . import __version__
 from .closures import WORLD, ContactPatchPoint, JointTarget, PointTarget
 from .corner import Results
+from .deadcentre import dead_centres, warn_dead_centres
 from .errors import InputError
 from .geometry import DERIVED_POINTS, MM, Geometry, unit
 from .linkage import Built, FrameMotion, Linkage, closure_row
@@ -250,6 +251,7 @@ class AxleModel:
         self.urdf, self.model, self.kin = built.urdf, built.model, built.kin
         self.points = dict(built.points)
         self.closures, self.branches = built.closures, built.branches
+        self.dead_centres = dead_centres(self.tree)  # for the failure report
         self.q_design = built.q_design
         self.point_names = {}
         for side, g in self.geometries.items():
@@ -417,8 +419,9 @@ class AxleReader(Reader):
         raise InputError(self.source, key, problem)
 
 
-def load_axle(source) -> AxleGeometry:
-    """Read and validate an axle file (``scope: axle``, spec/axle.md): a path or a dict."""
+def load_axle(source, warn_as: str | None = None) -> AxleGeometry:
+    """Read and validate an axle file (``scope: axle``, spec/axle.md): a path or a dict
+    (``warn_as``: the file a dict came from, for the warnings; its errors say <dict>)."""
     from .geometry import _parse, warn_implausible
 
     data, name, sha = load_yaml(source)
@@ -585,7 +588,7 @@ def load_axle(source) -> AxleGeometry:
                 )
     for g in corners.values():
         warn_implausible(g)
-    return AxleGeometry(
+    axle = AxleGeometry(
         name=r.text(data.get("name", "unnamed axle"), "name"),
         left=corners["left"],
         right=corners["right"],
@@ -600,6 +603,10 @@ def load_axle(source) -> AxleGeometry:
         sha256=sha,
         data=data,
     )
+    # a mirrored right side repeats its left's: said once, for the left
+    tree = axle_tree(axle.left, axle.right, "axle", axle)
+    warn_dead_centres(tree, warn_as or name, mirrored)
+    return axle
 
 
 def _stiffness(anti: dict, anti_roll: str, r: Reader) -> float | None:
@@ -927,7 +934,8 @@ def axle_results(model: AxleModel, sweep, solutions: list) -> AxleResults:
             units[f"{name}_{axis}"] = "mm"
     source = model.axle.source if model.axle is not None else "<geometries>"
     sha = model.axle.sha256 if model.axle is not None else None
-    return AxleResults(columns, units, AxleResults.solver_meta(solutions, (source, sha), sweep))
+    meta = AxleResults.solver_meta(solutions, (source, sha), sweep, model)
+    return AxleResults(columns, units, meta)
 
 
 def _side_rates(model: AxleModel, plain: dict, qs: list) -> dict:

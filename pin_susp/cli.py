@@ -736,7 +736,9 @@ def _validate(args) -> int:
             print(f"  {r.engine}: skipped — {r.note}")
             continue
         if r.failed_steps:
-            print(f"  {r.engine}: did not converge at steps {r.failed_steps}")
+            print(f"  {r.engine}: did not converge at steps {_list(r.failed_steps)}")
+        if r.branch_steps or r.other_branch:
+            print(f"  {r.engine}: {_other_branch(r, corner)}")
         if r.not_compared:
             print(
                 f"  {r.engine}: {', '.join(sorted(r.not_compared))} not compared (they need the "
@@ -749,13 +751,48 @@ def _validate(args) -> int:
                 "; the roll centre of its size times max(1, |RC|/track)" if axle else ""
             )
             print(f"  {r.engine}: agrees within {args.tolerance:g} mm/deg ({centres})")
-        else:
+        elif r.disagree:
             ok = False
+            print(f"  {r.engine}: DISAGREES on {', '.join(sorted(r.disagree))} (marked !)")
+        elif r.failed_steps or r.branch_steps:
+            ok = False
+            unsolved = [
+                f"{len(steps)} step(s) {what}"
+                for steps, what in (
+                    (r.failed_steps, "it did not solve"),
+                    (r.branch_steps, "on another assembly branch"),
+                )
+                if steps
+            ]
             print(
-                f"  {r.engine}: DISAGREES on {', '.join(sorted(r.disagree)) or 'solving'} "
-                "(marked !)"
+                f"  {r.engine}: agrees where it solved on pin_susp's branch, but leaves "
+                f"{' and '.join(unsolved)} unconfirmed (nothing marked)"
             )
     return 0 if ok else 1
+
+
+def _other_branch(r, subject) -> str:
+    """An engine's steps on another assembly branch than pin_susp's, said as such: where
+    pin_susp solved them (a difference of assembly, not of kinematics) and where it
+    found no pose either; a dead centre at design is the likely cause."""
+    said = []
+    if r.branch_steps:
+        said.append(
+            f"lands on another assembly branch at steps {_list(r.branch_steps)} "
+            f"({', '.join(sorted(r.flipped))}), where pin_susp keeps the design's: "
+            "those steps are not compared"
+        )
+    if r.other_branch:
+        said.append(
+            f"{'and ' if said else 'lands on another assembly branch '}at steps "
+            f"{_list(r.other_branch)}, which pin_susp reaches on no branch of the design's"
+            + ("" if r.branch_steps else f" ({', '.join(sorted(r.flipped))})")
+        )
+    dead = [t for t in getattr(subject, "dead_centres", ()) if t.driven]
+    if dead:
+        near = ", ".join(f"{t.flow} {t.margin:.1f}° from dead centre" for t in dead)
+        said.append(f"near the dead centre at design ({near}: see the dead-centre warning)")
+    return "; ".join(said)
 
 
 def _demo_command(sub) -> None:
@@ -918,7 +955,12 @@ class Digest:
         self.worst_short = 0.0  # their largest residual, mm
         self.flipped = Steps()  # on another assembly branch
         self.loops: set[str] = set()  # the loops that flipped
-        self.band: dict[str, list] = {}  # side → [Steps outside, worst step, its angle]
+        # side → [Steps outside, worst step, its angle, |motion ratio| there (None: no
+        # ratio)]; side → [the angle nearest 90°, |motion ratio| there]: which way the
+        # ratio goes as the rocker nears over-centre
+        self.band: dict[str, list] = {}
+        self.nearest: dict[str, list] = {}
+        self.dead: list = []  # the links near dead centre at design (deadcentre.Transmission)
         self.unseat: dict[str, list] = {}  # side → [Steps below zero, least force]
 
     @classmethod
@@ -946,6 +988,8 @@ class Digest:
         for i, count in enumerate(counts):
             self.iterations[i] += count
         why = results.meta["why"]
+        if not self.dead:
+            self.dead = list(results.meta.get("dead_centres", ()))
         for i in np.flatnonzero(~ok):
             if "branch" in why[i]:
                 self.flipped.add([int(steps[i])])
@@ -962,13 +1006,25 @@ class Digest:
         for suffix, side in SIDES:
             angle = results.columns.get(f"rocker_transmission_angle{suffix}")
             if angle is not None:
+                ratio = results.columns.get(f"motion_ratio{suffix}")
+
+                def at(i, ratio=ratio):
+                    return None if ratio is None or np.isnan(ratio[i]) else abs(float(ratio[i]))
+
+                off = np.abs(angle - 90.0)
+                solved = np.flatnonzero(~np.isnan(off))
+                if len(solved):
+                    best = solved[np.argmin(off[solved])]
+                    near = self.nearest.get(side)
+                    if near is None or off[best] < abs(near[0] - 90.0):
+                        self.nearest[side] = [float(angle[best]), at(best)]
                 outside = np.flatnonzero((angle < low) | (angle > high))
                 if len(outside):
-                    worst = outside[np.argmax(np.abs(angle[outside] - 90.0))]
-                    band = self.band.setdefault(side, [Steps(), None, 90.0])
+                    worst = outside[np.argmax(off[outside])]
+                    band = self.band.setdefault(side, [Steps(), None, 90.0, None])
                     band[0].add(steps[outside])
-                    if abs(angle[worst] - 90.0) > abs(band[2] - 90.0):
-                        band[1], band[2] = int(steps[worst]), float(angle[worst])
+                    if off[worst] > abs(band[2] - 90.0):
+                        band[1:4] = int(steps[worst]), float(angle[worst]), at(worst)
             force = results.columns.get(f"spring_force{suffix}")
             if force is not None and np.nanmin(force, initial=np.inf) < 0.0:
                 unseat = self.unseat.setdefault(side, [Steps(), np.inf])
@@ -1042,11 +1098,12 @@ def _warn_transmission(results) -> None:
     low, high = TRANSMISSION_BAND
     for _, side in SIDES:
         if side in d.band:
-            steps, worst, angle = d.band[side]
+            steps, worst, angle, ratio = d.band[side]
+            best, best_ratio = d.nearest[side]
             warnings.warn(
                 f"{side}rocker transmission angle outside {low:g}…{high:g} deg at steps "
-                f"{steps} (worst {angle:.1f} deg at step {worst}): "
-                "the rocker nears over-centre, its motion ratio falls toward zero and flips",
+                f"{steps} (worst {angle:.1f} deg at step {worst}): the rocker nears "
+                f"over-centre, {_ratio_trend(ratio, best, best_ratio)}",
                 PlausibilityWarning,
                 stacklevel=2,
             )
@@ -1059,6 +1116,31 @@ def _warn_transmission(results) -> None:
                 PlausibilityWarning,
                 stacklevel=2,
             )
+
+
+def _ratio_trend(ratio: float | None, best: float, best_ratio: float | None) -> str:
+    """Which way the motion ratio goes as the pushrod nears the rocker's dead centre, by
+    the numbers: |ratio| at the worst step against it where the angle is nearest 90°
+    (as the geometry says, it rises: the rocker turns ever faster per mm of pushrod
+    travel — unless the spring's side of the rocker nears its own dead centre too).
+    Without a motion ratio (no spring), the geometry's word alone."""
+    if ratio is None or best_ratio is None:
+        return "the rocker turns ever faster per mm of wheel travel and can flip over"
+    way = "rises toward infinity" if ratio > best_ratio else "falls toward zero"
+    return (
+        f"its motion ratio {way} (|{ratio:.3g}| there, |{best_ratio:.3g}| at "
+        f"{best:.0f} deg) and can flip"
+    )
+
+
+def _dead_centre_cause(d: Digest) -> str:
+    """The failure report's cause for steps out of reach or on another branch: a link
+    that drives its body near dead centre at design (its warning is printed too)."""
+    driven = [t for t in d.dead if t.driven]
+    if not driven:
+        return ""
+    said = ", ".join(f"{t.flow} {t.margin:.1f}° from dead centre" for t in driven)
+    return f" — the mechanism is at a dead centre at design ({said}: see the dead-centre warning)"
 
 
 def _report_failures(
@@ -1081,7 +1163,7 @@ def _report_failures(
         )
     print(
         f"pin-susp: warning: {d.failed} of {d.steps} steps did not converge: "
-        f"{'; '.join(reasons)}. Their rows {consequence}.",
+        f"{'; '.join(reasons)}{_dead_centre_cause(d)}. Their rows {consequence}.",
         file=sys.stderr,
     )
     return EXIT_NOT_CONVERGED

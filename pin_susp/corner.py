@@ -287,7 +287,7 @@ class Results:
             if only is None or name in only:
                 columns[name], units[name] = values, column_unit
         geometry = (corner.geometry.source, corner.geometry.sha256)
-        return cls(columns, units, cls.solver_meta(solutions, geometry, sweep))
+        return cls(columns, units, cls.solver_meta(solutions, geometry, sweep, corner))
 
     @staticmethod
     def solver_columns(solutions: list[Solution]) -> tuple[dict, dict]:
@@ -301,13 +301,15 @@ class Results:
         return columns, dict.fromkeys(columns, "") | {"solver_max_residual": "mm"}
 
     @staticmethod
-    def solver_meta(solutions: list[Solution], geometry: tuple, sweep: Sweep) -> dict:
-        """What the CSV's comments and the failure report need: sources, q, reasons."""
+    def solver_meta(solutions: list[Solution], geometry: tuple, sweep: Sweep, model=None) -> dict:
+        """What the CSV's comments and the failure report need: sources, q, reasons, and
+        the model's links near dead centre at design (a cause of steps out of reach)."""
         return {
             "geometry": geometry,
             "sweep": (sweep.source, sweep.sha256),
             "q": np.array([s.q for s in solutions]),
             "why": [s.why for s in solutions],  # '' where converged
+            "dead_centres": list(getattr(model, "dead_centres", ())),
         }
 
     def __getitem__(self, name: str) -> np.ndarray:

@@ -234,12 +234,23 @@ def load_geometry(source: str | Path | dict) -> Geometry:
     """Read and validate a geometry file (path) or an already-loaded dict.
 
     Raises InputError naming the file, the key and the problem; warns
-    (PlausibilityWarning) about valid values outside a car's plausible range.
+    (PlausibilityWarning) about valid values outside a car's plausible range, and
+    about a link near dead centre at design (docs/geometry.md, "Dead centres").
     """
     data, name, sha = load_yaml(source)
     g = _parse(data, Reader(name), sha)
     warn_implausible(g)
+    warn_dead_centres(g)
     return g
+
+
+def warn_dead_centres(g: Geometry, source: str | None = None) -> list:
+    """A PlausibilityWarning for each link of the corner within a few degrees of dead
+    centre at design (:mod:`pin_susp.deadcentre`), naming ``source`` (default: the
+    geometry's); the ones found."""
+    from . import deadcentre
+
+    return deadcentre.warn_dead_centres(g.mechanism.tree(g), source or g.source)
 
 
 def warn_implausible(g: Geometry) -> None:

@@ -22,6 +22,7 @@ load is its outboard ball joint is a pair of two-force legs.
 from __future__ import annotations
 
 import math
+import warnings
 import weakref
 from dataclasses import dataclass
 
@@ -29,7 +30,7 @@ import numpy as np
 import pinocchio as pin
 
 from .closures import BallClosure, DistanceClosure, JointTarget
-from .errors import PinSuspError
+from .errors import PinSuspError, PlausibilityWarning
 from .solver import NewtonSolver
 from .sweep import Sweep
 from .yamlio import Reader, load_yaml
@@ -184,7 +185,58 @@ def member_forces(corner, sweep, cases: list, solutions=None, results=None, prog
         if name != "step_index":
             columns[name] = np.repeat(values, n)
             units[name] = results.units.get(name, "")
+    _warn_dead_centre_share(corner, cases, columns, axle)
     return Results(columns, units, results.meta)
+
+
+# A spring's share of the tyre's vertical load outside this band (spring force over
+# |Fz|): a car's is about 1/motion ratio, 0.5…3 — this far off, a lever at dead centre.
+SPRING_SHARE = (0.1, 10.0)
+
+
+def _warn_dead_centre_share(subject, cases: list, columns: dict, axle: bool) -> None:
+    """Where the model has a link near dead centre at design (deadcentre.py, warned
+    when its file was read), a PlausibilityWarning for each load case whose spring
+    takes a share of the tyre's vertical load outside SPRING_SHARE: the forces are
+    the dead centre's lever, not the car's (7.9 N in the spring from a 2 kN bump)."""
+    dead = list(getattr(subject, "dead_centres", ()))
+    if not dead:
+        return
+    source = subject.axle.source if axle and subject.axle is not None else None
+    if not axle:
+        source = subject.geometry.source
+    low, high = SPRING_SHARE
+    for side in ("left", "right") if axle else ("",):
+        suffix = f"_{side}" if side else ""
+        spring = columns.get(f"force_spring{suffix}")
+        here = [t for t in dead if t.body.startswith(f"{side}_")] if side else dead
+        if spring is None or not here:
+            continue
+        cause = ", ".join(f"{t.flow} is {t.margin:.1f}° from dead centre" for t in here)
+        for k, case in enumerate(cases):
+            c = getattr(case, side) if side else case
+            fz = abs(float(c.contact_patch[2] + c.wheel_center[2]))
+            force = np.abs(np.asarray(spring[k :: len(cases)], dtype=float))
+            if not fz > 0.0 or np.isnan(force).all():
+                continue
+            share = float(np.nanmax(force)) / fz
+            if low <= share <= high:
+                continue
+            body = here[0].body.replace("_", " ")
+            why = (
+                f"so the load bypasses the spring into the {body}'s pivot"
+                if share < low
+                else f"so the {body} multiplies the load as a lever near dead centre"
+            )
+            warnings.warn(
+                f"{source}: load case {case.name!r}: the {side + ' ' if side else ''}spring "
+                f"takes {'at most' if share < low else 'up to'} {share * fz:.3g} N of the "
+                f"{fz:.0f} N vertical load on the tyre "
+                f"(a car's takes about the load over its motion ratio): {cause} at design "
+                f"(see the dead-centre warning), {why}",
+                PlausibilityWarning,
+                stacklevel=3,
+            )
 
 
 _STATICS = weakref.WeakKeyDictionary()  # a subject's plan, made once (it is fixed by its tree)

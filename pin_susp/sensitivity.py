@@ -681,7 +681,8 @@ def axle_sensitivities(sens: AxleSensitivity, sweep=None, progress=None):
     solutions = solve_axle_sweep(model, sweep)
     columns, units = AxleResults.solver_columns(solutions)
     source = (model.axle.source, model.axle.sha256) if model.axle else ("<geometries>", None)
-    results = AxleResults(columns, units, AxleResults.solver_meta(solutions, source, sweep))
+    meta = AxleResults.solver_meta(solutions, source, sweep, model)
+    results = AxleResults(columns, units, meta)
     out = []
     for i, solution in enumerate(solutions):
         if solution.converged:

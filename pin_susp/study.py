@@ -485,11 +485,13 @@ def build(data: dict, source: str, axle: bool, variant: bool = False):
         if axle:
             from .axle import AxleModel, load_axle
 
-            return AxleModel(load_axle(data))
+            return AxleModel(load_axle(data, None if variant else source))
         from .corner import Corner
-        from .geometry import _parse
+        from .geometry import _parse, warn_dead_centres
 
         geometry = _parse(data, Reader("<dict>"), None)
+        if not variant:  # a link near dead centre, as every command says
+            warn_dead_centres(geometry, source)
         return Corner(geometry, warn=not variant, visuals=not variant)
     except InputError as exc:
         if exc.source == "<dict>":

@@ -24,6 +24,7 @@ points, drivers, targets and columns — is a scope (:class:`CornerScope`,
 
 from __future__ import annotations
 
+import itertools
 import logging
 import xml.etree.ElementTree as ET
 from contextlib import contextmanager
@@ -66,6 +67,11 @@ class EngineReport:
     units: dict[str, str] = field(default_factory=dict)
     failed_steps: list[int] = field(default_factory=list)
     disagree: set[str] = field(default_factory=set)
+    # steps it solved on another assembly branch than pin_susp's (not compared), and
+    # what flipped; ``other_branch``: such steps where pin_susp found no pose either
+    branch_steps: list[int] = field(default_factory=list)
+    other_branch: list[int] = field(default_factory=list)
+    flipped: set[str] = field(default_factory=set)
     not_compared: set[str] = field(default_factory=set)  # the engine could not compute them
     note: str = ""
     warnings: int = 0  # how many warnings the engine raised (MuJoCo's, Drake's: silenced, counted)
@@ -77,7 +83,7 @@ class EngineReport:
 
     @property
     def agrees(self) -> bool:
-        return not self.note and not self.failed_steps and not self.disagree
+        return not (self.note or self.failed_steps or self.disagree or self.branch_steps)
 
 
 def compare(
@@ -87,9 +93,16 @@ def compare(
     an axle's: ``subject`` is a Corner or an AxleModel)."""
     scope = _scope(subject)
     report = EngineReport(engine, tolerance)
+    branches = Branches(scope.tree)
     for i, points in enumerate(points_per_step):
         if points is None:
             report.failed_steps.append(i)
+            continue
+        flipped = branches.flipped(scope.positions(points))
+        if flipped is not None:  # another assembly: its differences mean nothing
+            report.flipped.add(flipped)
+            converged = results["solver_converged"][i]
+            (report.branch_steps if converged else report.other_branch).append(i)
             continue
         if not results["solver_converged"][i]:
             continue
@@ -103,6 +116,51 @@ def compare(
             for a, axis in enumerate("xyz"):
                 _record(report, "points", "mm", position[a] * 1e3, results[f"{name}_{axis}"][i])
     return report
+
+
+class Branches:
+    """pin_susp's assembly at design, to tell an engine's pose on another branch of the
+    mechanism: each loop's side (the chirality of its closure's branch points, which
+    pin_susp's solver keeps, closures.LoopBranch) and each body's handedness (four of
+    its points, its joint's among them: a rigid body turns but is never mirrored — a
+    point-based solve, which only keeps distances, can mirror one)."""
+
+    def __init__(self, tree):
+        from .closures import MEASURES, LoopBranch, chirality
+        from .deadcentre import _point_name
+
+        design = {name: p.tolist() for name, (_, p) in tree.points.items()}
+        self.checks = []  # (what flipped, measure, four point names, sign at design)
+        for c in tree.closures:
+            if c.branch and all(n in design for n in c.branch):
+                measure = MEASURES[c.branch_kind]
+                v = measure(*(design[n] for n in c.branch))
+                if abs(v) >= LoopBranch.DEGENERATE:
+                    self.checks.append((f"the {c.name} loop", measure, c.branch, np.sign(v)))
+        on = {}
+        for name, (body, _) in tree.points.items():
+            on.setdefault(body, []).append(name)
+        for b in tree.bodies:
+            if b.joint is None:
+                continue
+            own = [_point_name(n, b.name, tree) for n in b.joint.defined_by]
+            names = list(dict.fromkeys([n for n in own if n in design] + on.get(b.name, [])))
+            quads = list(itertools.combinations(names[:8], 4))
+            if not quads:
+                continue
+            best = max(quads, key=lambda q: abs(chirality(*(design[n] for n in q))))
+            v = chirality(*(design[n] for n in best))
+            if abs(v) > 1e-3:  # well clear of flat
+                what = f"the {b.name.replace('_', ' ')} mirrored"
+                self.checks.append((what, chirality, best, np.sign(v)))
+
+    def flipped(self, positions: dict) -> str | None:
+        """What is on another branch at these positions (name → (3,) m), or None."""
+        for what, measure, names, sign in self.checks:
+            if all(n in positions for n in names):
+                if measure(*(np.asarray(positions[n]).tolist() for n in names)) * sign <= 0:
+                    return what
+        return None
 
 
 def _record(report, name, unit, theirs, ours, size=None) -> None:
