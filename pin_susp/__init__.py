@@ -26,6 +26,10 @@ from typing import TYPE_CHECKING
 # (PEP 562), so that `import pin_susp` or a CLI command that needs only the
 # sweep does not pay for loads, sensitivities, studies and their libraries.
 _EXPORTS = {
+    "Axle": "axle",
+    "AxleModel": "axle",
+    "AxleResults": "axle",
+    "load_axle": "axle",
     "Corner": "corner",
     "Results": "corner",
     "InputError": "errors",
@@ -48,6 +52,7 @@ _EXPORTS = {
 }
 
 if TYPE_CHECKING:  # for type checkers and IDEs; at run time __getattr__ below
+    from .axle import Axle, AxleModel, AxleResults, load_axle
     from .corner import Corner, Results
     from .errors import InputError, PinSuspError
     from .geometry import Geometry, load_geometry
@@ -87,6 +92,9 @@ def __dir__() -> list[str]:
 
 __all__ = [
     "METRICS",
+    "Axle",
+    "AxleModel",
+    "AxleResults",
     "Corner",
     "Geometry",
     "InputError",
@@ -97,6 +105,7 @@ __all__ = [
     "SetupModel",
     "Sweep",
     "Target",
+    "load_axle",
     "load_cases",
     "member_forces",
     "load_geometry",
