@@ -7,14 +7,23 @@ plus loop closures, and solved by Newton's method on the joint manifold.
     corner = pin_susp.Corner("examples/double_wishbone.yaml")
     results = corner.run_sweep("examples/bump_steer.yaml")
     results["camber"]            # deg, one value per step
+    results.to_pandas()          # a DataFrame, as the CSV has it
     results.to_csv("out.csv")
+    results.plot("report.png")   # the standard report
+    corner.geometry.hardpoints_mm["lower_wishbone_outboard"]  # mm, as in the file
+
+    axle = pin_susp.Axle("examples/axle_front.yaml")  # an axle, the same way
+    axle.run_sweep("examples/roll.yaml")["roll_center_z"]
 
     # setup: exact sensitivities, and the inverse (shim, trackrod, pushrod)
     sheet = pin_susp.setup_sheet(corner.geometry, shim=[15, 30])
     found = pin_susp.solve_setup(corner.geometry, {"camber": -2.5, "roadwheel_angle": 0.1})
 
-Files, the CLI, the CSV and this API speak mm and degrees; inside, the model
-is in SI units (m, rad).
+Files, the CLI, the CSV, results and poses speak mm and degrees; inside, the
+model is in SI units (m, rad): a Geometry's ``hardpoints`` and a Corner's
+``design_positions`` are in m (``hardpoints_mm`` reads them back in mm). The
+formats and columns are documented in docs/ (geometry.md, sweep.md, results.md,
+axle.md, loads.md, studies.md, urdf.md).
 """
 
 __version__ = "0.1.0"

@@ -1,4 +1,4 @@
-"""An axle: two corners on one chassis, one rack, one Pinocchio model (spec/axle.md).
+"""An axle: two corners on one chassis, one rack, one Pinocchio model (docs/axle.md).
 
 This first part composes the model. Each corner's tree (its mechanism
 module's) is prefixed by its side — ``left_upright``, ``left_upper_ball_joint``,
@@ -485,7 +485,7 @@ class AxleReader(Reader):
 
 
 def load_axle(source) -> AxleGeometry:
-    """Read and validate an axle file (``scope: axle``, spec/axle.md): a path or a dict."""
+    """Read and validate an axle file (``scope: axle``, docs/axle.md): a path or a dict."""
     from .geometry import _parse, warn_implausible
 
     data, name, sha = load_yaml(source)
@@ -1101,7 +1101,7 @@ def _motion(model: AxleModel, qs: list, solutions: list | None = None) -> dict:
 
 def _roll_rates(model: AxleModel, points: dict, sides: dict) -> dict:
     """Exact derivatives along roll: the left wheel centre up and the right one down
-    equally, the rack held (spec/axle.md): camber and toe per side (deg/deg), the
+    equally, the rack held (docs/axle.md): camber and toe per side (deg/deg), the
     U-bar's twist per side's hub z, and the roll centre's migration (mm/deg).
 
     With h the antisymmetric wheel-centre move, roll = atan2(a, b), a = Δz_L − Δz_R,

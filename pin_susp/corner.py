@@ -40,10 +40,9 @@ class Corner(Linkage):
     """
 
     def __repr__(self) -> str:
-        g = self.geometry
-        return summary_repr(
-            self,
-            lambda: (
+        def parts():
+            g = self.geometry
+            return (
                 g.source,
                 g.name,
                 g.type,
@@ -53,8 +52,9 @@ class Corner(Linkage):
                 "" if g.spring == "none" else g.spring,
                 "as set" if g.drawn is not None else "",
                 f"{self.mobility} inputs",
-            ),
-        )
+            )
+
+        return summary_repr(self, parts)
 
     def __init__(
         self,
@@ -424,7 +424,8 @@ class Results:
     def plot(self, path, label: str | None = None) -> None:
         """Draw the standard report — what ``pin-susp sweep --plot`` and ``pin-susp plot``
         draw: a panel per metric against wheel travel (or the rack, or an axle's roll or
-        heave) — into an image file, its format from its ending (.png, .pdf, .svg).
+        heave); of member_forces' table, the force report — into an image file, its
+        format from its ending (.png, .pdf, .svg).
 
         ``label``: the name in the title (default: the sweep file's). Drawn from the
         CSV's text (as the CLI draws it); a PinSuspError when no step converged.
@@ -440,8 +441,10 @@ class Results:
         from .export import csv_text
         from .plots import ResultsFile, report_figure, save_figure
 
-        name = label or _file_name(self.meta.get("sweep", ("",))[0]) or "results"
+        name = _file_name(self.meta.get("sweep", ("",))[0]) or "results"
         written = ResultsFile(name, raw=csv_text(self).encode())
+        if label is not None:
+            written.label = label
         save_figure(report_figure([written]), path)
 
 
