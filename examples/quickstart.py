@@ -1,4 +1,5 @@
-"""pin_susp from Python: load a corner, solve one pose, run a sweep, write CSV.
+"""pin_susp from Python: load a corner, solve one pose, run a sweep, write CSV, draw
+the report, read hardpoints back in mm, and sweep an axle.
 
 Run from the repository root:  python examples/quickstart.py
 """
@@ -13,7 +14,11 @@ HERE = Path(__file__).parent
 
 # A corner from its YAML file (a dict in the same format works too).
 corner = pin_susp.Corner(HERE / "double_wishbone.yaml")
+print(corner)  # <Corner 'double_wishbone.yaml' 'example corner': double_wishbone, ...>
 print(f"{corner.geometry.name}: {corner.model.nv} joints, mobility {corner.mobility}")
+
+# Hardpoints: the model works in metres; hardpoints_mm gives the file's mm back.
+print(f"  lower ball joint {corner.geometry.hardpoints_mm['lower_wishbone_outboard']} mm")
 
 # One pose: 25 mm of bump with the rack 5 mm to the left. Values in mm,
 # relative to the design position unless mode="absolute".
@@ -36,6 +41,23 @@ print(
     f"to {camber[-1]:.3f} deg at {travel[-1]:.0f} mm"
 )
 
+print(results)  # <Results 'bump_steer.yaml' on 'double_wishbone.yaml': 41 steps, ...>
+
+frame = results.to_pandas()  # a DataFrame, one row per step, units in frame.attrs
+print(frame[["wheel_travel", "camber", "roadwheel_angle"]].iloc[::10].to_string(index=False))
+
 out = Path("quickstart_results.csv")
 results.to_csv(out)
 print(f"wrote {out}")
+results.plot("quickstart_report.png")  # the report `pin-susp sweep --plot` draws
+print("wrote quickstart_report.png")
+
+# An axle: both corners on one chassis and one rack, swept in roll.
+axle = pin_susp.Axle(HERE / "axle_front.yaml")
+print(axle)
+roll = axle.run_sweep(HERE / "roll.yaml")
+print(roll)
+print(
+    f"at {roll['roll'][-1]:.0f} deg of roll: camber {roll['camber_left'][-1]:.3f} deg left, "
+    f"{roll['camber_right'][-1]:.3f} deg right"
+)

@@ -7,14 +7,23 @@ plus loop closures, and solved by Newton's method on the joint manifold.
     corner = pin_susp.Corner("examples/double_wishbone.yaml")
     results = corner.run_sweep("examples/bump_steer.yaml")
     results["camber"]            # deg, one value per step
+    results.to_pandas()          # a DataFrame, as the CSV has it
     results.to_csv("out.csv")
+    results.plot("report.png")   # the standard report
+    corner.geometry.hardpoints_mm["lower_wishbone_outboard"]  # mm, as in the file
+
+    axle = pin_susp.Axle("examples/axle_front.yaml")  # an axle, the same way
+    axle.run_sweep("examples/roll.yaml")["roll_center_z"]
 
     # setup: exact sensitivities, and the inverse (shim, trackrod, pushrod)
     sheet = pin_susp.setup_sheet(corner.geometry, shim=[15, 30])
     found = pin_susp.solve_setup(corner.geometry, {"camber": -2.5, "roadwheel_angle": 0.1})
 
-Files, the CLI, the CSV and this API speak mm and degrees; inside, the model
-is in SI units (m, rad).
+Files, the CLI, the CSV, results and poses speak mm and degrees; inside, the
+model is in SI units (m, rad): a Geometry's ``hardpoints`` and a Corner's
+``design_positions`` are in m (``hardpoints_mm`` reads them back in mm). The
+formats and columns are documented in docs/ (geometry.md, sweep.md, results.md,
+axle.md, loads.md, studies.md, urdf.md).
 """
 
 __version__ = "0.1.0"
@@ -26,6 +35,10 @@ from typing import TYPE_CHECKING
 # (PEP 562), so that `import pin_susp` or a CLI command that needs only the
 # sweep does not pay for loads, sensitivities, studies and their libraries.
 _EXPORTS = {
+    "Axle": "axle",
+    "AxleModel": "axle",
+    "AxleResults": "axle",
+    "load_axle": "axle",
     "Corner": "corner",
     "Results": "corner",
     "InputError": "errors",
@@ -48,6 +61,7 @@ _EXPORTS = {
 }
 
 if TYPE_CHECKING:  # for type checkers and IDEs; at run time __getattr__ below
+    from .axle import Axle, AxleModel, AxleResults, load_axle
     from .corner import Corner, Results
     from .errors import InputError, PinSuspError
     from .geometry import Geometry, load_geometry
@@ -87,6 +101,9 @@ def __dir__() -> list[str]:
 
 __all__ = [
     "METRICS",
+    "Axle",
+    "AxleModel",
+    "AxleResults",
     "Corner",
     "Geometry",
     "InputError",
@@ -97,6 +114,7 @@ __all__ = [
     "SetupModel",
     "Sweep",
     "Target",
+    "load_axle",
     "load_cases",
     "member_forces",
     "load_geometry",

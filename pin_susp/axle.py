@@ -1,4 +1,4 @@
-"""An axle: two corners on one chassis, one rack, one Pinocchio model (spec/axle.md).
+"""An axle: two corners on one chassis, one rack, one Pinocchio model (docs/axle.md).
 
 This first part composes the model. Each corner's tree (its mechanism
 module's) is prefixed by its side — ``left_upright``, ``left_upper_ball_joint``,
@@ -21,7 +21,7 @@ from .closures import WORLD, ContactPatchPoint, JointTarget, PointTarget
 from .corner import Results
 from .deadcentre import dead_centres, warn_dead_centres
 from .errors import InputError
-from .geometry import DERIVED_POINTS, MM, Geometry, unit
+from .geometry import DERIVED_POINTS, MM, Geometry, summary_repr, unit
 from .linkage import Built, FrameMotion, Linkage, closure_row
 from .mechanisms import axis_foot, xml_name
 from .solver import NewtonSolver, march
@@ -232,15 +232,30 @@ class AxleModel:
     """The composed model: its URDF, Pinocchio model, points (``left_…``, ``right_…``,
     contact patches included), closures and branches, at the design state.
 
-    ``AxleModel(axle)`` for an AxleGeometry (its bar and heave link included), or
-    ``AxleModel(left, right)`` for two corner Geometries."""
+    ``AxleModel(axle)`` for an axle file (a path or a dict, read by ``load_axle``) or
+    an AxleGeometry (its bar and heave link included), or ``AxleModel(left, right)``
+    for two corner Geometries. ``pin_susp.Axle`` is the same class.
+
+    >>> axle = pin_susp.Axle("examples/axle_front.yaml")
+    >>> axle
+    <AxleModel 'axle_front.yaml' 'front axle with U-bar': double_wishbone, 2 corners, ...>
+    >>> results = axle.run_sweep("examples/roll.yaml")
+    >>> results["roll_center_z"], results["camber_left"]  # mm, deg: numpy arrays
+    >>> results.to_pandas()  # a DataFrame, a row per step; results.plot("axle.png")
+
+    ``axle.geometries["left"]`` is each side's as-set Geometry (m; its
+    ``hardpoints_mm`` in mm), ``axle.axle`` the AxleGeometry (None for two corners).
+    """
 
     def __init__(self, left, right: Geometry | None = None, name: str = "axle"):
         elements = None
+        if right is None and not isinstance(left, AxleGeometry):  # an axle file
+            left = load_axle(left)
         if right is None:  # an AxleGeometry
             elements, name = left, left.name
             left, right = elements.left, elements.right
         self.axle = elements
+        self.name = name
         # shims and length adjusters first, per side: the as-set corners (as Corner does)
         from .setup import apply_setup
 
@@ -287,6 +302,41 @@ class AxleModel:
             side: (Linkage(g).spring_sense if g.spring == "torsion_bar" else 1.0)
             for side, g in self.geometries.items()
         }
+
+    def __repr__(self) -> str:
+        def parts():
+            g = self.geometries["left"]
+            a = self.axle
+            source = a.source if a is not None else "<geometries>"
+            return (
+                source,
+                self.name,
+                g.type,
+                f"{len(self.geometries)} corners",
+                g.steering,
+                "pushrod_rocker" if g.actuation == "pushrod_rocker" else "",
+                "" if g.spring == "none" else g.spring,
+                "" if a is None or a.anti_roll == "none" else f"anti-roll {a.anti_roll}",
+                "" if a is None or a.heave_link == "none" else f"heave link {a.heave_link}",
+                f"{self.mobility} inputs",
+            )
+
+        return summary_repr(self, parts)
+
+    def run_sweep(self, sweep, progress=None) -> AxleResults:
+        """Solve every step of an axle sweep (a path, a dict or a Sweep: heave, roll,
+        wheel heights, the rack; docs/axle.md) and compute every column.
+
+        >>> results = axle.run_sweep("examples/roll.yaml")
+        >>> results["camber_left"], results["roll_center_z"]  # deg, mm
+        >>> results.to_pandas()  # the CSV's columns as a DataFrame; results.plot(path)
+
+        ``progress(done, total)``: called after each step."""
+        from .sweep import Sweep, load_sweep
+
+        if not isinstance(sweep, Sweep):
+            sweep = load_sweep(sweep)
+        return axle_results(self, sweep, solve_axle_sweep(self, sweep, progress=progress))
 
     def _check_determined(self, source: str) -> None:
         """Both wheel heights and the rack must fix the pose at design (the closures
@@ -335,6 +385,9 @@ class AxleModel:
         start = np.array([t.residual(self.kin)[0] + t.value for t in targets])  # at q
         solver = NewtonSolver(self.kin, self.closures, targets, self.branches)
         return solver.solve(q, start, goal)
+
+
+Axle = AxleModel  # pin_susp.Axle, as pin_susp.Corner: an axle file → a model to sweep
 
 
 # ---------------------------------------------------------------- the axle file
@@ -386,6 +439,20 @@ class AxleGeometry:
     def corner(self, side: str) -> Geometry:
         return self.left if side == "left" else self.right
 
+    def __repr__(self) -> str:
+        return summary_repr(
+            self,
+            lambda: (
+                self.source,
+                self.name,
+                self.left.type,
+                self.left.steering,
+                "" if self.anti_roll == "none" else f"anti-roll {self.anti_roll}",
+                "" if self.heave_link == "none" else f"heave link {self.heave_link}",
+                "right mirrored" if self.mirrored else "",
+            ),
+        )
+
     @property
     def anti_roll_rigid(self) -> bool:
         """A bar that does not twist: the axle cannot roll."""
@@ -420,7 +487,7 @@ class AxleReader(Reader):
 
 
 def load_axle(source, warn_as: str | None = None) -> AxleGeometry:
-    """Read and validate an axle file (``scope: axle``, spec/axle.md): a path or a dict
+    """Read and validate an axle file (``scope: axle``, docs/axle.md): a path or a dict
     (``warn_as``: the file a dict came from, for the warnings; its errors say <dict>)."""
     from .geometry import _parse, warn_implausible
 
@@ -912,14 +979,19 @@ def _drive_rows(model: AxleModel) -> list:
 
 
 class AxleResults(Results):
-    """Columns of a solved axle sweep (spec/axle.md), in output units; written as a
-    corner's are (export.csv_text)."""
+    """Columns of a solved axle sweep (docs/axle.md, "Columns"), in output units; written
+    as a corner's are (export.csv_text): ``results["camber_left"]``,
+    ``results.to_pandas()``, ``results.to_csv(path)``, ``results.plot(path)``."""
 
 
 def axle_results(model: AxleModel, sweep, solutions: list) -> AxleResults:
     """Every corner column per side (suffix ``_left``/``_right``, derivatives along
     that side's wheel-centre z and the rack, the other wheel held), the axle's
-    columns, then the points (``left_…``, ``right_…``, the bar's)."""
+    columns, then the points (``left_…``, ``right_…``, the bar's).
+
+    >>> results = axle_results(model, sweep, solve_axle_sweep(model, sweep))
+    >>> results.to_pandas()  # a DataFrame, a row per step (model.run_sweep does both)
+    """
     columns, units = AxleResults.solver_columns(solutions)
     qs = [s.q if s.converged else None for s in solutions]
     points = model.motion(qs, solutions)
@@ -1037,7 +1109,7 @@ def _motion(model: AxleModel, qs: list, solutions: list | None = None) -> dict:
 
 def _roll_rates(model: AxleModel, points: dict, sides: dict) -> dict:
     """Exact derivatives along roll: the left wheel centre up and the right one down
-    equally, the rack held (spec/axle.md): camber and toe per side (deg/deg), the
+    equally, the rack held (docs/axle.md): camber and toe per side (deg/deg), the
     U-bar's twist per side's hub z, and the roll centre's migration (mm/deg).
 
     With h the antisymmetric wheel-centre move, roll = atan2(a, b), a = Δz_L − Δz_R,

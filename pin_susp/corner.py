@@ -14,7 +14,7 @@ import numpy as np
 
 from .closures import PointTarget
 from .errors import InputError
-from .geometry import Geometry, load_geometry, warn_outside
+from .geometry import Geometry, load_geometry, summary_repr, warn_outside
 from .linkage import Linkage
 from .metrics import METRICS, TOE_LINK, Pose, metric_columns, point_columns
 from .solver import NewtonSolver, Solution, march
@@ -26,11 +26,35 @@ CHUNK = 10_000  # steps solved and written at a time by a streamed sweep
 class Corner(Linkage):
     """One suspension corner: geometry (as set), URDF, Pinocchio model, sweeps.
 
-    >>> corner = Corner(load_geometry("examples/double_wishbone.yaml"))
+    >>> corner = Corner("examples/double_wishbone.yaml")  # a path, a dict or a Geometry
+    >>> corner
+    <Corner 'double_wishbone.yaml' 'example corner': double_wishbone, left, rack, 2 inputs>
     >>> pose = corner.solve_pose([Target("wheel_center", "z", 25.0),
     ...                           Target("trackrod_inboard", "y", 0.0)])
     >>> pose.metrics["camber"]  # deg
+    >>> results = corner.run_sweep("examples/bump_steer.yaml")
+    >>> results.to_pandas()  # a DataFrame, a row per step; results.plot("report.png")
+
+    ``corner.geometry`` is the as-set Geometry, in m (``geometry.hardpoints_mm`` in
+    mm); ``corner.design_positions`` every point at design, in m.
     """
+
+    def __repr__(self) -> str:
+        def parts():
+            g = self.geometry
+            return (
+                g.source,
+                g.name,
+                g.type,
+                g.side,
+                g.steering,
+                "pushrod_rocker" if g.actuation == "pushrod_rocker" else "",
+                "" if g.spring == "none" else g.spring,
+                "as set" if g.drawn is not None else "",
+                f"{self.mobility} inputs",
+            )
+
+        return summary_repr(self, parts)
 
     def __init__(
         self,
@@ -114,7 +138,14 @@ class Corner(Linkage):
         return self._pose(solution)
 
     def run_sweep(self, sweep: Sweep | str | dict, progress=None) -> Results:
-        """Solve every step of a sweep and compute every column (metrics, derivatives)."""
+        """Solve every step of a sweep and compute every column (metrics, derivatives).
+
+        >>> results = corner.run_sweep("examples/bump_steer.yaml")  # a path, dict or Sweep
+        >>> results["camber"]  # deg, a numpy array, one value per step
+        >>> results.to_pandas()  # the same columns as a DataFrame, as the CSV has them
+        >>> results.to_csv("results.csv"); results.plot("report.png")
+
+        ``progress(i, n)``: called after each step."""
         if not isinstance(sweep, Sweep):
             sweep = load_sweep(sweep)
         tangents = []
@@ -128,6 +159,9 @@ class Corner(Linkage):
 
         Each chunk starts from the last converged pose before it (the design state for
         the first), as the sweep's march does.
+
+        >>> for part in corner.run_sweep_chunks("examples/bump_steer.yaml", rows=20):
+        ...     part.to_pandas()  # a DataFrame of these 20 rows (the last may be shorter)
         """
         if not isinstance(sweep, Sweep):
             sweep = load_sweep(sweep)
@@ -256,12 +290,43 @@ class Corner(Linkage):
 
 
 class Results:
-    """Columns of a solved sweep, in output units (mm, deg); see spec/results.md."""
+    """Columns of a solved sweep, in output units (mm, deg); see docs/results.md.
+
+    ``results["camber"]``: a column (numpy array, one value per step, NaN where a
+    step failed or a metric is undefined); ``results.keys()``: the columns' names,
+    in the CSV's order; ``results.units``: name → unit; ``results.to_pandas()``: a
+    DataFrame; ``results.to_csv(path)``; ``results.plot(path)``: the standard
+    report. ``pd.DataFrame(results.columns)`` is the DataFrame without the units.
+    """
 
     def __init__(self, columns: dict[str, np.ndarray], units: dict[str, str], meta: dict):
         self.columns = columns
         self.units = units
         self.meta = meta
+
+    def __repr__(self) -> str:
+        """``<Results 'sweep.yaml' on 'geometry.yaml': 41 steps, 41 converged, 86 columns>``;
+        never raises (an empty or failed sweep's too)."""
+        kind = type(self).__name__
+        try:
+            steps = len(next(iter(self.columns.values()), ()))
+            converged = self.columns.get("solver_converged")
+            ok = steps if converged is None else int(np.count_nonzero(converged))
+            parts = [f"{steps} steps", f"{ok} converged"]
+            if ok < steps:
+                failed = [str(int(i)) for i in self.columns["step_index"][self.failed_steps]]
+                more = ", ..." if len(failed) > 5 else ""
+                parts[-1] += f" (failed: {', '.join(failed[:5])}{more})"
+            parts.append(f"{len(self.columns)} columns")
+            where = ""
+            names = [_file_name(self.meta.get(w, ("",))[0]) for w in ("sweep", "geometry")]
+            if names[0]:
+                where += f" {names[0]!r}"
+            if names[1]:
+                where += f" on {names[1]!r}"
+            return f"<{kind}{where}: {', '.join(parts)}>"
+        except Exception:  # a repr never raises
+            return f"<{kind}>"
 
     @classmethod
     def from_solutions(
@@ -313,9 +378,27 @@ class Results:
         }
 
     def __getitem__(self, name: str) -> np.ndarray:
-        return self.columns[name]
+        try:
+            return self.columns[name]
+        except KeyError:
+            raise KeyError(f"no column {name!r} (results.keys() lists them)") from None
+
+    def __contains__(self, name: object) -> bool:
+        return name in self.columns
+
+    def keys(self):
+        """The columns' names, in the CSV's order (``dict(results)`` is the columns)."""
+        return self.columns.keys()
+
+    def __iter__(self):
+        # Not rows nor names: `pd.DataFrame(results)` or `list(results)` says what to use.
+        raise TypeError(
+            f"{type(self).__name__} is a table of columns: use results.to_pandas() for a "
+            "DataFrame, results.keys() for the columns' names, results[name] for one"
+        )
 
     def __len__(self) -> int:
+        """The number of steps (rows)."""
         return len(self.columns["step_index"])
 
     @property
@@ -323,16 +406,57 @@ class Results:
         return np.flatnonzero(~self.columns["solver_converged"])
 
     def to_pandas(self):
-        """The columns as a pandas DataFrame, one row per step; the units (mm, deg, ...)
-        in ``.attrs["units"]``; an undefined value (a blank CSV cell) is NaN."""
+        """The columns as a pandas DataFrame, one row per step, in the CSV's order and
+        with its values; the units (mm, deg, ...) in ``.attrs["units"]``; an undefined
+        value (a blank CSV cell) is NaN.
+
+        >>> frame = results.to_pandas()
+        >>> frame[["wheel_travel", "camber"]], frame.attrs["units"]["camber"]  # 'deg'
+        """
         from .export import results_frame
 
         return results_frame(self)
 
     def to_csv(self, path) -> None:
+        """The CSV that ``pin-susp sweep -o`` writes (docs/results.md), whole or not at all."""
         from .export import write_csv
 
         write_csv(self, path)
+
+    def plot(self, path, label: str | None = None) -> None:
+        """Draw the standard report — what ``pin-susp sweep --plot`` and ``pin-susp plot``
+        draw: a panel per metric against wheel travel (or the rack, or an axle's roll or
+        heave); of member_forces' table, the force report — into an image file, its
+        format from its ending (.png, .pdf, .svg).
+
+        ``label``: the name in the title (default: the sweep file's). Drawn from the
+        CSV's text (as the CLI draws it); a PinSuspError when no step converged.
+
+        >>> corner.run_sweep("examples/bump_steer.yaml").plot("report.png")
+        """
+        from .errors import PinSuspError
+        from .plots import check_image_path
+
+        check_image_path(path)  # before any work
+        if len(self) == 0 or not np.any(self.columns["solver_converged"]):
+            raise PinSuspError(f"{path}: no step converged: nothing to plot")
+        from .export import csv_text
+        from .plots import ResultsFile, report_figure, save_figure
+
+        name = _file_name(self.meta.get("sweep", ("",))[0]) or "results"
+        written = ResultsFile(name, raw=csv_text(self).encode())
+        if label is not None:
+            written.label = label
+        save_figure(report_figure([written]), path)
+
+
+def _file_name(source) -> str:
+    """A source's file name ('' for one that is no file: '<dict>', '<targets>')."""
+    if not source or str(source).startswith("<"):
+        return ""
+    from pathlib import Path
+
+    return Path(str(source)).name
 
 
 def _along(t: Target) -> str:

@@ -27,7 +27,8 @@ AXLE_POINTS = ("axle_inboard", "axle_outboard")
 COILOVER_POINTS = ("strut_top", "strut_bottom")
 PUSHROD_ROCKER_POINTS = ("pushrod_outboard", "pushrod_inboard", "rocker_axis_a", "rocker_axis_b")
 
-# Points computed from the upright's hardpoints and the wheel (spec/geometry.md).
+# Points computed from the upright's hardpoints and the wheel (docs/geometry.md, "Derived
+# points").
 DERIVED_POINTS = (
     "axle_midpoint",
     "wheel_center",
@@ -95,7 +96,11 @@ class Options:
 
 @dataclass(frozen=True)
 class Geometry:
-    """One suspension corner at its design condition, SI units, world frame."""
+    """One suspension corner at its design condition, SI units, world frame.
+
+    The model's numbers are in metres: ``hardpoints`` maps each point to its
+    (x, y, z) in m. ``hardpoints_mm`` reads them back in the file's mm.
+    """
 
     name: str
     side: str  # "left" | "right"
@@ -133,7 +138,7 @@ class Geometry:
 
     @property
     def sign(self) -> float:
-        """s = +1 for a left corner, −1 for a right one (spec/results.md)."""
+        """s = +1 for a left corner, −1 for a right one (docs/results.md)."""
         return 1.0 if self.side == "left" else -1.0
 
     @property
@@ -169,10 +174,64 @@ class Geometry:
         return self.mechanism.steering_points(self)
 
     def design_points(self) -> dict[str, np.ndarray]:
-        """Every hardpoint and derived point at the design condition."""
+        """Every hardpoint and derived point at the design condition (m)."""
         points = dict(self.hardpoints)
         points.update(wheel_points(points["axle_inboard"], points["axle_outboard"], self.wheel))
         return points
+
+    @property
+    def hardpoints_mm(self) -> dict[str, np.ndarray]:
+        """Each hardpoint's (x, y, z) in mm, as the file gives it (fresh arrays: the
+        model's own ``hardpoints`` are in m). Rounded to 1e-10 mm, so that the file's
+        numbers come back as written (m → mm alone is one ulp off for 1 % of them).
+        An as-set geometry's are the as-set points (a camber shim moves the upright's,
+        a length adjuster the trackrod's or pushrod's end); its ``drawn`` has the file's."""
+        return {name: to_mm(p) for name, p in self.hardpoints.items()}
+
+    def design_points_mm(self) -> dict[str, np.ndarray]:
+        """Every hardpoint and derived point (wheel centre, contact patch, ...) at the
+        design condition, in mm (as ``hardpoints_mm``)."""
+        return {name: to_mm(p) for name, p in self.design_points().items()}
+
+    def __repr__(self) -> str:
+        """One line: the file, the name and the choices that decide the mechanism."""
+        return summary_repr(
+            self,
+            lambda: (
+                self.source,
+                self.name,
+                self.type,
+                self.side,
+                self.steering,
+                "pushrod_rocker" if self.actuation == "pushrod_rocker" else "",
+                "" if self.spring == "none" else self.spring,
+                "as set" if self.drawn is not None else "",
+                f"{len(self.hardpoints)} hardpoints",
+            ),
+        )
+
+
+def to_mm(p_m: np.ndarray) -> np.ndarray:
+    """A point (or points) in m, in mm to 1e-10 mm: a number of the file (up to 10
+    decimals, within MAX_LENGTH_MM) comes back exactly as float() read it."""
+    return np.round(np.asarray(p_m, dtype=float) / MM, 10)
+
+
+def summary_repr(obj, parts) -> str:
+    """``<Kind 'file.yaml' 'name': part, part, ...>``, parts() giving (source, name,
+    *parts): one line that never raises — the file by its name only, the name when it
+    is not the file's, empty parts left out; ``<Kind>`` when parts() fails."""
+    kind = type(obj).__name__
+    try:
+        source, name, *shown = parts()
+        where = ""
+        if source and not str(source).startswith("<"):
+            where = f" {Path(str(source)).name!r}"
+        if name and (not where or str(name) != Path(str(source)).stem):
+            where += f" {str(name)!r}"
+        return f"<{kind}{where}: " + ", ".join(str(p) for p in shown if p) + ">"
+    except Exception:  # a repr never raises, even on a half-built object
+        return f"<{kind}>"
 
 
 def unit(v: np.ndarray) -> np.ndarray:

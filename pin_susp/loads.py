@@ -1,5 +1,5 @@
 """Quasi-static loads: the force in every member and joint at a solved pose
-(spec/loads.md).
+(docs/loads.md).
 
 At a pose q the closures' Jacobian J_c, the spring's row J_s (d length/dq of a
 coilover, d angle/dq of a torsion bar) and the rack's row J_r hold every
@@ -15,7 +15,7 @@ multilink's lower front link) follow from Pinocchio's inverse dynamics at rest
 (``rnea`` with v = a = 0 and no gravity) with the applied loads and the closure
 forces as external forces: ``data.f[j]`` is then the force the parent puts on
 the subtree through joint j. A pivot's two bushings share its force and moment
-(the axial part equally: spec/loads.md's convention); a wishbone whose only
+(the axial part equally: docs/loads.md's convention); a wishbone whose only
 load is its outboard ball joint is a pair of two-force legs.
 """
 
@@ -61,7 +61,7 @@ class AxleLoadCase:
 
 
 def load_cases(source, axle: bool = False) -> list:
-    """Read a load-case file (spec/loads.md): ``cases:`` a list of {name,
+    """Read a load-case file (docs/loads.md): ``cases:`` a list of {name,
     contact_patch: {fx, fy, fz}, wheel_center: {…}, moment: {mx, my, mz}}; for an
     axle (``axle``) each case's loads sit in ``left:`` and ``right:`` blocks."""
     data, name, _ = load_yaml(source)
@@ -128,12 +128,17 @@ def _load(value, key: str, r: Reader) -> float:
 
 
 def member_forces(corner, sweep, cases: list, solutions=None, results=None, progress=None):
-    """Every force column at every step of a sweep under every load case (spec/loads.md):
+    """Every force column at every step of a sweep under every load case (docs/loads.md):
     a Results with one row per step and case — ``step_index``, ``load_case``,
     ``loads_unbounded`` (1 at a toggle: the forces there are blank, not huge), the
     forces, then the sweep's own columns. ``corner``: a Corner, or an AxleModel (its
     columns suffixed _left/_right, the bar's ``torque_arb``); ``sweep``: a Sweep, path
-    or dict; ``cases``: LoadCases (AxleLoadCases) or a load-case file."""
+    or dict; ``cases``: LoadCases (AxleLoadCases) or a load-case file.
+
+    >>> forces = member_forces(corner, "examples/bump_steer.yaml", "examples/loads.yaml")
+    >>> forces.to_pandas()  # a DataFrame, a row per step and case, as the CSV has it
+    >>> forces.plot("forces.png")  # the force report, as `pin-susp loads --plot` draws it
+    """
     from .corner import Results
     from .sweep import load_sweep
 
@@ -734,7 +739,7 @@ def _skew(v: np.ndarray) -> np.ndarray:
 
 
 class SpringRates:
-    """The spring's force and the rates at the wheel along bump (spec/loads.md):
+    """The spring's force and the rates at the wheel along bump (docs/loads.md):
     ``spring_force`` (N, compression +) or ``spring_torque`` (N·m, a torsion bar's,
     + resisting bump) = preload + rate · deflection from design; ``wheel_rate`` =
     d(F·MR)/dz = rate·MR² + F·dMR/dz (N/mm), and ``ride_rate`` = wheel and tyre rate in

@@ -10,7 +10,7 @@ rad); NaN where the metric is undefined. The same code runs on
 The registry ``METRICS`` gives each column's name, unit, label, the
 conversion to output units and the drivers it has derivative columns for;
 it alone decides which columns a sweep writes and in what order.
-Definitions and signs follow spec/results.md: s = +1 left, −1 right; â =
+Definitions and signs follow docs/results.md: s = +1 left, −1 right; â =
 unit(axle_outboard − axle_inboard); k̂ = unit(UBJ − LBJ); WC = wheel centre,
 CP = contact patch.
 """
@@ -401,7 +401,7 @@ class Metric:
     """A column: name, output unit, label, function; ``drivers`` it has derivatives for.
 
     ``applies`` says whether the metric is defined for a corner; ``always_written``
-    columns appear (empty) even where it is not, as spec/results.md asks.
+    columns appear (empty) even where it is not, as docs/results.md asks.
     """
 
     name: str

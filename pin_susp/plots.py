@@ -1175,7 +1175,7 @@ def axle_drawing_figure(model, q=None, labels: bool = False, caption: str = "des
 
     The road is the line through both contact patches. Each side: its kingpin's
     ends to its FVIC (dashed) and its contact patch through the FVIC (dash-dot);
-    where the two contact-patch lines cross, the roll centre (spec/axle.md's
+    where the two contact-patch lines cross, the roll centre (docs/axle.md's
     ``roll_center_y``, ``roll_center_z``). An FVIC at infinity or further than 20 m
     is not drawn but noted (its contact-patch line still is, towards it); so is a
     roll centre further than that. ``labels``: the left corner's hardpoints and the

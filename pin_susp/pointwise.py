@@ -3,10 +3,10 @@
 It shares no kinematics with the Pinocchio path: the unknowns are the
 coordinates of the moving hardpoints (and the rack's displacement), the
 constraints are rigid-body distances between hardpoints of one part, the
-derived points are written again from spec/geometry.md. ``pin-susp
+derived points are written again from docs/geometry.md. ``pin-susp
 validate`` and the tests solve every step with it and compare.
 
-An axle (spec/axle.md) is both corners' formulations with their names
+An axle (docs/axle.md) is both corners' formulations with their names
 prefixed by side, one rack unknown that moves both trackrods' inboard ends,
 and the anti-roll bar's parts, droplinks and plane rows (:data:`ANTI_ROLL`).
 """

@@ -493,7 +493,7 @@ def axle_held(model) -> str:
     return f"each wheel centre's height{rack} held"
 
 
-# the axle's own columns, after each side's (spec/axle.md's names)
+# the axle's own columns, after each side's (docs/axle.md's names)
 AXLE_COLUMNS = (
     "body_roll",
     "camber_to_ground_left",
@@ -511,7 +511,7 @@ AXLE_COLUMNS = (
 
 
 class AxleSensitivity:
-    """d(column)/d(hardpoint coordinate) of an axle (spec/axle.md), exact.
+    """d(column)/d(hardpoint coordinate) of an axle (docs/axle.md), exact.
 
     Each side is its corner's HardpointSensitivity (the as-set corner): with each
     wheel centre's height and the rack held, the sides share nothing else, so a

@@ -464,7 +464,7 @@ def setup_sheet(
 
 # ---------------------------------------------------------------- an axle
 #
-# Each side of an axle is its corner (spec/axle.md): AxleModel applies each side's
+# Each side of an axle is its corner (docs/axle.md): AxleModel applies each side's
 # setup as the corner does, the rack held at design, and with the rack held the
 # sides share nothing else. So an axle's setup sheet, sensitivities and inverse
 # solve are each side's corner's; the axle adds its own static columns (track,

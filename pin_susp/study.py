@@ -1,4 +1,4 @@
-"""Studies: many variants of one geometry through one sweep, on Dask (spec/studies.md).
+"""Studies: many variants of one geometry through one sweep, on Dask (docs/studies.md).
 
 A study file names a geometry, a sweep and the hardpoint coordinates that vary
 (mm from design). Its variants come from a design of experiments (full
@@ -113,7 +113,7 @@ class Term:
 
 @dataclass
 class Study:
-    """A study file, read and checked (spec/studies.md)."""
+    """A study file, read and checked (docs/studies.md)."""
 
     source: str
     sha256: str | None
@@ -902,7 +902,7 @@ def run_study(
     progress=None,
     announce=None,
 ) -> Outcome:
-    """Run a study into ``outdir`` (spec/studies.md); see the module's docstring.
+    """Run a study into ``outdir`` (docs/studies.md); see the module's docstring.
 
     ``progress(done, total)`` after each batch; ``announce(text)`` for a line worth
     printing before the work (the Dask dashboard's address).

@@ -1,4 +1,4 @@
-"""study.png: the figure of a study (spec/studies.md).
+"""study.png: the figure of a study (docs/studies.md).
 
 ``study_figure`` draws, by the study's kind:
 

@@ -1,4 +1,4 @@
-"""Sweep file → targets per step (spec/sweep.md).
+"""Sweep file → targets per step (docs/sweep.md).
 
 A sweep speaks the file's units: target values in mm. Targets are paired by
 index (step i uses value i of every target), not a Cartesian product.

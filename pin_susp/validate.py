@@ -17,7 +17,7 @@ bump twist are checked too.
 The metrics are then computed from each engine's points and compared with
 pin_susp's, metric by metric and point by point.
 
-A corner or an axle (spec/axle.md) alike: what differs between them — their
+A corner or an axle (docs/axle.md) alike: what differs between them — their
 points, drivers, targets and columns — is a scope (:class:`CornerScope`,
 :class:`AxleScope`); the engines only see points and targets.
 """
@@ -248,7 +248,7 @@ class CornerScope:
 
 
 class AxleScope:
-    """An axle's (spec/axle.md): the drivers are each wheel centre's z and the rack
+    """An axle's (docs/axle.md): the drivers are each wheel centre's z and the rack
     (or each side's fixed toe link); a point is a Dual per side (its rates along
     that side's hub z, the other wheel and the rack held, and along the rack or its
     toe link's length), as axle_results takes them."""

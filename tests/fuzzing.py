@@ -55,7 +55,7 @@ GEOMETRY_FILES = (
 )
 BASES = {name: yaml.safe_load((EXAMPLES / name).read_text()) for name in GEOMETRY_FILES}
 
-# The geometry file's ``type:`` values (spec/mechanisms.md) and the steering each takes
+# The geometry file's ``type:`` values (docs/geometry.md) and the steering each takes
 # when config.steering is left out (the first of the mechanism's allowed values).
 MECHANISMS = ("double_wishbone", "macpherson", "multilink", "trailing_arm")
 DEFAULT_STEERING = {
@@ -351,7 +351,7 @@ STRUT_POINTS = {k: BASES["pushrod_rocker.yaml"]["hardpoints"][k] for k in (
 
 def _as_multilink(data) -> str:
     """A double wishbone rewritten as the multilink it is: each wishbone two links that
-    meet in its ball joint (spec/mechanisms.md: a valid corner, the same motion)."""
+    meet in its ball joint (docs/geometry.md: a valid corner, the same motion)."""
     hp = data.get("hardpoints")
     if not isinstance(hp, dict):
         return "as multilink (no hardpoints)"
@@ -1483,7 +1483,7 @@ WHEEL_MOUNTED += ("wheel_inboard", "wheel_outboard")
 
 def bodies(g) -> tuple[list[str], list[list[str]], list[Loop], list[Line]]:
     """(chassis points, rigid groups incl. rods, branch loops, point-on-line conditions)
-    of an as-set Geometry, per mechanism as spec/mechanisms.md describes it (written
+    of an as-set Geometry, per mechanism as docs/geometry.md describes it (written
     here, not read from pin_susp.mechanisms: an independent check). A loop's four
     points keep the sign of their chirality; a line (p, a, b) keeps p on the line
     through a and b, on a's design side."""

@@ -3,7 +3,7 @@
 ``PointwiseCorner`` wraps pin_susp.pointwise — hardpoint coordinates as
 unknowns, rigid distances, scipy least_squares — which shares no kinematics
 with the Pinocchio path. The shim assembly and the metrics are written again
-here from the reference article and spec/results.md.
+here from the reference article and docs/results.md.
 """
 
 from __future__ import annotations
@@ -42,7 +42,7 @@ class PointwiseCorner:
 
 
 def spec_metrics(p: dict[str, np.ndarray], s: float) -> dict[str, float]:
-    """camber, caster, kpi, toe, scrub, trail, half track as spec/results.md writes them."""
+    """camber, caster, kpi, toe, scrub, trail, half track as docs/results.md writes them."""
     a = p["axle_outboard"] - p["axle_inboard"]
     a = a / np.linalg.norm(a)
     lbj, ubj = p["lower_wishbone_outboard"], p["upper_wishbone_outboard"]

@@ -1,4 +1,4 @@
-"""The axle model (spec/axle.md): two corners composed on one chassis and one rack.
+"""The axle model (docs/axle.md): two corners composed on one chassis and one rack.
 
 Checked against the corner model, solved on its own: a mirrored axle in pure
 heave puts each side where the corner goes; in roll the left side is the

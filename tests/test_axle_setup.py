@@ -1,4 +1,4 @@
-"""`pin-susp setup` and `pin-susp sensitivity` on an axle (spec/axle.md, issue 13).
+"""`pin-susp setup` and `pin-susp sensitivity` on an axle (docs/axle.md, issue 13).
 
 Checked against independent computations: each side's setup sheet against its
 corner written out as a corner file (the right one mirrored); the inverse solve

@@ -1,4 +1,4 @@
-"""`pin-susp validate` on an axle (spec/axle.md): every step of an axle sweep re-solved
+"""`pin-susp validate` on an axle (docs/axle.md): every step of an axle sweep re-solved
 by the point-based formulation — both corners' points as unknowns, one rack unknown
 for both trackrods, the U-bar's arm ends on circles about the bar's axis, the T-bar's
 crossbar a rigid triangle with its pivot and its midpoint in y = 0, rigid droplinks,

@@ -1,4 +1,4 @@
-"""Member forces (spec/loads.md), against computations that share nothing with the
+"""Member forces (docs/loads.md), against computations that share nothing with the
 multipliers: the upright's free body written from the solved points, and virtual
 work through a re-solved pose."""
 

@@ -1,4 +1,4 @@
-"""The mechanisms of spec/mechanisms.md — MacPherson, multilink, trailing arm, and the
+"""The mechanisms of docs/geometry.md — MacPherson, multilink, trailing arm, and the
 double wishbone beside them — each checked against a computation written here.
 
 Nothing is checked against pin_susp's own output read back: the references are a
@@ -133,7 +133,7 @@ def test_open_kinematics_macpherson_file_loads_unchanged_with_its_design_values(
     assert m["kpi"] == pytest.approx(np.degrees(np.arctan2(200.0, 650.0)), abs=1e-12)
     assert m["damper_length"] == pytest.approx(np.sqrt(26**2 + 130**2 + 422.5**2), abs=1e-12)
     # open-kinematics' printed values. Its caster, atan(40/650) = 3.52145°, is quoted as
-    # 3.522° in spec/mechanisms.md: that is 3.5215 rounded a second time, so it is held
+    # 3.522° in docs/geometry.md: that is 3.5215 rounded a second time, so it is held
     # to the four digits that round to it.
     assert round(m["kpi"], 3) == 17.103
     assert round(m["damper_length"], 2) == 442.81

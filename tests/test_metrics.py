@@ -1,4 +1,4 @@
-"""Metrics as spec/results.md defines them: symmetry, invariance, hand values."""
+"""Metrics as docs/results.md defines them: symmetry, invariance, hand values."""
 
 import copy
 
@@ -231,5 +231,5 @@ def test_motion_ratio_has_one_sign_convention_for_coilover_and_torsion_bar():
     swapped = pin_susp.Corner(_torsion_bar(True)).run_sweep(sweep)
     assert coil["motion_ratio"][16] > 0 and bar["motion_ratio"][16] > 0  # bump loads both
     np.testing.assert_allclose(swapped["motion_ratio"], bar["motion_ratio"], rtol=0, atol=1e-12)
-    # the twist itself keeps its spec sign, which the a→b order flips
+    # the twist itself keeps its documented sign (docs/results.md), which the a→b order flips
     np.testing.assert_allclose(swapped["torsion_bar_twist"], -bar["torsion_bar_twist"], atol=1e-9)

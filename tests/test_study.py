@@ -1,4 +1,4 @@
-"""Studies (spec/studies.md): variants, their rows against direct sweeps, Monte Carlo
+"""Studies (docs/studies.md): variants, their rows against direct sweeps, Monte Carlo
 against the first-order prediction, the bump-steer optimisation, bad input."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Studies on a real Dask cluster (spec/studies.md, behaviour): a scheduler and two workers
+"""Studies on a real Dask cluster (docs/studies.md, behaviour): a scheduler and two workers
 started here as processes on 127.0.0.1, a worker killed mid-study, a run interrupted and
 resumed, and a scheduler that is not there. The reference is always the serial run
 (``--scheduler none``, in this process): every other run must equal it bit for bit."""

@@ -1,4 +1,4 @@
-"""study.png (spec/studies.md "Outputs"): Monte Carlo histograms with the first-order
+"""study.png (docs/studies.md "Outputs"): Monte Carlo histograms with the first-order
 prediction, DOE main effects, the optimiser's curves before and after; drawn from
 synthetic variants whose numbers are known, and once from a real run of the CLI."""
 

@@ -1,4 +1,4 @@
-"""The five-link corner: the upright held by five rigid links (spec/mechanisms.md).
+"""The five-link corner: the upright held by five rigid links (docs/geometry.md).
 
 | body             | joint to parent                                          |
 |------------------|----------------------------------------------------------|
