@@ -176,3 +176,59 @@ def test_the_loop_of_a_pivot_on_the_lbj_is_guarded_by_its_other_crank(tmp_path):
     assert not _on_branches(solver, flipped.q[None])  # the batched check
     solver.set_targets(values[35])
     assert solver.newton(flipped.q).branch == "upper_ball_joint"  # the step-by-step one
+
+
+def test_an_axle_with_the_pivot_on_the_lbj_guards_both_uprights(tmp_path, capsys):
+    """The axle's corners (prefixed by side) keep the fallback: both upper ball joints
+    are guarded by the lower pivot's plane, and a heave sweep's converged steps keep
+    the design's sign on both sides (from the CSV's points)."""
+    from pin_susp.axle import AxleModel, load_axle
+
+    data = yaml.safe_load((EXAMPLES / "axle_front.yaml").read_text())
+    data["hardpoints"]["left"][PIVOTS[0]] = dict(LBJ)  # the right side mirrors the left
+    path = tmp_path / "axle.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    model = AxleModel(load_axle(path))
+    for side in ("left", "right"):
+        loop = next(b for b in model.branches if b.name == f"{side}_upper_ball_joint")
+        assert not loop.degenerate
+        assert loop.points[-1].name == f"{side}_lower_wishbone_outboard"
+    sweep = tmp_path / "heave.yaml"
+    sweep.write_text(
+        yaml.safe_dump(
+            {
+                "version": 1,
+                "steps": 41,
+                "targets": [
+                    {"quantity": "heave", "start": -40, "stop": 60},
+                    {"quantity": "roll", "start": 0, "stop": 0},
+                    {
+                        "point": "trackrod_inboard",
+                        "side": "left",
+                        "direction": {"axis": "y"},
+                        "start": -10,
+                        "stop": 10,
+                    },
+                ],
+            }
+        )
+    )
+    out = tmp_path / "axle.csv"
+    assert main(["sweep", str(path), str(sweep), "-o", str(out), "-q"]) == 1
+    columns = read_csv(out)
+    ok = columns["solver_converged"] == 1.0
+    assert ok.sum() >= 10 and not ok[35:].any()
+    names = (  # the side of the plane (lower pivot axis, UBJ) the LBJ is on
+        "lower_wishbone_inboard_front",
+        "lower_wishbone_inboard_rear",
+        "upper_wishbone_outboard",
+        "lower_wishbone_outboard",
+    )
+    for side, mirror in (("left", 1.0), ("right", -1.0)):  # the right: y negated
+        at = [np.column_stack([columns[f"{side}_{n}_{a}"] for a in "xyz"]) for n in names]
+        drawn = data["hardpoints"]["left"]
+        design = volume(
+            *(np.array([[drawn[n]["x"], mirror * drawn[n]["y"], drawn[n]["z"]]]) for n in names)
+        )
+        assert abs(design[0]) > 1e4
+        assert np.all(volume(*at)[ok] * design[0] > 0.0), side
