@@ -71,6 +71,7 @@ def prefixed(tree: Tree, side: str) -> Tree:
             anchors=tuple((link(a), p) for a, p in c.anchors),
             points=tuple(point(n) for n in c.points),
             branch=tuple(point(n) for n in c.branch),
+            branch_fallback=tuple(point(n) for n in c.branch_fallback),
         )
         for c in tree.closures
     ]

@@ -187,21 +187,44 @@ class LoopBranch:
     apart; it is fixed at the design state. Crossing zero is passing the
     loop's toggle (lock-up): a Newton step that lands on the other sign has
     found the other assembly, however small its residual.
+
+    ``fallback``: four more points telling the same assemblies apart (the loop seen
+    from its other crank), kept instead when ``points``' measure vanishes at design
+    (three of them on a line: a pivot placed on the other ball joint), so that such
+    a design's loop is still guarded (pick_branch).
     """
 
     # |chirality| at design below this: the loop sits at its toggle, no side to keep
     DEGENERATE = 1e-6
 
-    def __init__(self, name: str, points: list, kin: Kinematics, kind: str = "chirality"):
+    def __init__(
+        self, name: str, points: list, kin: Kinematics, kind: str = "chirality", fallback=()
+    ):
         self.name = name
-        self.points = points
         self.measure = MEASURES[kind]  # or "alignment": a point's side along a line
-        value = self.chirality(kin)
+        candidates = [list(c) for c in (points, fallback) if c]
+        self.points, value = pick_branch(
+            candidates, self.measure, lambda p: p.position(kin).tolist()
+        )
         self.sign = math.copysign(1.0, value)
         self.degenerate = abs(value) < self.DEGENERATE
 
     def chirality(self, kin: Kinematics) -> float:
         return self.measure(*(p.position(kin).tolist() for p in self.points))
+
+
+def pick_branch(candidates: list, measure, position) -> tuple:
+    """The first of a loop's point sets (``candidates``) whose ``measure`` at design
+    (``position(point)``) is clear of zero, and that value; the first set when none is
+    (the loop sits at its toggle: no side to keep)."""
+    first = None
+    for points in candidates:
+        value = measure(*(position(p) for p in points))
+        if abs(value) >= LoopBranch.DEGENERATE:
+            return points, value
+        if first is None:
+            first = points, value
+    return first
 
 
 class BranchGuard:

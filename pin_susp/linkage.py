@@ -66,7 +66,13 @@ class Built:
                 length = float(np.linalg.norm(b.position(self.kin) - a.position(self.kin)))
                 self.closures.append(DistanceClosure(spec.name, a, b, length))
         self.branches = [
-            LoopBranch(c.name, [self.points[n] for n in c.branch], self.kin, c.branch_kind)
+            LoopBranch(
+                c.name,
+                [self.points[n] for n in c.branch],
+                self.kin,
+                c.branch_kind,
+                [self.points[n] for n in c.branch_fallback],
+            )
             for c in tree.closures
             if c.branch
         ]

@@ -28,6 +28,11 @@ Y = np.array([0.0, 1.0, 0.0])
 Z = np.array([0.0, 0.0, 1.0])
 SIDES = ("left", "right")
 WHEEL_POINTS = ("axle_midpoint", "wheel_center", "wheel_inboard", "wheel_outboard")
+# Residual evaluations a solve may take. A reachable step from the design state takes
+# at most 8 on every example (a closed pose is a root: Levenberg-Marquardt converges
+# as Newton does); a step out of reach has no root, and with tolerances of 1e-15 scipy's
+# own limit, 100 per unknown, made it run on for 6100 evaluations on an axle (8 s a step).
+MAX_EVALUATIONS = 100
 
 
 # ---------------------------------------------------------------- targets
@@ -301,6 +306,7 @@ class PointwiseLinkage:
             xtol=1e-15,
             ftol=1e-15,
             gtol=1e-15,
+            max_nfev=MAX_EVALUATIONS,
         )
         return sol.x, float(np.max(np.abs(sol.fun)))
 

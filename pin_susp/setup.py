@@ -25,7 +25,14 @@ from dataclasses import dataclass, replace
 import numpy as np
 import pinocchio as pin
 
-from .closures import MEASURES, DistanceClosure, JointTarget, LoopBranch, PointTarget
+from .closures import (
+    MEASURES,
+    DistanceClosure,
+    JointTarget,
+    LoopBranch,
+    PointTarget,
+    pick_branch,
+)
 from .errors import InputError
 from .geometry import MM, Geometry, load_geometry
 from .jet import Dual
@@ -70,8 +77,8 @@ def _check_branches(drawn: Geometry, hardpoints: dict[str, np.ndarray], key: str
         if not loop.branch:
             continue
         measure = MEASURES[loop.branch_kind]
-        before = measure(*(drawn.hardpoints[n] for n in loop.branch))
-        after = measure(*(hardpoints[n] for n in loop.branch))
+        points, before = pick_branch(loop.branch_candidates, measure, lambda n: drawn.hardpoints[n])
+        after = measure(*(hardpoints[n] for n in points))
         if abs(before) >= LoopBranch.DEGENERATE and before * after <= 0.0:
             raise InputError(
                 drawn.source,

@@ -191,7 +191,9 @@ class NewtonSolver:
         first = self.newton(q)
         if first.converged:
             return first
-        return self._continuation(q, start, goal, SUBDIVISIONS, first.iterations, first)
+        return explained(
+            self._continuation(q, start, goal, SUBDIVISIONS, first.iterations, first), first
+        )
 
     def _continuation(self, q, start, goal, depth, spent, fallback) -> Solution:
         if depth == 0:
@@ -214,6 +216,15 @@ class NewtonSolver:
             spent = full.iterations
         full.iterations = spent
         return full
+
+
+def explained(failed: Solution, attempt: Solution | None) -> Solution:
+    """A step that did not converge, explained: when an ``attempt`` at the same targets
+    met the residual on another assembly branch, that is the reason (the continuation's
+    own failure, a residual part-way, says less); its iterations are the step's total."""
+    if failed.converged or failed.branch is not None or attempt is None or attempt.branch is None:
+        return failed
+    return Solution(attempt.q, False, failed.iterations, attempt.max_residual, attempt.branch)
 
 
 def _solve(J: np.ndarray, b: np.ndarray) -> np.ndarray | None:
@@ -277,13 +288,20 @@ def march(
     with np.errstate(invalid="ignore", divide="ignore"):  # a singular J: NaN, handled
         for i in range(n):
             started = clock()
-            solution = None
-            guess = predictor.guess(values[i], bool(repeats[i]) and predictor.before is not None)
+            solution = guessed = None
+            # After a failed step the predictor's last solution is not the step before:
+            # its step is no repeat (the parabola would assume one), and the guess is
+            # checked like any other solution — on the design branch or refused.
+            follows = i == 0 or solutions[-1].converged
+            repeat = follows and bool(repeats[i]) and predictor.before is not None
+            guess = predictor.guess(values[i], repeat)
             if guess is not None:  # one Newton iteration from a good guess, usually
                 solver.set_targets(values[i])
-                solution = solver.newton(guess)
+                solution = guessed = solver.newton(guess)
             if solution is None or not solution.converged:
-                solution = solver.solve(q, previous, values[i])
+                solution = explained(solver.solve(q, previous, values[i]), guessed)
+                if guessed is not None:
+                    solution.iterations += guessed.iterations
             tangent = None
             if solution.converged:
                 q, previous = solution.q, values[i]

@@ -118,6 +118,15 @@ class Closure:
     # branch_kind "alignment": the sign of (b − a)·(d − c) instead.
     branch: tuple[str, str, str, str] | tuple[()] = ()
     branch_kind: str = "chirality"
+    # Four more points telling the same two assemblies apart (with the same kind), used
+    # when ``branch``'s measure vanishes at design — e.g. a pivot placed on the other
+    # ball joint: its plane is undefined, yet the loop still has two assemblies.
+    branch_fallback: tuple[str, str, str, str] | tuple[()] = ()
+
+    @property
+    def branch_candidates(self) -> list[tuple[str, ...]]:
+        """The branch's point sets in order of preference (closures.pick_branch)."""
+        return [b for b in (self.branch, self.branch_fallback) if b]
 
 
 @dataclass(frozen=True)

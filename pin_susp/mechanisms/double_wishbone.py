@@ -234,6 +234,15 @@ def tree(g) -> Tree:
             ((UBJ, p[UBJ]), ("upright", p[UBJ])),
             (UBJ, UBJ),
             branch=("upper_wishbone_inboard_front", "upper_wishbone_inboard_rear", LBJ, UBJ),
+            # an upper pivot on the LBJ leaves that plane undefined: the LBJ's circle
+            # about the lower pivot meets the upright's sphere about the UBJ on either
+            # side of the plane (lower pivot axis, UBJ) — the upright upside down
+            branch_fallback=(
+                "lower_wishbone_inboard_front",
+                "lower_wishbone_inboard_rear",
+                UBJ,
+                LBJ,
+            ),
         ),
         steering_link(g, p, (LBJ, UBJ, inner, outer)),
     ]
