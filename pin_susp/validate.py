@@ -126,17 +126,18 @@ class Branches:
     point-based solve, which only keeps distances, can mirror one)."""
 
     def __init__(self, tree):
-        from .closures import MEASURES, LoopBranch, chirality
+        from .closures import MEASURES, LoopBranch, chirality, pick_branch
         from .deadcentre import _point_name
 
         design = {name: p.tolist() for name, (_, p) in tree.points.items()}
         self.checks = []  # (what flipped, measure, four point names, sign at design)
         for c in tree.closures:
-            if c.branch and all(n in design for n in c.branch):
+            candidates = [b for b in c.branch_candidates if all(n in design for n in b)]
+            if candidates:  # the solver's own choice of points (its fallback included)
                 measure = MEASURES[c.branch_kind]
-                v = measure(*(design[n] for n in c.branch))
+                names, v = pick_branch(candidates, measure, design.__getitem__)
                 if abs(v) >= LoopBranch.DEGENERATE:
-                    self.checks.append((f"the {c.name} loop", measure, c.branch, np.sign(v)))
+                    self.checks.append((f"the {c.name} loop", measure, names, np.sign(v)))
         on = {}
         for name, (body, _) in tree.points.items():
             on.setdefault(body, []).append(name)
