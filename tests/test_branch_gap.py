@@ -232,3 +232,14 @@ def test_an_axle_with_the_pivot_on_the_lbj_guards_both_uprights(tmp_path, capsys
         )
         assert abs(design[0]) > 1e4
         assert np.all(volume(*at)[ok] * design[0] > 0.0), side
+
+
+def test_validate_says_an_engine_on_the_flipped_assembly_lands_on_another_branch(tmp_path, capsys):
+    """MuJoCo closes step 21 of the pivot-on-LBJ corner with the upright flipped over:
+    validate checks its points with the loop's own points, fallback included."""
+    pytest.importorskip("mujoco")
+    path, _ = pivot_on_lbj(tmp_path, PIVOTS[0])
+    assert main(["validate", str(path), str(EXAMPLES / "bump_steer.yaml")]) == 1
+    out = capsys.readouterr().out
+    assert "mujoco: lands on another assembly branch at steps 21," in out, out
+    assert "(the upper_ball_joint loop)" in out and "DISAGREES" not in out
