@@ -919,7 +919,8 @@ class Digest:
         self.flipped = Steps()  # on another assembly branch
         self.loops: set[str] = set()  # the loops that flipped
         self.band: dict[str, list] = {}  # side → [Steps outside, worst step, its angle]
-        self.unseat: dict[str, list] = {}  # side → [Steps below zero, least force]
+        # side → [Steps below zero, least force, those in droop (or at design), in bump]
+        self.unseat: dict[str, list] = {}
 
     @classmethod
     def of(cls, results) -> Digest:
@@ -971,9 +972,17 @@ class Digest:
                         band[1], band[2] = int(steps[worst]), float(angle[worst])
             force = results.columns.get(f"spring_force{suffix}")
             if force is not None and np.nanmin(force, initial=np.inf) < 0.0:
-                unseat = self.unseat.setdefault(side, [Steps(), np.inf])
-                unseat[0].add(steps[np.flatnonzero(force < 0.0)])
+                unseat = self.unseat.setdefault(side, [Steps(), np.inf, Steps(), Steps(), False])
+                below = force < 0.0
+                unseat[0].add(steps[np.flatnonzero(below)])
                 unseat[1] = min(unseat[1], float(np.nanmin(force)))
+                travel = results.columns.get(f"wheel_travel{suffix}")
+                bump = below & (travel > 0.0) if travel is not None else np.zeros_like(below)
+                unseat[2].add(steps[np.flatnonzero(below & ~bump)])  # droop, or at design
+                unseat[3].add(steps[np.flatnonzero(bump)])
+                ratio = results.columns.get(f"motion_ratio{suffix}")
+                if ratio is not None:  # extending in bump: past over-centre
+                    unseat[4] |= bool(np.any(bump & (ratio <= 0.0)))
 
     def _column(self, name: str, v, steps) -> None:
         import numpy as np
@@ -1051,11 +1060,25 @@ def _warn_transmission(results) -> None:
                 stacklevel=2,
             )
         if side in d.unseat:
-            steps, least = d.unseat[side]
+            steps, least, droop, bump, over_centre = d.unseat[side]
+            advice = []
+            if droop.count:  # it extends as the wheel drops: the preload runs out
+                where = f" in droop (steps {droop})" if bump.count else ""
+                advice.append(f"{where}: more preload, or limit the droop travel (a droop limiter)")
+            if bump.count:
+                where = f"; in bump (steps {bump})" if droop.count else " (in bump)"
+                if over_centre:  # it should compress in bump: its motion ratio has turned
+                    why = (
+                        "the spring extends as the wheel rises there (motion_ratio <= 0: a "
+                        "rocker past over-centre, or one that works the spring the wrong "
+                        "way; check the pushrod and rocker) — droop is not the cause"
+                    )
+                else:  # compressing, yet below zero: it starts below zero (the preload)
+                    why = "more preload: the spring compresses in bump here, it starts too low"
+                advice.append(f"{where}: {why}")
             warnings.warn(
                 f"{side}spring force below zero at steps {steps} "
-                f"(least {least:.0f} N): the spring would unseat there — more "
-                "preload, or less droop",
+                f"(least {least:.0f} N): the spring would unseat there" + "".join(advice),
                 PlausibilityWarning,
                 stacklevel=2,
             )
