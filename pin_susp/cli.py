@@ -359,6 +359,8 @@ def _loads(args) -> int:
             f"wrote {args.output}: {len(results)} steps x {len(cases)} load cases"
             + (f"; {unbounded} row(s) at a toggle (forces unbounded: blank)" if unbounded else "")
         )
+        for note in results.meta.get("notes", ()):
+            print(f"  {note}")
         _force_summary(forces)
         if plot:
             print(f"wrote {args.plot}")
@@ -590,7 +592,7 @@ def _pose_at(corner, at: str) -> dict:
         "urdf_robot": corner.tree.name,
         "sweep": sweep.source,
         "step": i,
-        "targets": {t.point: float(t.values[i]) for t in sweep.targets},
+        "targets": {t.point: float(t.values[i]) for t in corner.held_targets(sweep.targets)},
         "joints": joints,
     }
 
@@ -921,6 +923,7 @@ class Digest:
         self.band: dict[str, list] = {}  # side → [Steps outside, worst step, its angle]
         # side → [Steps below zero, least force, those in droop (or at design), in bump]
         self.unseat: dict[str, list] = {}
+        self.notes: list[str] = []  # how the sweep's targets were read (the rack held)
 
     @classmethod
     def of(cls, results) -> Digest:
@@ -946,6 +949,9 @@ class Digest:
         self.iterations += [0] * (len(counts) - len(self.iterations))
         for i, count in enumerate(counts):
             self.iterations[i] += count
+        for note in results.meta.get("notes", ()):
+            if note not in self.notes:
+                self.notes.append(note)
         why = results.meta["why"]
         for i in np.flatnonzero(~ok):
             if "branch" in why[i]:
@@ -1025,6 +1031,8 @@ def _summary(results, path) -> None:
         f"max residual {d.max_residual:.1e} mm, "
         f"{d.iterations_median:g} iterations per step (median)"
     )
+    for note in d.notes:
+        print(f"  {note}")
     print(f"  {'metric':<32}{'unit':>7}{'first':>13}{'last':>13}{'min':>13}{'max':>13}")
     blank = []
     for name, (first, last, low, high, far, _) in d.stats.items():

@@ -21,6 +21,7 @@ from .solver import NewtonSolver, Solution, march
 from .sweep import Sweep, Target, check_held, load_sweep
 
 CHUNK = 10_000  # steps solved and written at a time by a streamed sweep
+RACK_HELD = "rack held at design (the sweep gives no rack target)"
 
 
 class Corner(Linkage):
@@ -61,11 +62,31 @@ class Corner(Linkage):
             value = columns[m.name][0][0]
             warn_outside(f"{self.geometry.source}: design {m.name}", value, *m.plausible, m.unit)
 
+    def held_targets(self, targets: list[Target]) -> list[Target]:
+        """The targets a sweep's steps hold: its own, and on a rack-steered corner whose
+        sweep gives every target but the rack's (a bump-only sweep) the rack held at
+        design (rack_displacement 0; ``sweep_notes`` says so). Every other set of targets
+        as given (checked by ``solver_for``)."""
+        targets = list(targets)
+        if not self.actuators or len(targets) != self.mobility - 1:
+            return targets
+        if any(t.point in self.points and self.body_of(t.point) == "rack" for t in targets):
+            return targets
+        if any(t.quantity is not None or t.side is not None for t in targets):
+            return targets  # an axle's targets: refused by _check_targets
+        steps = len(targets[0].values) if targets else 1
+        return [*targets, Target(self.geometry.steering_points[0], "y", np.zeros(steps))]
+
+    def sweep_notes(self, targets: list[Target]) -> list[str]:
+        """What the summary says of how the sweep's targets were read."""
+        return [RACK_HELD] if len(self.held_targets(targets)) > len(targets) else []
+
     def drive_order(self, targets: list[Target]) -> list[int] | None:
         """Which target is which driver, when the targets are exactly the drivers
         (wheel-centre z, then the rack along y, in any order); None otherwise."""
         if TOE_LINK in self.drivers:  # a driver no sweep target is: motion() solves it
             return None
+        targets = self.held_targets(targets)
         wanted = [Target("wheel_center", "z").key]
         if self.geometry.steering == "rack":
             wanted.append(Target(self.geometry.steering_points[0], "y").key)
@@ -75,7 +96,9 @@ class Corner(Linkage):
         return [have.index(w) for w in wanted]
 
     def solver_for(self, targets: list[Target], source: str = "<targets>") -> NewtonSolver:
-        """Check targets against this mechanism and build the Newton solver."""
+        """Check targets against this mechanism and build the Newton solver (the rack
+        held at design where a rack corner's sweep gives no rack target)."""
+        targets = self.held_targets(targets)
         self._check_targets(targets, source)
         rows = [PointTarget(self.points[t.point], t.unit_direction) for t in targets]
         solver = NewtonSolver(self.kin, self.closures, rows, self.branches)
@@ -93,9 +116,10 @@ class Corner(Linkage):
         return solver
 
     def target_values(self, targets: list[Target]) -> np.ndarray:
-        """Absolute target values (m), one row per step, one column per target."""
+        """Absolute target values (m), one row per step, one column per held target
+        (``held_targets``)."""
         cols = []
-        for t in targets:
+        for t in self.held_targets(targets):
             values = np.asarray(t.values, dtype=float) * 1e-3
             if t.mode == "relative":
                 values = values + self.design_positions[t.point] @ t.unit_direction
@@ -235,7 +259,10 @@ class Corner(Linkage):
         moving_rack = [i for i, t in enumerate(targets) if self.body_of(t.point) == "rack"]
         if len(targets) != self.mobility:
             if self.actuators:
-                what = "bump and steer: a wheel target and one trackrod_inboard target along y"
+                what = (
+                    "bump and steer: a wheel target and one trackrod_inboard target along y; "
+                    "a wheel target alone holds the rack at design"
+                )
             elif self.geometry.steering_points:
                 what = "bump: one wheel target (the fixed toe link leaves no steer)"
             else:
@@ -287,7 +314,9 @@ class Results:
             if only is None or name in only:
                 columns[name], units[name] = values, column_unit
         geometry = (corner.geometry.source, corner.geometry.sha256)
-        return cls(columns, units, cls.solver_meta(solutions, geometry, sweep))
+        meta = cls.solver_meta(solutions, geometry, sweep)
+        meta["notes"] = corner.sweep_notes(sweep.targets)
+        return cls(columns, units, meta)
 
     @staticmethod
     def solver_columns(solutions: list[Solution]) -> tuple[dict, dict]:

@@ -1,6 +1,7 @@
 """Inputs a user trips on (issue 24, point 6): the tyre's one key, a camber target
 without a shim, the spring-unseating advice, a bump-only sweep on a rack corner."""
 
+import numpy as np
 import pytest
 import yaml
 from conftest import EXAMPLES, example
@@ -204,3 +205,71 @@ def test_every_command_line_in_the_docs_parses():
             if exc.code:
                 bad.append(f"{name}: {line}: {err.getvalue().strip()}")
     assert not bad, "\n".join(bad)
+
+
+def bump_only(steps: int) -> dict:
+    return {"steps": steps, "targets": [
+        {"point": "wheel_center", "direction": {"axis": "z"}, "start": -30, "stop": 30}
+    ]}  # fmt: skip
+
+
+def rack_held(steps: int) -> dict:
+    s = bump_only(steps)
+    s["targets"].append(
+        {"point": "trackrod_inboard", "direction": {"axis": "y"}, "start": 0, "stop": 0}
+    )
+    return s
+
+
+@pytest.mark.parametrize("steps", [21, 400])  # step by step, and the batched long sweep
+def test_a_bump_only_sweep_on_a_rack_corner_holds_the_rack_at_design(corner, steps):
+    """The same rows as the sweep that holds the rack at 0 itself, on both solve paths."""
+    own = corner.run_sweep(bump_only(steps))
+    held = corner.run_sweep(rack_held(steps))
+    assert own.columns.keys() == held.columns.keys()
+    for name, values in held.columns.items():
+        np.testing.assert_allclose(own[name], values, rtol=0, atol=1e-9, err_msg=name)
+    assert np.all(own["rack_displacement"] == 0.0) and own["solver_converged"].all()
+    assert own.meta["notes"] == ["rack held at design (the sweep gives no rack target)"]
+    assert held.meta["notes"] == []
+
+
+def test_the_summary_says_the_rack_was_held(tmp_path, capsys):
+    sweep = write(tmp_path / "bump.yaml", bump_only(11))
+    out = tmp_path / "r.csv"
+    geometry = str(EXAMPLES / "double_wishbone.yaml")
+    assert main(["sweep", geometry, str(sweep), "-o", str(out)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[1] == "  rack held at design (the sweep gives no rack target)"
+    assert main(["sweep", geometry, str(EXAMPLES / "bump_rack_held.yaml"), "-o", str(out)]) == 0
+    assert "rack held" not in capsys.readouterr().out
+    cases = str(EXAMPLES / "loads.yaml")
+    rocker = str(EXAMPLES / "pushrod_rocker.yaml")
+    assert main(["loads", rocker, str(sweep), "--cases", cases, "-o", str(out)]) == 0
+    assert "  rack held at design (the sweep gives no rack target)" in capsys.readouterr().out
+
+
+def test_a_bump_only_sweep_validates_and_differentiates_with_the_rack_held(corner):
+    """The pointwise re-solve (scipy on the points) holds the rack too and agrees; the
+    hardpoint sensitivities are those with the rack's own target."""
+    from pin_susp.sensitivity import hardpoint_sensitivities
+    from pin_susp.sweep import load_sweep
+    from pin_susp.validate import validate
+
+    results, (report,) = validate(corner, load_sweep(bump_only(5)), engines=("pointwise",))
+    assert not report.note and not report.failed_steps and not report.disagree
+    assert report.differences["roadwheel_angle"] < 1e-9 and report.worst < 1e-6
+    np.testing.assert_array_equal(results["rack_displacement"], 0.0)
+    sa = hardpoint_sensitivities(corner, bump_only(3))
+    sb = hardpoint_sensitivities(corner, rack_held(3))
+    for x, y in zip(sa, sb, strict=True):
+        for name, v in y.values.items():
+            np.testing.assert_allclose(x.values[name], v, atol=1e-12, err_msg=name)
+
+
+def test_a_rack_corner_still_refuses_a_sweep_of_the_rack_alone(tmp_path, corner):
+    steer = {"steps": 3, "targets": [
+        {"point": "trackrod_inboard", "direction": {"axis": "y"}, "start": -5, "stop": 5}
+    ]}  # fmt: skip
+    with pytest.raises(InputError, match="a wheel target alone holds the rack at design"):
+        corner.run_sweep(steer)
