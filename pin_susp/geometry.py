@@ -524,9 +524,9 @@ def _wheel(value, r: Reader) -> Wheel:
     given = [k for k in ("tyre", "tire") if k in w]
     if not given:
         r.fail(
-            "config.wheel.tyre",
-            "missing key: the tyre's size {aspect_ratio, section_width, rim_diameter} "
-            "and, for the ride rate, its rate (tire: is read as a synonym)",
+            "config.wheel.tire",
+            "missing key: the tyre, as tire: or tyre: (one key, either spelling) with its "
+            "size {aspect_ratio, section_width, rim_diameter} and, for the ride rate, its rate",
         )
     tyre, keys = {}, {}
     for name in given:

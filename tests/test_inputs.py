@@ -59,7 +59,7 @@ def test_a_missing_size_names_the_block_and_its_synonym(tmp_path):
     text = read_error(wheel(tmp_path, tyre={"rate": 120}))
     assert "config.wheel.tyre.aspect_ratio: missing key" in text and "tire:" in text
     text = read_error(wheel(tmp_path))
-    assert "config.wheel.tyre: missing key" in text and "tire:" in text
+    assert "config.wheel.tire: missing key: the tyre, as tire: or tyre:" in text
 
 
 def test_an_unknown_tyre_key_lists_the_size_and_the_rate(tmp_path):
