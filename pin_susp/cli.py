@@ -330,7 +330,9 @@ def _loads_command(sub) -> None:
         "quasi-static "
         "forces under each load case of CASES (README, Loads and rates): the tension in every "
         "two-force member (wishbone legs, trackrod or toe link, pushrod, links), the "
-        "spring's force, the rack's, and the load at every ball joint and pivot bushing. "
+        "spring's force, the rack's, and the load at every ball joint and pivot bushing "
+        "(a wishbone's also along each leg: a wishbone carrying the pushrod is no "
+        "two-force member, its legs blank and said so). "
         "One CSV row per step and case, then the sweep's own columns. Exit code 1 if a "
         "step did not converge.",
     )
@@ -423,11 +425,19 @@ def _chosen_case(path, cases, name: str | None) -> str:
 
 
 def _force_summary(forces) -> None:
-    """The largest tension and compression of each member over the sweep, per case."""
+    """The largest tension and compression of each member over the sweep, per case; a
+    wishbone that is not a two-force member (it carries a pushrod, say) by its bushing
+    loads resolved along each leg, and said so."""
     import numpy as np
 
+    bent = forces.meta.get("not_two_force", {})
+    stand_in = {}  # a bent arm's blank leg → its bushing's load along the leg
+    for _, legs, alongs in bent.values():
+        stand_in.update(zip(legs, alongs, strict=True))
     names = [n for n in forces.columns if n.startswith(("force_", "torque_"))]
-    print(f"  {'member':36s} {'case':18s} {'min':>12s} {'max':>12s}")
+    names = [stand_in.get(n, n) for n in names]
+    width = max([36, *(len(n) for n in names)])
+    print(f"  {'member':{width}s} {'case':18s} {'min':>12s} {'max':>12s}")
     for case in dict.fromkeys(forces["load_case"]):
         rows = forces["load_case"] == case
         for name in names:
@@ -436,9 +446,15 @@ def _force_summary(forces) -> None:
                 continue
             unit = forces.units.get(name, "N")
             print(
-                f"  {name:36s} {str(case)[:18]:18s} {np.nanmin(values):12.1f} "
+                f"  {name:{width}s} {str(case)[:18]:18s} {np.nanmin(values):12.1f} "
                 f"{np.nanmax(values):12.1f} {unit}"
             )
+    for arm, (points, legs, alongs) in bent.items():
+        print(
+            f"  {arm}: not a two-force member (it also carries {', '.join(points)}): its "
+            f"legs bend, {' and '.join(legs)} are blank; {' and '.join(alongs)} are its "
+            "bushings' loads resolved along each leg (+ as a leg's tension)"
+        )
 
 
 def _is_axle(path) -> bool:
@@ -1839,8 +1855,9 @@ def _view(args) -> int:
             others = f"the first of {len(cases)}: --case NAME for another" * (
                 args.case is None and len(cases) > 1
             )
-            print(force_key(case, scale, others))
-            caption = force_caption(case, scale, Path(args.cases).name)
+            bent = bool(scene.not_two_force)
+            print(force_key(case, scale, others, bent))
+            caption = force_caption(case, scale, Path(args.cases).name, bent)
         frames = (
             scene.animate(qs, fps=args.fps, markers=markers, colours=colours)
             if qs is not None
