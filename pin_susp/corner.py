@@ -21,7 +21,6 @@ from .solver import NewtonSolver, Solution, march
 from .sweep import Sweep, Target, check_held, load_sweep
 
 CHUNK = 10_000  # steps solved and written at a time by a streamed sweep
-RACK_HELD = "rack held at design (the sweep gives no rack target)"
 
 
 class Corner(Linkage):
@@ -61,25 +60,6 @@ class Corner(Linkage):
                 continue
             value = columns[m.name][0][0]
             warn_outside(f"{self.geometry.source}: design {m.name}", value, *m.plausible, m.unit)
-
-    def held_targets(self, targets: list[Target]) -> list[Target]:
-        """The targets a sweep's steps hold: its own, and on a rack-steered corner whose
-        sweep gives every target but the rack's (a bump-only sweep) the rack held at
-        design (rack_displacement 0; ``sweep_notes`` says so). Every other set of targets
-        as given (checked by ``solver_for``)."""
-        targets = list(targets)
-        if not self.actuators or len(targets) != self.mobility - 1:
-            return targets
-        if any(t.point in self.points and self.body_of(t.point) == "rack" for t in targets):
-            return targets
-        if any(t.quantity is not None or t.side is not None for t in targets):
-            return targets  # an axle's targets: refused by _check_targets
-        steps = len(targets[0].values) if targets else 1
-        return [*targets, Target(self.geometry.steering_points[0], "y", np.zeros(steps))]
-
-    def sweep_notes(self, targets: list[Target]) -> list[str]:
-        """What the summary says of how the sweep's targets were read."""
-        return [RACK_HELD] if len(self.held_targets(targets)) > len(targets) else []
 
     def drive_order(self, targets: list[Target]) -> list[int] | None:
         """Which target is which driver, when the targets are exactly the drivers
