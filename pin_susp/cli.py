@@ -330,7 +330,9 @@ def _loads_command(sub) -> None:
         "quasi-static "
         "forces under each load case of CASES (README, Loads and rates): the tension in every "
         "two-force member (wishbone legs, trackrod or toe link, pushrod, links), the "
-        "spring's force, the rack's, and the load at every ball joint and pivot bushing. "
+        "spring's force, the rack's, and the load at every ball joint and pivot bushing "
+        "(a wishbone's also along each leg: a wishbone carrying the pushrod is no "
+        "two-force member, its legs blank and said so). "
         "One CSV row per step and case, then the sweep's own columns. Exit code 1 if a "
         "step did not converge.",
     )
@@ -359,6 +361,8 @@ def _loads(args) -> int:
             f"wrote {args.output}: {len(results)} steps x {len(cases)} load cases"
             + (f"; {unbounded} row(s) at a toggle (forces unbounded: blank)" if unbounded else "")
         )
+        for note in results.meta.get("notes", ()):
+            print(f"  {note}")
         _force_summary(forces)
         if plot:
             print(f"wrote {args.plot}")
@@ -421,11 +425,19 @@ def _chosen_case(path, cases, name: str | None) -> str:
 
 
 def _force_summary(forces) -> None:
-    """The largest tension and compression of each member over the sweep, per case."""
+    """The largest tension and compression of each member over the sweep, per case; a
+    wishbone that is not a two-force member (it carries a pushrod, say) by its bushing
+    loads resolved along each leg, and said so."""
     import numpy as np
 
+    bent = forces.meta.get("not_two_force", {})
+    stand_in = {}  # a bent arm's blank leg → its bushing's load along the leg
+    for _, legs, alongs in bent.values():
+        stand_in.update(zip(legs, alongs, strict=True))
     names = [n for n in forces.columns if n.startswith(("force_", "torque_"))]
-    print(f"  {'member':36s} {'case':18s} {'min':>12s} {'max':>12s}")
+    names = [stand_in.get(n, n) for n in names]
+    width = max([36, *(len(n) for n in names)])
+    print(f"  {'member':{width}s} {'case':18s} {'min':>12s} {'max':>12s}")
     for case in dict.fromkeys(forces["load_case"]):
         rows = forces["load_case"] == case
         for name in names:
@@ -434,9 +446,15 @@ def _force_summary(forces) -> None:
                 continue
             unit = forces.units.get(name, "N")
             print(
-                f"  {name:36s} {str(case)[:18]:18s} {np.nanmin(values):12.1f} "
+                f"  {name:{width}s} {str(case)[:18]:18s} {np.nanmin(values):12.1f} "
                 f"{np.nanmax(values):12.1f} {unit}"
             )
+    for arm, (points, legs, alongs) in bent.items():
+        print(
+            f"  {arm}: not a two-force member (it also carries {', '.join(points)}): its "
+            f"legs bend, {' and '.join(legs)} are blank; {' and '.join(alongs)} are its "
+            "bushings' loads resolved along each leg (+ as a leg's tension)"
+        )
 
 
 def _is_axle(path) -> bool:
@@ -590,7 +608,7 @@ def _pose_at(corner, at: str) -> dict:
         "urdf_robot": corner.tree.name,
         "sweep": sweep.source,
         "step": i,
-        "targets": {t.point: float(t.values[i]) for t in sweep.targets},
+        "targets": {t.point: float(t.values[i]) for t in corner.held_targets(sweep.targets)},
         "joints": joints,
     }
 
@@ -961,7 +979,10 @@ class Digest:
         self.band: dict[str, list] = {}
         self.nearest: dict[str, list] = {}
         self.dead: list = []  # the links near dead centre at design (deadcentre.Transmission)
-        self.unseat: dict[str, list] = {}  # side → [Steps below zero, least force]
+        # side → [Steps below zero, least force, those in droop (or at design), in bump,
+        # extending in bump (past over-centre)]
+        self.unseat: dict[str, list] = {}
+        self.notes: list[str] = []  # how the sweep's targets were read (the rack held)
 
     @classmethod
     def of(cls, results) -> Digest:
@@ -987,6 +1008,9 @@ class Digest:
         self.iterations += [0] * (len(counts) - len(self.iterations))
         for i, count in enumerate(counts):
             self.iterations[i] += count
+        for note in results.meta.get("notes", ()):
+            if note not in self.notes:
+                self.notes.append(note)
         why = results.meta["why"]
         if not self.dead:
             self.dead = list(results.meta.get("dead_centres", ()))
@@ -1027,9 +1051,17 @@ class Digest:
                         band[1:4] = int(steps[worst]), float(angle[worst]), at(worst)
             force = results.columns.get(f"spring_force{suffix}")
             if force is not None and np.nanmin(force, initial=np.inf) < 0.0:
-                unseat = self.unseat.setdefault(side, [Steps(), np.inf])
-                unseat[0].add(steps[np.flatnonzero(force < 0.0)])
+                unseat = self.unseat.setdefault(side, [Steps(), np.inf, Steps(), Steps(), False])
+                below = force < 0.0
+                unseat[0].add(steps[np.flatnonzero(below)])
                 unseat[1] = min(unseat[1], float(np.nanmin(force)))
+                travel = results.columns.get(f"wheel_travel{suffix}")
+                bump = below & (travel > 0.0) if travel is not None else np.zeros_like(below)
+                unseat[2].add(steps[np.flatnonzero(below & ~bump)])  # droop, or at design
+                unseat[3].add(steps[np.flatnonzero(bump)])
+                ratio = results.columns.get(f"motion_ratio{suffix}")
+                if ratio is not None:  # extending in bump: past over-centre
+                    unseat[4] |= bool(np.any(bump & (ratio <= 0.0)))
 
     def _column(self, name: str, v, steps) -> None:
         import numpy as np
@@ -1072,6 +1104,8 @@ def _summary(results, path) -> None:
         f"max residual {d.max_residual:.1e} mm, "
         f"{d.iterations_median:g} iterations per step (median)"
     )
+    for note in d.notes:
+        print(f"  {note}")
     print(f"  {'metric':<32}{'unit':>7}{'first':>13}{'last':>13}{'min':>13}{'max':>13}")
     blank = []
     for name, (first, last, low, high, far, _) in d.stats.items():
@@ -1108,11 +1142,25 @@ def _warn_transmission(results) -> None:
                 stacklevel=2,
             )
         if side in d.unseat:
-            steps, least = d.unseat[side]
+            steps, least, droop, bump, over_centre = d.unseat[side]
+            advice = []
+            if droop.count:  # it extends as the wheel drops: the preload runs out
+                where = f" in droop (steps {droop})" if bump.count else ""
+                advice.append(f"{where}: more preload, or limit the droop travel (a droop limiter)")
+            if bump.count:
+                where = f"; in bump (steps {bump})" if droop.count else " (in bump)"
+                if over_centre:  # it should compress in bump: its motion ratio has turned
+                    why = (
+                        "the spring extends as the wheel rises there (motion_ratio <= 0: a "
+                        "rocker past over-centre, or one that works the spring the wrong "
+                        "way; check the pushrod and rocker) — droop is not the cause"
+                    )
+                else:  # compressing, yet below zero: it starts below zero (the preload)
+                    why = "more preload: the spring compresses in bump here, it starts too low"
+                advice.append(f"{where}: {why}")
             warnings.warn(
                 f"{side}spring force below zero at steps {steps} "
-                f"(least {least:.0f} N): the spring would unseat there — more "
-                "preload, or less droop",
+                f"(least {least:.0f} N): the spring would unseat there" + "".join(advice),
                 PlausibilityWarning,
                 stacklevel=2,
             )
@@ -1894,8 +1942,9 @@ def _view(args) -> int:
             others = f"the first of {len(cases)}: --case NAME for another" * (
                 args.case is None and len(cases) > 1
             )
-            print(force_key(case, scale, others))
-            caption = force_caption(case, scale, Path(args.cases).name)
+            bent = bool(scene.not_two_force)
+            print(force_key(case, scale, others, bent))
+            caption = force_caption(case, scale, Path(args.cases).name, bent)
         frames = (
             scene.animate(qs, fps=args.fps, markers=markers, colours=colours)
             if qs is not None

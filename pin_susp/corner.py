@@ -90,6 +90,7 @@ class Corner(Linkage):
         (wheel-centre z, then the rack along y, in any order); None otherwise."""
         if TOE_LINK in self.drivers:  # a driver no sweep target is: motion() solves it
             return None
+        targets = self.held_targets(targets)
         wanted = [Target("wheel_center", "z").key]
         if self.geometry.steering == "rack":
             wanted.append(Target(self.geometry.steering_points[0], "y").key)
@@ -99,7 +100,9 @@ class Corner(Linkage):
         return [have.index(w) for w in wanted]
 
     def solver_for(self, targets: list[Target], source: str = "<targets>") -> NewtonSolver:
-        """Check targets against this mechanism and build the Newton solver."""
+        """Check targets against this mechanism and build the Newton solver (the rack
+        held at design where a rack corner's sweep gives no rack target)."""
+        targets = self.held_targets(targets)
         self._check_targets(targets, source)
         rows = [PointTarget(self.points[t.point], t.unit_direction) for t in targets]
         solver = NewtonSolver(self.kin, self.closures, rows, self.branches)
@@ -117,9 +120,10 @@ class Corner(Linkage):
         return solver
 
     def target_values(self, targets: list[Target]) -> np.ndarray:
-        """Absolute target values (m), one row per step, one column per target."""
+        """Absolute target values (m), one row per step, one column per held target
+        (``held_targets``)."""
         cols = []
-        for t in targets:
+        for t in self.held_targets(targets):
             values = np.asarray(t.values, dtype=float) * 1e-3
             if t.mode == "relative":
                 values = values + self.design_positions[t.point] @ t.unit_direction
@@ -269,7 +273,10 @@ class Corner(Linkage):
         moving_rack = [i for i, t in enumerate(targets) if self.body_of(t.point) == "rack"]
         if len(targets) != self.mobility:
             if self.actuators:
-                what = "bump and steer: a wheel target and one trackrod_inboard target along y"
+                what = (
+                    "bump and steer: a wheel target and one trackrod_inboard target along y; "
+                    "a wheel target alone holds the rack at design"
+                )
             elif self.geometry.steering_points:
                 what = "bump: one wheel target (the fixed toe link leaves no steer)"
             else:
@@ -352,7 +359,9 @@ class Results:
             if only is None or name in only:
                 columns[name], units[name] = values, column_unit
         geometry = (corner.geometry.source, corner.geometry.sha256)
-        return cls(columns, units, cls.solver_meta(solutions, geometry, sweep, corner))
+        meta = cls.solver_meta(solutions, geometry, sweep, corner)
+        meta["notes"] = corner.sweep_notes(sweep.targets)
+        return cls(columns, units, meta)
 
     @staticmethod
     def solver_columns(solutions: list[Solution]) -> tuple[dict, dict]:

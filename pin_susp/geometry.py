@@ -43,9 +43,9 @@ COINCIDENT = 1e-6  # m
 # Valid but implausible for a car (docs/geometry.md): a warning each, never an error.
 # key path → (low, high, unit as written in the file)
 PLAUSIBLE = {
-    "config.wheel.tire.rim_diameter": (8.0, 24.0, "in"),
-    "config.wheel.tire.section_width": (100.0, 400.0, "mm"),
-    "config.wheel.tire.aspect_ratio": (0.2, 0.9, ""),
+    "config.wheel.tyre.rim_diameter": (8.0, 24.0, "in"),
+    "config.wheel.tyre.section_width": (100.0, 400.0, "mm"),
+    "config.wheel.tyre.aspect_ratio": (0.2, 0.9, ""),
     "config.wheel.offset": (-150.0, 150.0, "mm"),
     "tyre radius": (150.0, 500.0, "mm"),
     "config.wheelbase": (1000.0, 5000.0, "mm"),
@@ -64,6 +64,11 @@ class Wheel:
     aspect_ratio: float
     rim_diameter: float
     tyre_rate: float | None = None  # N/mm (config.wheel.tyre.rate), for the ride rate
+    # each size's key as the file wrote it (tyre: or its synonym tire:), for warnings
+    keys: dict = field(default_factory=dict, compare=False, repr=False)
+
+    def key(self, name: str) -> str:
+        return self.keys.get(name, f"config.wheel.tyre.{name}")
 
     @property
     def radius(self) -> float:
@@ -316,9 +321,9 @@ def warn_implausible(g: Geometry) -> None:
     """A PlausibilityWarning for each value outside PLAUSIBLE (a unit slip, often)."""
     w = g.wheel
     values = {
-        "config.wheel.tire.rim_diameter": w.rim_diameter / INCH,
-        "config.wheel.tire.section_width": w.section_width / MM,
-        "config.wheel.tire.aspect_ratio": w.aspect_ratio,
+        "config.wheel.tyre.rim_diameter": w.rim_diameter / INCH,
+        "config.wheel.tyre.section_width": w.section_width / MM,
+        "config.wheel.tyre.aspect_ratio": w.aspect_ratio,
         "config.wheel.offset": w.offset / MM,
         "tyre radius": w.radius / MM,
     }
@@ -333,6 +338,8 @@ def warn_implausible(g: Geometry) -> None:
     values["distance from the wheel centre"] = np.linalg.norm(g.hardpoints[far] - center) / MM
     for key, value in values.items():
         what = f"hardpoints.{far}: {key}" if key.startswith("distance") else key
+        if key.startswith("config.wheel.tyre."):  # as the file wrote it: tyre: or tire:
+            what = w.key(key.rpartition(".")[2])
         warn_outside(f"{g.source}: {what}", value, *PLAUSIBLE[key])
 
 
@@ -574,22 +581,51 @@ def _spring_rate(spring_map: dict, spring: str, strut, r: Reader) -> tuple:
     )
 
 
+TYRE_SIZE = ("aspect_ratio", "section_width", "rim_diameter")
+TYRE_KEYS = (*TYRE_SIZE, "rate")
+
+
 def _wheel(value, r: Reader) -> Wheel:
-    w = r.mapping(value, "config.wheel", required=("tire",), optional=("offset", "tyre"))
-    tyre = r.mapping(w.get("tyre", {}), "config.wheel.tyre", optional=("rate",))
-    tyre_rate = None if "rate" not in tyre else r.positive(tyre["rate"], "config.wheel.tyre.rate")
-    tire = r.mapping(
-        w["tire"],
-        "config.wheel.tire",
-        required=("aspect_ratio", "section_width", "rim_diameter"),
-    )
-    key = "config.wheel.tire"
+    """config.wheel: its offset and the tyre — one key, ``tyre:`` (``tire:`` read as its
+    synonym) with the size and the rate. A file may still split them between the two
+    (the size under tire:, the rate under tyre:, as before): they are read as one, and
+    a value given under both is an error that names each."""
+    w = r.mapping(value, "config.wheel", optional=("offset", "tyre", "tire"))
+    given = [k for k in ("tyre", "tire") if k in w]
+    if not given:
+        r.fail(
+            "config.wheel.tire",
+            "missing key: the tyre, as tire: or tyre: (one key, either spelling) with its "
+            "size {aspect_ratio, section_width, rim_diameter} and, for the ride rate, its rate",
+        )
+    tyre, keys = {}, {}
+    for name in given:
+        block = r.mapping(w[name], f"config.wheel.{name}", optional=TYRE_KEYS)
+        for k, v in block.items():
+            if k in tyre:
+                r.fail(
+                    f"config.wheel.{name}.{k}",
+                    f"given also as {keys[k]}: tire: is a synonym of tyre:, one tyre — "
+                    "give each value once (best all under tyre:)",
+                )
+            tyre[k], keys[k] = v, f"config.wheel.{name}.{k}"
+    for k in TYRE_SIZE:
+        if k not in tyre:
+            holder = next((n for n in given if any(s in w[n] for s in TYRE_SIZE)), given[0])
+            other = {"tyre": "tire", "tire": "tyre"}[holder]
+            r.fail(
+                f"config.wheel.{holder}.{k}",
+                f"missing key (the tyre's size: {', '.join(TYRE_SIZE)}; "
+                f"{other}: is the same key, read as one with {holder}:)",
+            )
+    tyre_rate = None if "rate" not in tyre else r.positive(tyre["rate"], keys["rate"])
     return Wheel(
         offset=r.length(w.get("offset", 0.0), "config.wheel.offset") * MM,
-        section_width=_size(tire["section_width"], f"{key}.section_width", r) * MM,
-        aspect_ratio=_size(tire["aspect_ratio"], f"{key}.aspect_ratio", r, limit=100.0),
-        rim_diameter=_size(tire["rim_diameter"], f"{key}.rim_diameter", r, INCH / MM) * INCH,
+        section_width=_size(tyre["section_width"], keys["section_width"], r) * MM,
+        aspect_ratio=_size(tyre["aspect_ratio"], keys["aspect_ratio"], r, limit=100.0),
+        rim_diameter=_size(tyre["rim_diameter"], keys["rim_diameter"], r, INCH / MM) * INCH,
         tyre_rate=tyre_rate,
+        keys=keys,
     )
 
 

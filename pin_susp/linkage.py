@@ -36,6 +36,8 @@ from .metrics import HUB_Z, RACK, TOE_LINK, metric_columns
 from .solver import NewtonSolver
 from .urdf import read_closures, tree_to_urdf
 
+RACK_HELD = "rack held at design (the sweep gives no rack target)"
+
 
 class Built:
     """A tree as a Pinocchio model: the URDF text, the model parsed from it, a
@@ -322,6 +324,27 @@ class Linkage:
             points["wheel_center"], axis, self.geometry.wheel.radius
         )
         return points
+
+    def held_targets(self, targets: list) -> list:
+        """The targets a sweep's steps hold: its own, and on a rack-steered corner whose
+        sweep gives every target but the rack's (a bump-only sweep) the rack held at
+        design (rack_displacement 0; ``sweep_notes`` says so). Every other set of targets
+        as given (checked by ``solver_for``)."""
+        targets = list(targets)
+        if not self.actuators or len(targets) != self.mobility - 1:
+            return targets
+        if any(t.point in self.points and self.body_of(t.point) == "rack" for t in targets):
+            return targets
+        if any(t.quantity is not None or t.side is not None for t in targets):
+            return targets  # an axle's targets: refused by _check_targets
+        steps = len(targets[0].values) if targets else 1
+        from .sweep import Target
+
+        return [*targets, Target(self.geometry.steering_points[0], "y", np.zeros(steps))]
+
+    def sweep_notes(self, targets: list) -> list[str]:
+        """What the summary says of how the sweep's targets were read."""
+        return [RACK_HELD] if len(self.held_targets(targets)) > len(targets) else []
 
     def body_of(self, point: str) -> str:
         return self.points[point].body

@@ -16,7 +16,10 @@ multilink's lower front link) follow from Pinocchio's inverse dynamics at rest
 forces as external forces: ``data.f[j]`` is then the force the parent puts on
 the subtree through joint j. A pivot's two bushings share its force and moment
 (the axial part equally: docs/loads.md's convention); a wishbone whose only
-load is its outboard ball joint is a pair of two-force legs.
+load is its outboard ball joint is a pair of two-force legs. A wishbone that
+carries more (the pushrod, a coilover) is not: its leg columns are blank, and
+every wishbone's bushing loads are also written resolved along each leg
+(``load_<arm>_<end>_bushing_along_leg``, + as a tension; README, Loads and rates).
 """
 
 from __future__ import annotations
@@ -191,7 +194,8 @@ def member_forces(corner, sweep, cases: list, solutions=None, results=None, prog
             columns[name] = np.repeat(values, n)
             units[name] = results.units.get(name, "")
     _warn_dead_centre_share(corner, cases, columns, axle)
-    return Results(columns, units, results.meta)
+    meta = dict(results.meta, not_two_force=statics.not_two_force())
+    return Results(columns, units, meta)
 
 
 # A spring's share of the tyre's vertical load outside this band (spring force over
@@ -437,7 +441,11 @@ class Statics:
             return [f"force_{body.name}"]
         if j.kind == "revolute" and len(j.defined_by) == 2:
             names = [f"load_{_bushing(self._point(body.name, n))}" for n in j.defined_by]
-            return _xyz(names[0]) + _xyz(names[1]) + list(self._legs(body.name, j.defined_by) or {})
+            legs = self._legs(body.name, j.defined_by)
+            if legs is None:
+                return _xyz(names[0]) + _xyz(names[1])
+            along = [f"{name}_along_leg" for name in names]  # each bushing's load on its leg
+            return _xyz(names[0]) + _xyz(names[1]) + list(legs) + along
         return []
 
     def _bearing(self, body, j) -> bool:
@@ -450,18 +458,48 @@ class Statics:
         return j.kind == "revolute" and len(j.defined_by) != 2
 
     def _legs(self, arm: str, pickups) -> dict | None:
-        """A wishbone's legs: name → pickup, when the arm is loaded at its outboard ball
-        alone (its legs two-force members); {} with blank columns when not; None for
-        an arm that is no wishbone."""
+        """A wishbone's legs: name → pickup (in the pivot's order); None for an arm that
+        is no wishbone."""
         outboard = f"{arm}_outboard"
         if not arm.endswith("wishbone") or outboard not in self.subject.points:
             return None
-        names = {
+        return {
             f"force_{arm}_{'front' if 'front' in n else 'rear'}": self._named(arm, n)
             for n in pickups
         }
-        others = [n for n, (b, _) in self.subject.tree.points.items() if b == arm and n != outboard]
-        return dict.fromkeys(names) if others else names
+
+    def _two_force(self, arm: str) -> bool:
+        """Whether a wishbone's legs are two-force members: the arm is loaded at its
+        outboard ball alone. A pushrod (or a coilover, a droplink) on it loads it
+        elsewhere too: its legs then bend, and only the bushing loads resolved along
+        each leg are written (``..._bushing_along_leg``), the leg columns blank."""
+        outboard = f"{arm}_outboard"
+        return not [
+            n for n, (b, _) in self.subject.tree.points.items() if b == arm and n != outboard
+        ]
+
+    def not_two_force(self) -> dict[str, tuple[list, list, list]]:
+        """The wishbones whose legs are not two-force members: arm → (the other points
+        that load it, e.g. ``pushrod_outboard``; its blank leg columns; its bushings'
+        ``..._along_leg`` columns), by the columns' names (an axle's with their side)."""
+        out = {}
+        for body, j, *_ in self.joints:
+            arm = body.name
+            if j.kind != "revolute" or len(j.defined_by) != 2:
+                continue
+            legs = self._legs(arm, j.defined_by)
+            if not legs or self._two_force(arm):
+                continue
+            outboard = f"{arm}_outboard"
+            points = [
+                n for n, (b, _) in self.subject.tree.points.items() if b == arm and n != outboard
+            ]
+            along = [f"load_{_bushing(self._point(arm, n))}_along_leg" for n in j.defined_by]
+            names = [*legs, *along]
+            if self.axle:
+                names = [_sided(n) for n in names]
+            out[arm] = (points, names[:2], names[2:])
+        return out
 
     # ---------------------------------------------------------------- solving
 
@@ -612,11 +650,11 @@ class Statics:
         d = b - a
         legs = self._legs(body.name, j.defined_by)
         pickups = None
-        if legs is not None and all(v is not None for v in legs.values()):
+        if legs is not None:
             pickups = np.array([subject.design_positions[n] for n in legs.values()])
         ball = subject.points.get(f"{body.name}_outboard")
-        blank = 0 if legs is None else len(legs)
-        return ("pivot", a, d[:, None], d[:, None] / (d @ d), pickups, ball, blank)
+        two_force = legs is not None and self._two_force(body.name)
+        return ("pivot", a, d[:, None], d[:, None] / (d @ d), pickups, ball, two_force)
 
     def _joint_columns(self, spec, force, moment, extra) -> list[np.ndarray]:
         """From the parent's force on a subtree (poses × 3 × cases) and its moment about
@@ -631,23 +669,29 @@ class Statics:
             return [np.einsum("si,sic->sc", u, force)[:, None]]
         if kind == "none":
             return []
-        _, a, d, d_scaled, pickups, ball, blank = spec
-        if pickups is not None:  # two two-force legs: each bush takes its leg's pull
+        _, a, d, d_scaled, pickups, ball, two_force = spec
+        if pickups is not None:  # a wishbone: its legs' directions, pickup → ball
             U = (extra[ball.name][:, None, :] - pickups[None]).transpose(0, 2, 1)  # s × 3 × 2
             U = U / np.linalg.norm(U, axis=1)[:, None, :]
+        if two_force:  # two two-force legs: each bush takes its leg's pull
             Ut = U.transpose(0, 2, 1)
             # the chassis holds the arm through its legs: force = −Σ tension · (pickup → ball)ˆ
             t = np.linalg.solve(Ut @ U, Ut @ -force)  # exact: the force is in their plane
-            return [U[:, :, :1] * t[:, 0:1], U[:, :, 1:] * t[:, 1:2], t]  # tension · û
-        at_a = moment - np.cross(a[None, :, None], force, axisa=1, axisb=1, axisc=1)
-        dd = float((d.T @ d)[0, 0])
-        on_b = np.cross(at_a, d[None], axisa=1, axisb=1, axisc=1) / dd + d_scaled[None] * (
-            0.5 * np.einsum("i,sic->sc", d[:, 0], force)[:, None]
-        )
-        out = [on_b - force, -on_b]  # the bushings' loads on the chassis (axial: halves)
-        if blank:
-            out.append(np.full((force.shape[0], blank, force.shape[2]), np.nan))
-        return out
+            out = [U[:, :, :1] * t[:, 0:1], U[:, :, 1:] * t[:, 1:2], t]  # tension · û
+        else:
+            at_a = moment - np.cross(a[None, :, None], force, axisa=1, axisb=1, axisc=1)
+            dd = float((d.T @ d)[0, 0])
+            on_b = np.cross(at_a, d[None], axisa=1, axisb=1, axisc=1) / dd + d_scaled[None] * (
+                0.5 * np.einsum("i,sic->sc", d[:, 0], force)[:, None]
+            )
+            out = [on_b - force, -on_b]  # the bushings' loads on the chassis (axial: halves)
+            if pickups is None:
+                return out
+            out.append(np.full((force.shape[0], 2, force.shape[2]), np.nan))  # no leg forces
+        # each bushing's load on the chassis resolved along its leg (+ pulling the chassis
+        # toward the ball, as a leg's tension): the leg's tension where it is two-force
+        along = [np.einsum("si,sic->sc", U[:, :, k], out[k])[:, None] for k in range(2)]
+        return [*out, *along]
 
     def solve_cases(self, q: np.ndarray, cases: list[LoadCase]) -> list[dict[str, float]]:
         """The columns under each case at q, as dicts; at a toggle every force is NaN and

@@ -230,6 +230,15 @@ def mechanical_trail(ps: PointSet):
     return ps.steering_axis_on_ground()[..., X] - ps["contact_patch_center"][..., X]
 
 
+def trail_in_wheel_axes(ps: PointSet):
+    """(G − CP)·ĥ, ĥ = s·(ŵ_y, −ŵ_x, 0) the wheel's heading on the ground (ŵ as for the
+    scrub radius; ĥ = +x at zero toe): the trail along the wheel's own heading when
+    steered, positive = contact patch behind the axis ground point."""
+    w = unit(ps.spin_axis() * np.array([1.0, 1.0, 0.0]))
+    d = ps.steering_axis_on_ground() - ps["contact_patch_center"]
+    return ps.s * (d[..., X] * w[..., Y] - d[..., Y] * w[..., X])
+
+
 def wheel_travel(ps: PointSet):
     """WC_z − WC_z,design: positive = bump."""
     return ps["wheel_center"][..., Z] - ps.design["wheel_center"][..., Z]
@@ -446,6 +455,21 @@ METRICS = (
     ),
     Metric("wheel_travel", "mm", "Wheel travel (+ bump)", wheel_travel),
     Metric("half_track", "mm", "Half track", half_track, drivers=BOTH, plausible=(250, 1300)),
+    # trail and scrub both along the wheel's own heading (scrub_radius already is)
+    Metric(
+        "trail_in_wheel_axes",
+        "mm",
+        "Mechanical trail along the wheel's heading",
+        trail_in_wheel_axes,
+        drivers=BOTH,
+    ),
+    Metric(
+        "scrub_in_wheel_axes",
+        "mm",
+        "Scrub radius in the wheel's axes (= scrub_radius)",
+        scrub_radius,
+        drivers=BOTH,
+    ),
     Metric(
         "wheel_center_x", "mm", "Wheel centre x", wheel_center_x, drivers=(HUB_Z,), written=False
     ),

@@ -191,8 +191,7 @@ class HardpointSensitivity:
         c = self.corner
         if targets is None:
             targets = [Target("wheel_center", "z", 0.0)]
-            if c.geometry.steering == "rack":
-                targets.append(Target("trackrod_inboard", "y", 0.0))
+        targets = c.held_targets(targets)  # the rack at design where none is given
         m, kin = self.model, self.kin
         qa = pin.neutral(m)
         qa[self.real] = q  # every joint has one dof: its q index is its v index

@@ -331,6 +331,30 @@ def _targets(targets: dict[str, float]) -> dict[str, float]:
     return out
 
 
+SHIM_DOCS = "docs/geometry.md#camber-shim-configcamber_shim-double-wishbone-only"
+
+
+def _camber_alternatives(g) -> str:
+    """What sets camber on a corner without a shim: the shim to add (a double
+    wishbone's), else its points — with where to read on."""
+    if g.type == "double_wishbone":
+        return (
+            f": add config.camber_shim (see {SHIM_DOCS}), or set camber by moving the "
+            "upper ball joint (`pin-susp sensitivity` gives camber per mm of each hardpoint; "
+            "a study finds the move, docs/studies.md)"
+        )
+    example = {
+        "macpherson": "the strut top on a camber plate",
+        "multilink": "a link's outboard pickup",
+        "trailing_arm": "the arm's pivot axis",
+    }.get(g.type, "a pickup")
+    return (
+        f" (a double-wishbone option, {SHIM_DOCS}): on a {g.type} corner camber is set "
+        f"by its points, e.g. {example} (`pin-susp sensitivity` gives "
+        "camber per mm of each hardpoint; a study finds the move, docs/studies.md)"
+    )
+
+
 def solve_setup(g, targets: dict[str, float], max_iterations: int = 25) -> InverseResult:
     """Find shim thickness, trackrod and pushrod deltas that hit the targets.
 
@@ -347,8 +371,7 @@ def solve_setup(g, targets: dict[str, float], max_iterations: int = 25) -> Inver
             raise InputError(
                 drawn.source,
                 "config.camber_shim",
-                "a camber target needs a camber shim in the geometry"
-                + ("" if drawn.type == "double_wishbone" else " (a double-wishbone option)"),
+                "a camber target needs a camber shim in the geometry" + _camber_alternatives(drawn),
             )
         if name == "roadwheel_angle" and not drawn.steering_points:
             raise InputError(

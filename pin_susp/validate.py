@@ -217,10 +217,10 @@ class CornerScope:
         return PointwiseCorner(self.subject.geometry)
 
     def step_targets(self, sweep) -> list[list]:
-        values = self.subject.target_values(sweep.targets)
+        held = self.subject.held_targets(sweep.targets)  # the rack at design if not given
+        values = self.subject.target_values(held)
         return [
-            [(t.point, t.unit_direction, float(v[k])) for k, t in enumerate(sweep.targets)]
-            for v in values
+            [(t.point, t.unit_direction, float(v[k])) for k, t in enumerate(held)] for v in values
         ]
 
     def held(self, points: dict) -> list:

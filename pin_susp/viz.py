@@ -34,7 +34,9 @@ wishbone's legs, a multilink's tree link). The colour is matplotlib's
 ``coolwarm`` at 0.5 + 0.5·tension/scale: red in tension, blue in
 compression, grey at zero, the scale being the largest |force| of any
 coloured member over the sweep under that case; near-black at a toggle,
-where the force is unbounded. An axle's are both corners' and its droplinks,
+where the force is unbounded. A wishbone leg that is not a two-force member
+(its arm carries a pushrod or a spring: its leg columns are blank) is
+yellow-green, off the ramp. An axle's are both corners' and its droplinks,
 under one scale; the bar's torque (``torque_arb``, N·m) is no force on that
 scale, and the bar keeps its own colour. One replay shows one case: meshcat's
 animation is one clip of poses and colours, and a selector would need
@@ -69,6 +71,9 @@ GROUND_SPAN = 1.2  # ... or this times the width of what is drawn, if wider (an 
 MARKERS = {"roll_centre": (0x00D8F0, 0.025)}  # name: colour, radius (m)
 FORCE_MAP = "coolwarm"  # matplotlib's: blue (compression) → grey (0) → red (tension)
 UNBOUNDED = (0.1, 0.1, 0.1)  # a member at a toggle: its force has no bound
+# a wishbone leg that is no two-force member (its arm carries a pushrod, say): no tension
+# to colour, and none of the ramp's colours (its blue would read as compression)
+NOT_TWO_FORCE = (0.6, 0.8, 0.2)  # yellow-green
 VIEW = np.array([1.6, 0.35, 0.7])  # camera direction: front, outboard (y by side), above
 FOV = 75.0  # degrees, vertical: meshcat's default camera (three.js PerspectiveCamera)
 FILL = 0.8  # the corner's share of the view's height, or of its width ...
@@ -314,6 +319,7 @@ class Scene:
 
         self.model = model
         self.server = None
+        self.not_two_force: list[str] = []  # legs force_colours found no two-force member
         if viewer is None:
             self.server, zmq_url = start_server()
             viewer = meshcat.Visualizer(zmq_url=zmq_url)
@@ -525,7 +531,8 @@ class Scene:
         (N): the largest |force| of a coloured member over the sweep. Tension red,
         compression blue, grey at zero (``FORCE_MAP``); UNBOUNDED where the force is
         blank (a toggle). A member whose column is blank at every other step (a leg of
-        an arm that carries more than its ball joint) is not coloured."""
+        an arm that carries more than its ball joint: no two-force member) is
+        NOT_TWO_FORCE, off the ramp; ``self.not_two_force`` lists those nodes."""
         import matplotlib
 
         rows = np.asarray(forces["load_case"]) == case
@@ -537,8 +544,10 @@ class Scene:
             for column, node in self.members(forces.columns).items()
         }
         # a leg blank wherever the forces are bounded is no two-force member (its arm
-        # carries the pushrod): it keeps its own colour
-        tension = {n: t for n, t in tension.items() if np.isfinite(t).any() or not bounded.any()}
+        # carries the pushrod): NOT_TWO_FORCE, off the scale
+        bent = [n for n, t in tension.items() if bounded.any() and not np.isfinite(t).any()]
+        self.not_two_force = bent
+        tension = {n: t for n, t in tension.items() if n not in bent}
         scale = max(
             (float(np.nanmax(np.abs(t), initial=0.0)) for t in tension.values()), default=0.0
         )
@@ -548,6 +557,10 @@ class Scene:
             share = t / scale if scale > 0.0 else np.zeros_like(t)
             rgb = ramp(0.5 + 0.5 * np.nan_to_num(share))[:, :3]
             rgb[~np.isfinite(t)] = UNBOUNDED
+            out[node] = rgb
+        for node in bent:
+            rgb = np.tile(NOT_TWO_FORCE, (len(bounded), 1))
+            rgb[~bounded] = UNBOUNDED
             out[node] = rgb
         return out, scale
 
@@ -606,17 +619,25 @@ def _set_colour(node, rgb) -> None:
         node.set_property("color", [*rgb, 1.0])
 
 
-def force_key(case: str, scale: float, note: str = "") -> str:
-    """The colours' key, one line of text: the case, the scale, what red and blue are."""
+def force_key(case: str, scale: float, note: str = "", bent: bool = False) -> str:
+    """The colours' key, one line of text: the case, the scale, what red and blue are;
+    ``bent``: some legs are no two-force members (their colour said too)."""
     return (
         f"members coloured by force under {case!r}{f' ({note})' if note else ''}: "
         f"red tension, blue compression, grey 0, full colour at {scale:.0f} N "
         "(the largest |force| over the sweep); near-black: unbounded (a toggle)"
+        + (
+            "; yellow-green: a wishbone leg that is not a two-force member (its arm "
+            "carries more than its ball joint: see its *_bushing_along_leg columns)"
+            if bent
+            else ""
+        )
     )
 
 
-def force_caption(case: str, scale: float, source: str = "") -> str:
-    """The key as an HTML block over the replay: a colour bar from −scale to +scale."""
+def force_caption(case: str, scale: float, source: str = "", bent: bool = False) -> str:
+    """The key as an HTML block over the replay: a colour bar from −scale to +scale
+    (``bent``: and the colour of a leg that is no two-force member)."""
     import html
 
     import matplotlib
@@ -634,7 +655,14 @@ def force_caption(case: str, scale: float, source: str = "") -> str:
         f'<div style="display:flex;justify-content:space-between;width:220px">'
         f"<span>−{scale:.0f} N</span><span>0</span><span>+{scale:.0f} N</span></div>"
         f"compression ← → tension; "
-        f'<span style="color:{black}">■</span> unbounded (toggle)</div>'
+        f'<span style="color:{black}">■</span> unbounded (toggle)'
+        + (
+            f'<br><span style="color:{matplotlib.colors.to_hex(NOT_TWO_FORCE)}">■</span> '
+            "not a two-force member (no tension: its arm carries more than its ball joint)"
+            if bent
+            else ""
+        )
+        + "</div>"
     )
 
 

@@ -210,7 +210,7 @@ def sweep_case(change):
 
 SWEEP_ERRORS = {
     "too few targets": (
-        lambda s: s["targets"].pop(),
+        lambda s: s["targets"].pop(0),  # the rack alone (a wheel target alone holds it)
         "targets: 1 target(s) given, this corner needs exactly 2",
     ),
     "too many targets": (
