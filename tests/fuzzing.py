@@ -1841,8 +1841,10 @@ def _check_axle_rows(case: Case, o: Outcome, header, rows, context) -> None:
         axle = load_axle(str(Path(o.directory) / "g.yaml"))
     ROWS_CHECKED[f"{axle.left.type} axle"] += len(converged)
     design = {}
+    from pin_susp.setup import apply_setup
+
     for side in ("left", "right"):
-        g = axle.corner(side)
+        g = apply_setup(axle.corner(side))  # as set, as AxleModel solves it
         design[side] = design_points(g)
         prefix = f"{side}_"
         renamed = [
