@@ -19,6 +19,14 @@ process through ``pin_susp.cli.main()`` in a fresh temporary directory, and
 4. never a traceback (an exception escaping main() propagates as itself);
 5. nothing outside the declared outputs touched, no temporary file left, no
    ``MUJOCO_LOG.TXT``, the inputs unchanged.
+
+The same hold for axles (each corner's rows checked as a corner's from its
+``left_``/``right_`` columns, heave and roll from both wheel centres), for
+``loads`` (one row per step and case), for Parquet outputs (read back with
+pyarrow: the same cells) and for studies (variants.parquet's flags, the
+steps' residuals; a ``--resume`` after an input changed is refused). A
+degenerate linkage of any mechanism (``_degenerate_moves``) must be refused:
+exit 2, one line naming its points.
 """
 
 from __future__ import annotations
@@ -1182,7 +1190,7 @@ def cases(draw, pictures: bool | None = None) -> Case:
             if edit in files:
                 edits[edit] = files[edit] + b"# changed after the run\n"
             elif edit == "parts":
-                edits["res/variants.parquet"] = b""  # not the run's: a stranger's file
+                edits[os.path.join(out, "variants.parquet")] = b""  # a stranger's file
         outputs.append(out)
     else:  # setup
         argv = ["setup", g_arg]
@@ -1344,7 +1352,8 @@ def run_case(case: Case):
             finally:
                 os.chdir(cwd)
             for name, text in case.edits.items():
-                (run_dir / name).write_bytes(text)
+                if (run_dir / name).parent.is_dir():  # (the first run may have written none)
+                    (run_dir / name).write_bytes(text)
         before = _snapshot(run_dir)
         out, err = io.StringIO(), io.StringIO()
         os.chdir(run_dir)

@@ -1,9 +1,12 @@
 """Property-based fuzzing of ``pin-susp`` in process (strategies and invariants: fuzzing.py).
 
-``make test`` runs ``PIN_SUSP_FUZZ_EXAMPLES`` inputs (default 500, about 20 s),
-derandomized: the same inputs every run, no example database and nothing
-written into the repository. ``make fuzz`` runs 10 000 (about 8 min) with a
-fresh seed, printed with the counts per exit code and command.
+``make test`` runs ``PIN_SUSP_FUZZ_EXAMPLES`` inputs (default 500, about 20 s of
+CPU), derandomized: the same inputs every run, no example database and nothing
+written into the repository. ``make fuzz`` runs 10 000 (about 10 min) with a
+fresh seed, printed with the counts per exit code, command and mechanism
+(corners and axles). Both draw every command that takes a geometry (sweep and
+loads to CSV or Parquet, a 10 001-step sweep that streams, setup, sensitivity,
+urdf, mjcf, draw, validate and studies: the slow ones rarely).
 ``PIN_SUSP_FUZZ_SEED=N`` repeats a run; ``PIN_SUSP_FUZZ_FINDINGS=DIR`` saves
 each failing input as files to run by hand (the shrunk one last);
 ``PIN_SUSP_FUZZ_COLLECT=1`` counts failures instead of stopping at them (the
