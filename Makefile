@@ -26,9 +26,12 @@ test: $(STAMP)
 	if [ $$status -eq 5 ]; then echo "make test: pytest collected no tests" >&2; fi; \
 	exit $$status
 
-# Property-based fuzzing of the command line (tests/test_fuzz.py): 10 000 random inputs,
-# a new seed each run (printed; PIN_SUSP_FUZZ_SEED=N repeats it), then the counts per exit
-# code and command. PIN_SUSP_FUZZ_FINDINGS=DIR saves each failing input as files.
+# Property-based fuzzing of the command line (tests/test_fuzz.py): 10 000 random inputs —
+# corners and axles of every mechanism through every command that takes a geometry (sweep,
+# loads, setup, sensitivity, urdf, mjcf, draw, validate, tiny studies and their --resume),
+# CSV, Parquet and streamed outputs, degenerate linkages — a new seed each run (printed;
+# PIN_SUSP_FUZZ_SEED=N repeats it), then the counts per exit code, command and mechanism.
+# PIN_SUSP_FUZZ_FINDINGS=DIR saves each failing input as files.
 fuzz: $(STAMP)
 	PIN_SUSP_FUZZ_EXAMPLES=$${PIN_SUSP_FUZZ_EXAMPLES:-10000} \
 	PIN_SUSP_FUZZ_SEED=$${PIN_SUSP_FUZZ_SEED:-random} \

@@ -421,7 +421,8 @@ AXLE_KEYS = (
 
 @dataclass(frozen=True)
 class AxleGeometry:
-    """Both corners (their Geometry, as set), the axle elements' points and options."""
+    """Both corners (their Geometry as drawn, each with its side's setup: AxleModel
+    applies it), the axle elements' points and options."""
 
     name: str
     left: Geometry

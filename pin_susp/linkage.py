@@ -256,29 +256,64 @@ class Linkage:
 
     def _check_mobility(self) -> None:
         """The closures must be independent at design, and the wheel must move in bump:
-        otherwise the file describes no suspension (one clear error, not a singular solve)."""
+        otherwise the file describes no suspension (one clear error naming the points of
+        the closures or joints concerned, not a singular solve)."""
         self._drive.evaluate(self.q_design)
         rows = self._drive.jacobian
         n = len(rows) - len(self._drive.targets)
         if n:
-            s = np.linalg.svd(rows[:n], compute_uv=False)
+            u, s, _ = np.linalg.svd(rows[:n])
             if s[-1] <= 1e-9 * s[0]:
                 raise InputError(
                     self.geometry.source,
                     "hardpoints",
                     "the linkage's closures are dependent at the design state (a link that "
                     "adds no constraint, or a loop at its toggle): the corner has more "
-                    f"freedoms than {self.mobility} and no pose can be solved",
+                    f"freedoms than {self.mobility} and no pose can be solved "
+                    f"({self._closure_points(u[:, -1])})",
                 )
-        s = np.linalg.svd(rows, compute_uv=False)
+        _, s, vt = np.linalg.svd(rows)
         if s[-1] <= 1e-9 * s[0]:  # (a lone zero row too: a wheel that cannot rise)
             held = " with the rack held" if self.geometry.steering == "rack" else ""
             raise InputError(
                 self.geometry.source,
                 "hardpoints",
                 f"the linkage locks the wheel for bump: its one motion{held} does not move "
-                "the wheel centre up or down",
+                f"the wheel centre up or down ({self._joint_points(vt[-1])})".replace(" ()", ""),
             )
+
+    def _closure_points(self, weights: np.ndarray) -> str:
+        """The closures a dependent combination of closure rows is made of, with their
+        points: 'closures trackrod (trackrod_inboard, trackrod_outboard), ...'."""
+        points = {c.name: c.points for c in self.tree.closures}
+        named, row = [], 0
+        scale = np.abs(weights).max()
+        for c in self.closures:
+            if np.abs(weights[row : row + c.size]).max() > 1e-6 * scale:
+                ends = points.get(c.name, ())
+                named.append(f"{c.name} ({', '.join(ends)})" if ends else c.name)
+            row += c.size
+        return "closures " + ", ".join(named)
+
+    def _joint_points(self, motion: np.ndarray) -> str:
+        """The joints a motion dq turns or slides, by the points that place them."""
+        defined = {
+            b.joint.name: b.joint.defined_by for b in self.tree.bodies if b.joint is not None
+        }
+        scale = np.abs(motion).max()
+        names: list[str] = []
+        for j in range(1, self.model.njoints):
+            v = self.model.joints[j].idx_v
+            if np.abs(motion[v : v + self.model.joints[j].nv]).max() <= 1e-6 * scale:
+                continue
+            joint = self.model.names[j]
+            base = next((k for k in defined if joint == k or joint.startswith(k + "_")), None)
+            for point in defined.get(base, ()):
+                if point not in names:
+                    names.append(point)
+        if not names:
+            return ""
+        return f"the wheel centre held, the joints at {', '.join(names)} still move"
 
     def positions(self, q: np.ndarray) -> dict[str, np.ndarray]:
         """World position (m) of every named point at configuration q."""

@@ -19,6 +19,14 @@ process through ``pin_susp.cli.main()`` in a fresh temporary directory, and
 4. never a traceback (an exception escaping main() propagates as itself);
 5. nothing outside the declared outputs touched, no temporary file left, no
    ``MUJOCO_LOG.TXT``, the inputs unchanged.
+
+The same hold for axles (each corner's rows checked as a corner's from its
+``left_``/``right_`` columns, heave and roll from both wheel centres), for
+``loads`` (one row per step and case), for Parquet outputs (read back with
+pyarrow: the same cells) and for studies (variants.parquet's flags, the
+steps' residuals; a ``--resume`` after an input changed is refused). A
+degenerate linkage of any mechanism (``_degenerate_moves``) must be refused:
+exit 2, one line naming its points.
 """
 
 from __future__ import annotations
@@ -411,7 +419,8 @@ def _mutate_geometry(draw, data) -> str:
     kinds = (
         "drop_key drop_hardpoint unknown_key retype wild_coordinate wild_point mirror "
         "side_only steering actuation mount spring shim adjuster wheel restyle_number "
-        "points_as_lists degenerate degenerate scale translate mechanism clamp as_multilink"
+        "points_as_lists degenerate degenerate scale translate mechanism clamp as_multilink "
+        "degenerate_named degenerate_named"
     ).split()
     kind = draw(st.sampled_from(kinds))
     if kind == "drop_key":
@@ -599,6 +608,8 @@ def _mutate_geometry(draw, data) -> str:
         value = draw(st.sampled_from(MECHANISMS + ("Multilink", "strut", "")))
         data["type"] = value
         return f"type = {value!r}"
+    if kind == "degenerate_named":
+        return draw(_degenerate(data))
     if kind == "as_multilink" and _kind(data) == "double_wishbone":
         return _as_multilink(data)
     if kind == "clamp" and _kind(data) == "macpherson":
@@ -708,10 +719,11 @@ def geometries(draw) -> Inputs:
 class Plan:
     """A target as meant (when the sweep text was not broken on purpose)."""
 
-    point: str
+    point: str  # or an axle's quantity: heave, roll (mode "quantity")
     direction: tuple[float, float, float]  # unit
     mode: str
     values: list[float]
+    side: str | None = None  # an axle's corner
 
 
 def _design_point(geometry, name: str):
@@ -978,6 +990,9 @@ class Case:
     stale: list[str] = field(default_factory=list)  # outputs that exist before the run
     quiet: bool = False
     links: dict[str, str] = field(default_factory=dict)  # output -> input it links to
+    extra: dict[str, Inputs] = field(default_factory=dict)  # c.yaml (loads), study.yaml
+    before: list[str] | None = None  # a command line run first (a study to --resume)
+    edits: dict[str, bytes] = field(default_factory=dict)  # inputs changed after it
 
     def _repr_pretty_(self, printer, cycle) -> None:  # how Hypothesis prints a failing case
         printer.text(repr(self))
@@ -989,6 +1004,13 @@ class Case:
         if self.sweep is not None:
             parts.append(f"  sweep changes: {self.sweep.changes}")
             parts.append(_indent("s.yaml", self.sweep.text))
+        for name, inputs in self.extra.items():
+            parts.append(f"  {name} changes: {inputs.changes}")
+            parts.append(_indent(name, inputs.text))
+        if self.before is not None:
+            parts.append(f"  run first: pin-susp {' '.join(map(_quote, self.before))}")
+            for name, text in self.edits.items():
+                parts.append(_indent(f"{name}, then changed to", text))
         if self.stale:
             parts.append(f"  existing outputs: {self.stale}")
         if self.links:
@@ -1032,7 +1054,25 @@ def _pictures_available() -> bool:
 
 
 COMMANDS = ("sweep",) * 50 + ("sensitivity",) * 10 + ("urdf",) * 5 + ("urdf-at",) * 7
-COMMANDS += ("mjcf",) * 5 + ("setup",) * 13
+COMMANDS += ("mjcf",) * 5 + ("setup",) * 13 + ("loads",) * 12 + ("study",) * 2
+# Commands that take an axle (scope: axle) as well as a corner; validate is drawn apart.
+AXLE_COMMANDS = {"sweep", "sensitivity", "urdf", "mjcf", "setup", "loads", "draw"}
+AXLE_COMMANDS |= {"validate", "study"}
+STREAM_STEPS = 10_000  # pin_susp.cli.STREAM_STEPS: a longer corner sweep is streamed
+
+
+def _long_sweep(geometry) -> tuple[Inputs, list[Plan]]:
+    """A corner sweep of 10 001 steps: streamed to its file a chunk at a time."""
+    steps = STREAM_STEPS + 1
+    ramp = lambda a, b: [a + (b - a) * i / (steps - 1) for i in range(steps)]  # noqa: E731
+    targets = [{"point": "wheel_center", "direction": {"axis": "z"}, "start": -20, "stop": 20}]
+    plans = [Plan("wheel_center", (0.0, 0.0, 1.0), "relative", ramp(-20.0, 20.0))]
+    if _is_rack(geometry):
+        targets.append({"point": "trackrod_inboard", "direction": {"axis": "y"}, "start": -5,
+                        "stop": 5})  # fmt: skip
+        plans.append(Plan("trackrod_inboard", (0.0, 1.0, 0.0), "relative", ramp(-5.0, 5.0)))
+    data = {"version": 1, "steps": steps, "targets": targets}
+    return Inputs(data, to_yaml(data).encode(), [f"{steps} steps (streamed)"]), plans
 
 
 @st.composite
@@ -1043,24 +1083,37 @@ def cases(draw, pictures: bool | None = None) -> Case:
         pictures = _pictures_available()
     commands = COMMANDS + (("draw",) if pictures else ())
     command = draw(st.sampled_from(commands))
-    geometry = draw(geometries())
+    if command == "sensitivity" and chance(draw, 5):
+        command = "validate"  # slow (a point-based solve per step, MuJoCo): rare
+    axle = command in AXLE_COMMANDS and chance(draw, 20 if command != "study" else 10)
+    geometry = draw(axle_geometries() if axle else geometries())
     files = {"g.yaml": geometry.text}
+    extra: dict[str, Inputs] = {}
+    before = None
+    edits: dict[str, bytes] = {}
     g_arg = "g.yaml"
     if chance(draw, 1):
         g_arg = draw(st.sampled_from(("missing.yaml", ".", "g.yaml/")))
     sweep = plans = None
     outputs: list[str] = []
     quiet = False
-    if command in ("sweep", "sensitivity", "urdf-at"):
+    if command in ("sweep", "sensitivity", "urdf-at", "loads", "validate", "study"):
         with_sweep = command != "sensitivity" or not chance(draw, 25)
-        if with_sweep:
-            sweep, plans = draw(sweeps(geometry.data, 20 if command == "sensitivity" else 60))
+        longest = {"sensitivity": 20, "loads": 20, "validate": 4, "study": 5}.get(command, 60)
+        if with_sweep and axle:
+            sweep, plans = draw(axle_sweeps(geometry.data, min(longest, 30)))
+        elif with_sweep:
+            sweep, plans = draw(sweeps(geometry.data, longest))
+        if command == "sweep" and not axle and chance(draw, 1) and chance(draw, 30):
+            sweep, plans = _long_sweep(geometry.data)
+        if sweep is not None:
             files["s.yaml"] = sweep.text
     s_arg = "s.yaml"
     if sweep is not None and chance(draw, 1):
         s_arg = draw(st.sampled_from(("missing.yaml", "g.yaml", ".")))
+    table = "out.parquet" if chance(draw, 15) else "out.csv"
     if command == "sweep":
-        out = _output(draw, "out.csv", files)
+        out = _output(draw, table, files)
         quiet = not chance(draw, 30)
         argv = ["sweep", g_arg, s_arg, "-o", out] + (["-q"] if quiet else [])
         outputs.append(out)
@@ -1107,9 +1160,43 @@ def cases(draw, pictures: bool | None = None) -> Case:
         out = _output(draw, draw(st.sampled_from(("d.png", "d.svg", "d.txt"))), files)
         argv = ["draw", g_arg, "-o", out]
         outputs.append(out)
+    elif command == "loads":
+        loads = draw(load_cases(axle))
+        files["c.yaml"] = loads.text
+        extra["c.yaml"] = loads
+        out = _output(draw, table, files)
+        quiet = not chance(draw, 30)
+        argv = ["loads", g_arg, s_arg, "--cases", "c.yaml", "-o", out] + (["-q"] if quiet else [])
+        outputs.append(out)
+    elif command == "validate":
+        engine = draw(st.sampled_from(("pointwise",) * 4 + ("mujoco",)))
+        argv = ["validate", g_arg, s_arg, "--engine", engine]
+        if chance(draw, 10):
+            argv += ["--tolerance", draw(st.sampled_from(("1e-6", "0", "-1", "x", "1e-12")))]
+    elif command == "study":
+        study = draw(studies(geometry.data))
+        files["study.yaml"] = study.text
+        extra["study.yaml"] = study
+        out = draw(st.sampled_from(("res",) * 12 + ("res/", "new/res", "g.yaml", ".")))
+        argv = ["study", "study.yaml", "-o", out, "--scheduler", "none"]
+        if chance(draw, 30):
+            argv.append("--steps")
+        quiet = not chance(draw, 30)
+        argv += ["-q"] if quiet else []
+        if chance(draw, 30):  # run it, maybe change an input, then --resume
+            before = list(argv)
+            argv.append("--resume")
+            edit = draw(st.sampled_from(("none", "g.yaml", "s.yaml", "study.yaml", "parts")))
+            if edit in files:
+                edits[edit] = files[edit] + b"# changed after the run\n"
+            elif edit == "parts":
+                edits[os.path.join(out, "variants.parquet")] = b""  # a stranger's file
+        outputs.append(out)
     else:  # setup
         argv = ["setup", g_arg]
         argv += draw(_setup_arguments(geometry.data))
+        if axle and chance(draw, 40):
+            argv += ["--side", draw(st.sampled_from(("left", "right")))]
         if chance(draw, 35):
             out = _output(draw, "set.yaml", files)
             argv += ["-o", out]
@@ -1127,7 +1214,10 @@ def cases(draw, pictures: bool | None = None) -> Case:
                 links[out] = draw(st.sampled_from(sorted(files)))
             elif chance(draw, 20):
                 stale.append(out)
-    return Case(command, argv, files, outputs, geometry, sweep, plans, stale, quiet, links)
+    return Case(
+        command, argv, files, outputs, geometry, sweep, plans, stale, quiet, links, extra,
+        before, edits,
+    )  # fmt: skip
 
 
 def _has(geometry, what: str) -> bool:
@@ -1136,6 +1226,15 @@ def _has(geometry, what: str) -> bool:
     pushrod."""
     if not isinstance(geometry, dict):
         return False
+    if _is_axle_data(geometry):
+        ac = geometry.get("axle_config") if isinstance(geometry.get("axle_config"), dict) else {}
+        setup = ac.get("left_setup") if isinstance(ac.get("left_setup"), dict) else {}
+        actuation = ac.get("actuation") if isinstance(ac.get("actuation"), dict) else {}
+        return {
+            "shim": isinstance(setup.get("camber_shim"), dict),
+            "link": _kind(geometry) not in (None, "trailing_arm"),
+            "pushrod": actuation.get("type") == "pushrod_rocker",
+        }[what]
     config = geometry.get("config") if isinstance(geometry.get("config"), dict) else {}
     if what == "shim":
         return isinstance(config.get("camber_shim"), dict)
@@ -1241,9 +1340,22 @@ def run_case(case: Case):
             path.write_bytes(STALE)
         for name, target in case.links.items():
             (run_dir / name).symlink_to(target)
+        cwd = os.getcwd()
+        if case.before is not None:  # its own invariants are another case's
+            os.chdir(run_dir)
+            try:
+                with (
+                    contextlib.redirect_stdout(io.StringIO()),
+                    contextlib.redirect_stderr(io.StringIO()),
+                ):
+                    main(list(case.before))
+            finally:
+                os.chdir(cwd)
+            for name, text in case.edits.items():
+                if (run_dir / name).parent.is_dir():  # (the first run may have written none)
+                    (run_dir / name).write_bytes(text)
         before = _snapshot(run_dir)
         out, err = io.StringIO(), io.StringIO()
-        cwd = os.getcwd()
         os.chdir(run_dir)
         start = time.perf_counter()
         try:
@@ -1251,7 +1363,7 @@ def run_case(case: Case):
                 code = main(list(case.argv))
         except Exception as exc:
             COUNTS[case.command, type(exc).__name__] += 1
-            BY_MECHANISM[_kind(case.geometry.data) or "(none)", type(exc).__name__] += 1
+            BY_MECHANISM[label(case.geometry.data), type(exc).__name__] += 1
             exc.add_note(f"escaped pin_susp.cli.main() (invariant 4, never a traceback)\n{case!r}")
             exc.add_note(f"stderr: {err.getvalue()!r}")
             raise
@@ -1261,7 +1373,7 @@ def run_case(case: Case):
             SLOWEST.sort(reverse=True)
             del SLOWEST[3:]
         COUNTS[case.command, code] += 1
-        BY_MECHANISM[_kind(case.geometry.data) or "(none)", code] += 1
+        BY_MECHANISM[label(case.geometry.data), code] += 1
         after = _snapshot(run_dir)
         texts = {
             name: (run_dir / name).read_bytes()
@@ -1292,6 +1404,9 @@ EXIT_CODES = {
     "mjcf": {0, 2},
     "setup": {0, 2},
     "draw": {0, 2},
+    "loads": {0, 1, 2},
+    "validate": {0, 1, 2},
+    "study": {0, 1, 2},
 }
 _WARNING = re.compile(r"pin-susp: warning: (\d+) of (\d+) steps did not converge")
 _STEPS = re.compile(r"\bsteps? (\d+(?:, \d+)*)")
@@ -1307,6 +1422,13 @@ def check_case(case: Case, o: Outcome) -> None:
     if case.command == "sensitivity" and "--sweep" not in case.argv:
         expected = {0, 2}
     assert isinstance(o.code, int) and o.code in expected, "unexpected exit code" + context
+    lines = [line for line in o.stderr.splitlines() if line.strip()]
+    named = expected_refusal(case)
+    if named is not None and case.command != "study":
+        # a degenerate mechanism: refused at load, on one line naming its points
+        assert o.code == 2, f"a degenerate geometry ({named}) not refused" + context
+        if len(lines) == 1 and "g.yaml: " in lines[0]:
+            assert any(n in lines[0] for n in named), f"the refusal names none of {named}" + context
     # 5. nothing outside the declared outputs; no temporary file; no MuJoCo log
     leftovers = [p for p in o.new | o.changed if Path(p).name.startswith(".pin_susp-")]
     assert not leftovers, f"temporary files left: {leftovers}" + context
@@ -1314,7 +1436,6 @@ def check_case(case: Case, o: Outcome) -> None:
     assert not o.removed, f"files removed: {sorted(o.removed)}" + context
     inputs_changed = sorted(set(case.files) & o.changed)
     assert not inputs_changed, f"input files changed: {inputs_changed}" + context
-    lines = [line for line in o.stderr.splitlines() if line.strip()]
     paths_out = [os.path.normpath(out) for out in case.outputs]
     if len(set(paths_out)) < len(paths_out):
         assert o.code == 2, "two outputs on one path: one of them lost, not refused" + context
@@ -1326,19 +1447,25 @@ def check_case(case: Case, o: Outcome) -> None:
         assert not o.changed, f"exit 2 but changed {sorted(o.changed)}" + context
         return
     allowed = _declared(case)
-    stray = sorted(p for p in o.new | o.changed if p not in allowed)
+    trees = [os.path.normpath(out) + os.sep for out in case.outputs if case.command == "study"]
+    stray = sorted(p for p in o.new | o.changed if p not in allowed
+                   and not any(p.startswith(t) for t in trees))  # fmt: skip
     assert not stray, f"wrote outside the declared outputs: {stray}" + context
     errors = [line for line in lines if line.startswith("pin-susp: error")]
     assert not errors, f"exit {o.code} with an error line" + context
     for out in case.outputs:
         written = o.texts.get(os.path.normpath(out), STALE) != STALE
+        if case.command == "study":
+            written = os.path.normpath(os.path.join(out, "variants.parquet")) in o.texts
         # a report of a sweep where no step converged has nothing to draw: exit 1, said so
         skipped = o.code == 1 and f"{out} not drawn" in o.stderr
         assert written or skipped, f"exit {o.code} but {out} not written" + context
     if case.quiet and o.code == 0:
         assert o.stdout == "", "-q printed on stdout" + context
-    if case.command == "sweep":
+    if case.command in ("sweep", "loads"):
         _check_sweep(case, o, lines, context)
+    elif case.command == "study":
+        _check_study(case, o, context)
     elif case.command == "sensitivity":
         _check_sensitivity(case, o, lines, context)
     elif case.command == "setup":
@@ -1384,30 +1511,59 @@ def _warning(lines, context) -> tuple[int, int, set[int], list[str]]:
 
 
 def _check_sweep(case: Case, o: Outcome, lines, context) -> None:
-    text = o.texts[os.path.normpath(case.outputs[0])].decode()
+    """A sweep's or a loads run's table (CSV, or Parquet read back with pyarrow): the
+    sources' hashes, one row per step (and load case), the flags, and the rows."""
+    raw = o.texts[os.path.normpath(case.outputs[0])]
+    if case.outputs[0].endswith(".parquet"):
+        assert raw[:4] == b"PAR1", "a .parquet output that is not Parquet" + context
+        header, rows, meta = parquet_rows(raw)
+        shas = {k: json.loads(meta[k])["sha256"] for k in ("geometry", "sweep") if k in meta}
+    else:
+        text = raw.decode()
+        shas = {}
+        for what in ("geometry", "sweep"):
+            line = next((x for x in text.splitlines() if x.startswith(f"# {what}: ")), "")
+            sha = re.search(r"sha256=([0-9a-f]{64})", line)
+            if sha:
+                shas[what] = sha.group(1)
+        header, rows = parse_csv(text)
     for what, name in (("geometry", case.argv[1]), ("sweep", case.argv[2])):
-        line = next((x for x in text.splitlines() if x.startswith(f"# {what}: ")), "")
-        sha = re.search(r"sha256=([0-9a-f]{64})", line)
-        assert sha, f"no sha256 of the {what} in the CSV" + context
+        assert what in shas, f"no sha256 of the {what} in the output" + context
         digest = hashlib.sha256(case.files[os.path.normpath(name)]).hexdigest()
-        assert sha.group(1) == digest, f"the CSV's sha256 of {name} is not its bytes'" + context
-    header, rows = parse_csv(text)
+        assert shas[what] == digest, f"the output's sha256 of {name} is not its bytes'" + context
     for name in SOLVER_COLUMNS:
         assert name in header, f"no {name} column" + context
     col = {name: i for i, name in enumerate(header)}
     assert all(len(r) == len(header) for r in rows), "a row with a wrong cell count" + context
-    assert [r[0] for r in rows] == [str(i) for i in range(len(rows))], "step_index" + context
+    per_step = 1
+    if case.command == "loads":
+        names = list(dict.fromkeys(r[col["load_case"]] for r in rows))
+        per_step = max(len(names), 1)
+        expected_cases = [r[col["load_case"]] for r in rows[:per_step]] * (len(rows) // per_step)
+        assert [r[col["load_case"]] for r in rows] == expected_cases, "load case order" + context
+    steps_of = [str(i // per_step) for i in range(len(rows))]
+    assert [r[0] for r in rows] == steps_of, "step_index" + context
     if case.plans:
-        assert len(rows) == len(case.plans[0].values), "not one row per step" + context
+        n = len(case.plans[0].values) * per_step
+        assert len(rows) == n, "not one row per step (and load case)" + context
     flags = [r[col["solver_converged"]] for r in rows]
     assert set(flags) <= {"True", "False"}, f"solver_converged cells {set(flags)}" + context
-    failed = [i for i, f in enumerate(flags) if f == "False"]
+    failed = sorted({i // per_step for i, f in enumerate(flags) if f == "False"})
+    for i in range(0, len(rows), per_step):  # a step's flag is every case's
+        assert len(set(flags[i : i + per_step])) == 1, (
+            f"step {i // per_step}: mixed flags" + context
+        )
     solver = {col[n] for n in SOLVER_COLUMNS}
+    text = {col["solver_converged"]}
+    if case.command == "loads":  # every row names its case, and whether it is at a toggle
+        solver |= {col["load_case"], col["loads_unbounded"]}
+        text.add(col["load_case"])
     for i, r in enumerate(rows):
         if flags[i] == "True":
             residual = float(r[col["solver_max_residual"]])
+            assert math.isfinite(residual), f"row {i}: residual {residual}" + context
             assert residual <= RESIDUAL_LIMIT, f"row {i}: residual {residual}" + context
-            bad = [header[j] for j, c in enumerate(r) if j != col["solver_converged"]
+            bad = [header[j] for j, c in enumerate(r) if j not in text
                    and not _finite_or_empty(c)]  # fmt: skip
             assert not bad, f"row {i}: non-finite cells {bad[:5]}" + context
         else:
@@ -1421,10 +1577,13 @@ def _check_sweep(case: Case, o: Outcome, lines, context) -> None:
         # 2. exit 1 only with the failing steps named
         assert failed, "exit 1 but every row converged" + context
         n, total, named, _ = _warning(lines, context)
-        assert n == len(failed) and total == len(rows), "warning counts" + context
+        assert n == len(failed) and total == len(rows) // per_step, "warning counts" + context
         assert named <= set(failed), f"named {sorted(named - set(failed))} converged" + context
         assert set(failed[:10]) <= named, f"failed {failed[:10]}, named {sorted(named)}" + context
-    _check_geometry_of_rows(case, o, header, rows, context)
+    if "scope: axle" in case.geometry.text.decode("utf-8", "replace"):
+        _check_axle_rows(case, o, header, rows[::per_step], context)
+    else:
+        _check_geometry_of_rows(case, o, header, rows[::per_step], context)
 
 
 def _check_sensitivity(case: Case, o: Outcome, lines, context) -> None:
@@ -1455,10 +1614,47 @@ def _check_setup(case: Case, o: Outcome, context) -> None:
             assert not bad, f"setup sheet cells {bad[:5]}" + context
         else:
             from pin_susp import load_geometry
+            from pin_susp.axle import load_axle
 
+            load = load_axle if b"scope: axle" in text else load_geometry
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                load_geometry(Path(o.directory) / os.path.normpath(out))  # reads back
+                load(Path(o.directory) / os.path.normpath(out))  # reads back
+
+
+def _check_study(case: Case, o: Outcome, context) -> None:
+    """variants.parquet: exit 0 only with every variant converged at every step, exit 1
+    only with some flagged (steps_failed > 0, or an error saying why); steps.parquet
+    (--steps): a converged step's residual within 1e-9 mm, a failed one's blank."""
+    import pyarrow.parquet as pq
+
+    out = Path(o.directory) / os.path.normpath(case.outputs[0])
+    variants = pq.read_table(out / "variants.parquet").to_pylist()
+    assert variants, "no variant rows" + context
+    flagged = [v["variant_id"] for v in variants if not v["converged"]]
+    for v in variants:
+        if v["converged"]:
+            assert v["steps_failed"] == 0 and not v["error"], f"variant {v}" + context
+        else:
+            assert v["steps_failed"] > 0 or v["error"], f"variant {v} flagged, no cause" + context
+    if o.code == 0:
+        assert not flagged, f"exit 0 with variants {flagged[:10]} flagged" + context
+    else:
+        assert flagged, "exit 1 but every variant converged" + context
+    if "--steps" in case.argv:
+        import pyarrow.dataset as ds
+
+        steps = ds.dataset(out / "steps.parquet").to_table().to_pylist()
+        failed: Counter = Counter()
+        for row in steps:
+            if row["solver_converged"]:
+                r = row["solver_max_residual"]
+                assert r is not None and r <= RESIDUAL_LIMIT, f"a step's residual {r}" + context
+            else:
+                failed[row["variant_id"]] += 1
+        for v in variants:
+            if not v["error"]:
+                assert failed[v["variant_id"]] == v["steps_failed"], "steps_failed" + context
 
 
 # ------------------------------------------------- independent check of converged rows
@@ -1636,10 +1832,67 @@ def _check_geometry_of_rows(case: Case, o: Outcome, header, rows, context) -> No
     with warnings.catch_warnings():  # implausible values: the run has reported them
         warnings.simplefilter("ignore")
         g = Corner(str(Path(o.directory) / "g.yaml")).geometry
+    ROWS_CHECKED[g.type] += len(converged)
+    _check_rows_of(g, case.plans, header, converged, context)
+
+
+def _check_axle_rows(case: Case, o: Outcome, header, rows, context) -> None:
+    """An axle's converged rows, each corner as a corner from its own columns (left_…,
+    right_…: every rigid distance, the chassis, the rack's line, the branches, its
+    targets), and the heave and roll targets from both wheel centres."""
+    converged = [r for r in rows if r[header.index("solver_converged")] == "True"]
+    if not converged:
+        return
+    from pin_susp.axle import load_axle
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        axle = load_axle(str(Path(o.directory) / "g.yaml"))
+    ROWS_CHECKED[f"{axle.left.type} axle"] += len(converged)
+    design = {}
+    from pin_susp.setup import apply_setup
+
+    for side in ("left", "right"):
+        g = apply_setup(axle.corner(side))  # as set, as AxleModel solves it
+        design[side] = design_points(g)
+        prefix = f"{side}_"
+        renamed = [
+            h[len(prefix) :]
+            if h.startswith(prefix)
+            else ("other " + h if h.startswith(("left_", "right_")) else h)
+            for h in header
+        ]
+        plans = [p for p in case.plans or () if p.side == side and p.mode != "quantity"]
+        _check_rows_of(g, plans, renamed, converged, context)
+    col = {name: i for i, name in enumerate(header)}
+    scale = max(abs(x) for v in design["left"].values() for x in v)
+    tol = GEOMETRIC_TOLERANCE + 1e-12 * scale
+    for r in converged:
+        step = int(r[0])
+
+        def at(side, name, r=r):
+            return [float(r[col[f"{side}_{name}_{a}"]]) for a in "xyz"]
+
+        rise = {s: at(s, "wheel_center")[2] - design[s]["wheel_center"][2] for s in design}
+        for plan in case.plans or ():
+            if plan.mode != "quantity":
+                continue
+            if plan.point == "heave":
+                err = abs((rise["left"] + rise["right"]) / 2 - plan.values[step])
+            else:
+                across = (
+                    at("left", "contact_patch_center")[1] - at("right", "contact_patch_center")[1]
+                )
+                roll = math.atan2(rise["left"] - rise["right"], across)
+                err = abs(roll - math.radians(plan.values[step])) * abs(across)
+            assert err <= tol, f"step {step}: the axle's {plan.point} off by {err} mm" + context
+
+
+def _check_rows_of(g, plans, header, converged, context) -> None:
+    """The rows of one corner ``g`` (as set): from the columns named as a corner's."""
     design = design_points(g)
     col = {name: i for i, name in enumerate(header)}
     chassis, groups, loops, lines = bodies(g)
-    ROWS_CHECKED[g.type] += len(converged)
     scale = max(abs(x) for v in design.values() for x in v)
     tol = GEOMETRIC_TOLERANCE + 1e-12 * scale
     signs = {}
@@ -1689,7 +1942,7 @@ def _check_geometry_of_rows(case: Case, o: Outcome, header, rows, context) -> No
             travel = float(r[col["wheel_travel"]])
             err = abs(travel - (at("wheel_center")[2] - design["wheel_center"][2]))
             assert err <= tol, f"step {step}: wheel_travel off by {err} mm" + context
-        for plan in case.plans or ():
+        for plan in plans or ():
             p = at(plan.point)
             if p is None or plan.point not in design:
                 continue
@@ -1725,7 +1978,9 @@ def summary() -> str:
         c = by_mechanism[mechanism]
         counts = ", ".join(f"exit {k}: {v}" for k, v in sorted(c.items(), key=str))
         rows = (
-            f"; {ROWS_CHECKED[mechanism]} converged rows checked" if mechanism in MECHANISMS else ""
+            f"; {ROWS_CHECKED[mechanism]} converged rows checked"
+            if mechanism.removesuffix(" axle") in MECHANISMS
+            else ""
         )
         lines.append(f"  {mechanism:<16} {sum(c.values()):>6}  ({counts}{rows})")
     if SLOWEST:
@@ -1786,3 +2041,666 @@ def save_case(case: Case, exc: BaseException, folder: Path, keep_smaller: bool =
     (where / "problem.txt").write_text(f"{problem}\n{case!r}\n")
     sized.write_text(json.dumps(size(case)))
     return where
+
+
+# ------------------------------------------------- degenerate input, per mechanism
+
+
+def _degenerate_moves(data) -> list[tuple[str, str, str, float, tuple[str, ...]]]:
+    """(label, point, a, t, names): point := a + t·(b − a) makes the mechanism
+    degenerate (coincident pivots, a pivot on a spindle point, a zero-length arm);
+    the refusal must name one of ``names``. ``b`` is names[-1] (t = 0: onto a)."""
+    kind = _kind(data)
+    hp = data.get("hardpoints") if isinstance(data, dict) else None
+    if kind is None or not isinstance(hp, dict):
+        return []
+    have = {n for n in hp if _numeric_point(hp[n]) is not None}
+    moves = []
+
+    def add(label, point, a, b, t):
+        if {point, a, b} <= have:
+            moves.append((label, point, a, t, (point, a, b)))
+
+    moves_for_steering = []
+    for inner, outer in (
+        ("trackrod_inboard", "trackrod_outboard"),
+        ("toe_link_inboard", "toe_link_outboard"),
+    ):
+        moves_for_steering.append(("a link of no length", outer, inner, inner, 0.0))
+    add("the spin axis of no length", "axle_outboard", "axle_inboard", "axle_inboard", 0.0)
+    add("a coilover of no length", "strut_bottom", "strut_top", "strut_top", 0.0)
+    for args in moves_for_steering:
+        add(*args)
+    if kind in ("double_wishbone", "macpherson"):
+        for arm in ("lower_wishbone", "upper_wishbone"):
+            front, rear = f"{arm}_inboard_front", f"{arm}_inboard_rear"
+            add("coincident pivots", rear, front, front, 0.0)
+            for t in (0.0, 0.5, 2.0):  # the ball joint on the pivot axis: no arm
+                add("a zero-length arm", f"{arm}_outboard", front, rear, t)
+        if kind == "double_wishbone":
+            add(
+                "coincident ball joints",
+                "upper_wishbone_outboard",
+                "lower_wishbone_outboard",
+                "lower_wishbone_outboard",
+                0.0,
+            )
+            add("coincident rocker pivots", "rocker_axis_b", "rocker_axis_a", "rocker_axis_a", 0.0)
+            add(
+                "a pushrod of no length",
+                "pushrod_inboard",
+                "pushrod_outboard",
+                "pushrod_outboard",
+                0.0,
+            )
+            add(
+                "the pushrod on the rocker axis",
+                "pushrod_inboard",
+                "rocker_axis_a",
+                "rocker_axis_b",
+                0.5,
+            )
+        else:
+            add(
+                "the strut axis of no length",
+                "strut_top",
+                "lower_wishbone_outboard",
+                "lower_wishbone_outboard",
+                0.0,
+            )
+            add(
+                "the clamp on the ball joint",
+                "strut_bottom",
+                "lower_wishbone_outboard",
+                "lower_wishbone_outboard",
+                0.0,
+            )
+    elif kind == "multilink":
+        for link in LINKS:
+            add(
+                "a link of no length", f"{link}_outboard", f"{link}_inboard", f"{link}_inboard", 0.0
+            )
+    elif kind == "trailing_arm":
+        add(
+            "coincident pivots", "arm_pivot_outboard", "arm_pivot_inboard", "arm_pivot_inboard", 0.0
+        )
+        for t in (0.0, 0.5, 2.0):  # the spindle on the pivot axis: an arm of no length
+            add(
+                "the spindle on the pivot axis",
+                "axle_outboard",
+                "arm_pivot_inboard",
+                "arm_pivot_outboard",
+                t,
+            )
+    return moves
+
+
+@st.composite
+def _degenerate(draw, data) -> str:
+    """One degenerate move of the mechanism, exactly (or within a fraction of the 1e-3 mm
+    that counts as one point); the expected refusal is recorded on the data."""
+    moves = _degenerate_moves(data)
+    if not moves:
+        return "degenerate_named (not applicable)"
+    label, point, a, t, names = draw(st.sampled_from(moves))
+    b = names[-1]
+    eps = draw(st.sampled_from((0.0, 0.0, 1e-5, 2e-4)))  # mm: all below 1e-3 mm
+    hp = data["hardpoints"]
+    pa, pb = _numeric_point(hp[a]), _numeric_point(hp[b])
+    new = [round(pa[i] + t * (pb[i] - pa[i]), 9) + (eps if i == 2 else 0.0) for i in range(3)]
+    hp[point] = dict(zip("xyz", new, strict=True))
+    move = f"{point} = {a} + {t:g}·({b} − {a}) + {eps:g} mm z"
+    return f"degenerate: {label}: {move} ({', '.join(names)})"
+
+
+_NAMES = re.compile(r"\(([a-z_]+(?:, [a-z_]+)+)\)$")
+
+
+def expected_refusal(case: Case) -> tuple[str, ...] | None:
+    """The points a degenerate geometry's refusal must name, when the degenerate move
+    was the geometry's only change besides small perturbations."""
+    changes = case.geometry.changes
+    marked = [c for c in changes if c.startswith("degenerate: ")]
+    others = [c for c in changes[1:] if not c.startswith(("degenerate: ", "all ±5", "text "))]
+    if len(marked) != 1 or others or re.search(r" [+-]\d", " ".join(changes[1:])):
+        return None
+    m = _NAMES.search(marked[0])
+    return tuple(m.group(1).split(", ")) if m else None
+
+
+# --------------------------------------------------------------------------- axles
+
+AXLE_FILES = (
+    "examples/axle_front.yaml",  # U-bar on the rockers, coilovers, rack
+    "tests/data/axle_t_bar.yaml",  # T-bar
+    "tests/data/open_kinematics_axle_geometry.yaml",  # no bar, no spring
+    "tests/data/open_kinematics_axle_geometry_rocker.yaml",
+)
+AXLE_BASES = {name: yaml.safe_load((ROOT / name).read_text()) for name in AXLE_FILES}
+
+
+def as_axle(corner: dict) -> dict:
+    """A corner example as the axle of two of it (its right side mirrored): an axle of
+    every mechanism (docs/axle.md)."""
+    d = copy.deepcopy(corner)
+    config = d.pop("config", {}) or {}
+    vehicle = {
+        k: config.pop(k) for k in ("cg_position", "wheelbase", "front_brake_bias") if k in config
+    }
+    for k in ("driven_axle", "opposite_axle_axis_height", "strut"):
+        config.pop(k, None)
+    left = {k: config.pop(k) for k in ("camber_shim",) if k in config}
+    left |= config.pop("setup", None) or {}
+    axle = {"axle_position": "front", **config}
+    for k in ("actuation", "spring"):
+        if k in d:
+            axle[k] = d[k]
+    axle |= {"anti_roll": {"type": "none"}, "heave_link": {"type": "none"}}
+    if left:
+        axle["left_setup"] = left
+    out = {"type": d.get("type", "double_wishbone"), "scope": "axle", "name": "axle"}
+    out |= {"units": "millimeters", "vehicle_config": vehicle} if vehicle else {}
+    out |= {"axle_config": axle, "hardpoints": {"left": d["hardpoints"]}}
+    return out
+
+
+for _name in ("macpherson.yaml", "multilink_rear.yaml", "semi_trailing_arm.yaml"):
+    AXLE_BASES[f"{_name} as an axle"] = as_axle(BASES[_name])
+
+
+def _is_axle_data(data) -> bool:
+    return isinstance(data, dict) and data.get("scope") == "axle"
+
+
+def label(data) -> str:
+    """The mechanism a geometry names, as counted: 'multilink', 'multilink axle'."""
+    kind = _kind(data) or "(none)"
+    return f"{kind} axle" if _is_axle_data(data) and kind != "(none)" else kind
+
+
+def _axle_coordinate_paths(data) -> list[tuple]:
+    hp = data.get("hardpoints")
+    out = []
+    if isinstance(hp, dict):
+        for section, points in hp.items():
+            if isinstance(points, dict):
+                for name, point in points.items():
+                    if isinstance(point, dict):
+                        out += [
+                            ("hardpoints", section, name, a)
+                            for a in "xyz"
+                            if _is_number(point.get(a))
+                        ]
+    return out
+
+
+def _mirrored(points: dict) -> dict:
+    out = copy.deepcopy(points)
+    for p in out.values():
+        if isinstance(p, dict) and _is_number(p.get("y")):
+            p["y"] = -p["y"]
+    return out
+
+
+@st.composite
+def _mutate_axle(draw, data) -> str:
+    kinds = (
+        "drop_key unknown_key retype wild_coordinate anti_roll anti_roll stiffness heave_link "
+        "right_side right_side setup mount type restyle_number drop_point"
+    ).split()
+    kind = draw(st.sampled_from(kinds))
+    ac = data.get("axle_config") if isinstance(data.get("axle_config"), dict) else None
+    hp = data.get("hardpoints") if isinstance(data.get("hardpoints"), dict) else {}
+    if kind == "drop_key":
+        path = draw(st.sampled_from(sorted(paths(data, lambda n: True), key=repr)))
+        del get(data, path[:-1])[path[-1]]
+        return f"drop {'.'.join(map(str, path))}"
+    if kind == "unknown_key":
+        maps = [()] + paths(data, lambda n: isinstance(n, dict))
+        path = draw(st.sampled_from(sorted(maps, key=repr)))
+        key = draw(st.sampled_from(UNKNOWN_KEYS + ("config", "side", "droplink")))
+        get(data, path)[key] = draw(st.one_of(small(100), wild()))
+        return f"unknown key {key!r} in {'.'.join(map(str, path)) or 'top'}"
+    if kind == "retype":
+        leaves = [p for p in paths(data, _is_leaf) if p[0] != "hardpoints"] or [("name",)]
+        path = draw(st.sampled_from(sorted(leaves, key=repr)))
+        value = draw(st.one_of(wild(), small(100)))
+        put(data, path, value)
+        return f"{'.'.join(map(str, path))} = {value!r}"
+    if kind == "wild_coordinate" and _axle_coordinate_paths(data):
+        path = draw(st.sampled_from(_axle_coordinate_paths(data)))
+        value = draw(st.one_of(wild(), small(600)))
+        put(data, path, value)
+        return f"{'.'.join(map(str, path))} = {value!r}"
+    if kind == "drop_point" and _axle_coordinate_paths(data):
+        path = draw(st.sampled_from(_axle_coordinate_paths(data)))[:3]
+        del get(data, path[:-1])[path[-1]]
+        return f"drop {'.'.join(path)}"
+    if ac is None:
+        return f"{kind} (no axle_config)"
+    if kind == "anti_roll":
+        value = draw(st.sampled_from(("none", "u_bar", "t_bar", "x_bar", None)))
+        ac["anti_roll"] = {"type": value}
+        left = hp.get("left") if isinstance(hp.get("left"), dict) else {}
+        center = hp.setdefault("center", {}) if isinstance(hp.get("center", {}), dict) else {}
+        if value in ("u_bar", "t_bar") and draw(st.booleans()) and "droplink_rocker" not in left:
+            # a droplink from the lower wishbone (or the wheel's body) to the bar
+            ac["anti_roll"]["mount"] = draw(st.sampled_from(("lower_wishbone", "upright", "arm")))
+            lbj = _numeric_point(left.get("lower_wishbone_outboard")) or [0.0, 700.0, 200.0]
+            left["droplink_lower"] = {"x": lbj[0] + 60, "y": lbj[1] - 120, "z": lbj[2] + 20}
+            end = "droplink_u_bar" if value == "u_bar" else "droplink_t_bar"
+            left[end] = {"x": lbj[0] + 60, "y": 300.0, "z": lbj[2] + 10}
+            if value == "u_bar":
+                center["arb_u_bar_axis_a"] = {"x": lbj[0] - 40, "y": 300.0, "z": lbj[2] + 10}
+                center["arb_u_bar_axis_b"] = {"x": lbj[0] - 40, "y": -300.0, "z": lbj[2] + 10}
+            else:
+                left[end]["y"] = 300.0
+                center["arb_t_bar_pivot"] = {"x": lbj[0] - 200, "y": 0.0, "z": lbj[2] + 10}
+            return f"anti_roll {value} on the {ac['anti_roll']['mount']} (points fitted)"
+        return f"anti_roll {value!r}"
+    if kind == "stiffness":
+        anti = ac.get("anti_roll")
+        if isinstance(anti, dict):
+            anti["stiffness"] = draw(st.sampled_from(("rigid", 10.0, 250, 0, -5, "stiff", 1e300)))
+            return f"anti_roll.stiffness = {anti['stiffness']!r}"
+        return "stiffness (no anti_roll)"
+    if kind == "heave_link":
+        value = draw(st.sampled_from(("rocker_to_rocker", "none", "spring")))
+        ac["heave_link"] = {"type": value}
+        left = hp.get("left")
+        if value == "rocker_to_rocker" and isinstance(left, dict) and draw(st.booleans()):
+            left["heave_link_rocker"] = {"x": 0, "y": 320, "z": 480}
+            return "heave_link rocker_to_rocker (point fitted)"
+        return f"heave_link {value}"
+    if kind == "right_side":
+        left = hp.get("left")
+        if isinstance(left, dict):
+            hp["right"] = _mirrored(left)
+            if draw(st.booleans()):  # an asymmetric axle
+                paths_ = _axle_coordinate_paths({"hardpoints": {"right": hp["right"]}})
+                path = draw(st.sampled_from(paths_))
+                put(data, path, round(get(data, path) + draw(small(3)), 6))
+                return f"hardpoints.right: the mirror of left, {'.'.join(path[2:])} moved"
+            return "hardpoints.right: the mirror of left"
+        return "right_side (no left)"
+    if kind == "setup":
+        side = draw(st.sampled_from(("left_setup", "right_setup")))
+        key = draw(st.sampled_from(("trackrod_length_delta", "pushrod_length_delta", "colour")))
+        ac.setdefault(side, {})
+        if isinstance(ac[side], dict):
+            ac[side][key] = draw(st.one_of(small(5), wild()))
+            return f"axle_config.{side}.{key} = {ac[side][key]!r}"
+        return "setup (not a mapping)"
+    if kind == "mount":
+        anti = ac.get("anti_roll")
+        if isinstance(anti, dict):
+            anti["mount"] = draw(st.sampled_from(("upright", "lower_wishbone", "rocker", "arm")))
+            return f"anti_roll.mount = {anti['mount']}"
+        return "mount (no anti_roll)"
+    if kind == "type":
+        data["type"] = draw(st.sampled_from(MECHANISMS + ("double_wishbone_axle",)))
+        return f"type = {data['type']}"
+    if kind == "restyle_number":
+        numbers = [p for p in paths(data, _is_number) if restyled(get(data, p))]
+        if numbers:
+            path = draw(st.sampled_from(numbers))
+            text = draw(st.sampled_from(restyled(get(data, path))))
+            put(data, path, Raw(text))
+            return f"{'.'.join(map(str, path))} written {text}"
+    return f"{kind} (not applicable)"
+
+
+@st.composite
+def axle_geometries(draw) -> Inputs:
+    """An axle file: an example axle or a corner example as an axle, perturbed, maybe
+    broken."""
+    base = draw(st.sampled_from(sorted(AXLE_BASES)))
+    data = copy.deepcopy(AXLE_BASES[base])
+    changes = [base]
+    if chance(draw, 2):
+        text = draw(st.sampled_from(GARBAGE))
+        return Inputs(None, text, [*changes, f"garbage {text[:30]!r}"])
+    coordinates = _axle_coordinate_paths(data)
+    mode = draw(st.sampled_from(("none", "small", "small", "some")))
+    if mode == "small":  # every coordinate within ±2 mm (the T-bar's ends stay mirrored)
+        deltas = draw(st.lists(small(2), min_size=len(coordinates), max_size=len(coordinates)))
+        for path, d in zip(coordinates, deltas, strict=True):
+            if path[1] != "center" and path[2] != "droplink_t_bar":
+                put(data, path, round(get(data, path) + d, 6))
+        changes.append("all ±2 mm")
+    elif mode == "some":
+        for path, d in draw(
+            st.lists(st.tuples(st.sampled_from(coordinates), small(20)), min_size=1, max_size=3)
+        ):
+            put(data, path, round(get(data, path) + d, 6))
+            changes.append(f"{'.'.join(map(str, path))} {d:+g}")
+    if mode != "none" and _kind(data) == "macpherson":
+        changes.append(_onto_strut_line({"hardpoints": data["hardpoints"]["left"]}))
+    for _ in range(draw(st.sampled_from((0, 0, 0, 1, 1, 2)))):
+        changes.append(draw(_mutate_axle(data)))
+    return Inputs(data, _render(data, draw, changes), changes)
+
+
+def _axle_rack(data) -> bool | None:
+    if not _is_axle_data(data) or _kind(data) is None:
+        return None
+    if _kind(data) == "trailing_arm":
+        return False
+    ac = data.get("axle_config")
+    steering = ac.get("steering", {"type": "rack"}) if isinstance(ac, dict) else None
+    kind = steering.get("type", "rack") if isinstance(steering, dict) else None
+    return {"rack": True, "none": False}.get(kind) if isinstance(kind, str) else None
+
+
+@st.composite
+def axle_sweeps(draw, geometry, max_steps: int = 40):
+    """An axle's sweep: roll and heave (the roll.yaml / heave_roll.yaml kind), or a
+    wheel height per side; and the rack once: (Inputs, plans or None when broken)."""
+    rack = _axle_rack(geometry)
+    if rack is None:
+        rack = draw(st.booleans())
+    steps = draw(st.one_of(st.integers(1, min(8, max_steps)), st.integers(1, max_steps)))
+    targets, plans = [], []
+
+    def ramp(limit, offset=0.0):
+        start, stop = draw(small(limit)), draw(small(limit))
+        values = (
+            [start + (stop - start) * i / (steps - 1) for i in range(steps)]
+            if steps > 1
+            else [start]
+        )
+        return {"start": start, "stop": stop}, values
+
+    if draw(st.booleans()):  # roll and heave
+        spread, values = ramp(draw(st.sampled_from((4, 4, 4, 30, 120))))
+        targets.append({"quantity": "roll", **spread})
+        plans.append(Plan("roll", (0.0, 0.0, 1.0), "quantity", values))
+        spread, values = ramp(25)
+        targets.append({"quantity": "heave", **spread})
+        plans.append(Plan("heave", (0.0, 0.0, 1.0), "quantity", values))
+    else:
+        for side in ("left", "right"):
+            spread, values = ramp(draw(st.sampled_from((40, 40, 40, 400))))
+            targets.append(
+                {"point": "wheel_center", "side": side, "direction": {"axis": "z"}, **spread}
+            )
+            plans.append(Plan("wheel_center", (0.0, 0.0, 1.0), "relative", values, side))
+    if rack:
+        side = draw(st.sampled_from(("left", "right")))
+        spread, values = ramp(10)
+        targets.append(
+            {"point": "trackrod_inboard", "side": side, "direction": {"axis": "y"}, **spread}
+        )
+        plans.append(Plan("trackrod_inboard", (0.0, 1.0, 0.0), "relative", values, side))
+    if chance(draw, 20):
+        order = draw(st.permutations(range(len(targets))))
+        targets, plans = [targets[i] for i in order], [plans[i] for i in order]
+    data = {"version": 1, "steps": steps, "targets": targets}
+    changes = [f"{steps} steps (axle)"]
+    if chance(draw, 15):
+        for _ in range(draw(st.integers(1, 2))):
+            changes.append(draw(_mutate_axle_sweep(data)))
+        plans = None
+    return Inputs(data, to_yaml(data).encode(), changes), plans
+
+
+@st.composite
+def _mutate_axle_sweep(draw, data) -> str:
+    targets = data["targets"]
+    t = draw(st.sampled_from(targets)) if targets else None
+    kind = draw(
+        st.sampled_from(
+            (
+                "no_side",
+                "bad_side",
+                "repeat",
+                "quantity",
+                "drop",
+                "steps",
+                "point_target_without_side",
+                "unknown_key",
+            )
+        )
+    )
+    if t is None:
+        return "no target"
+    if kind == "no_side":
+        t.pop("side", None)
+        return "a target without side"
+    if kind == "bad_side":
+        t["side"] = draw(st.sampled_from(("centre", "both", None, 1, "Left")))
+        return f"side = {t['side']!r}"
+    if kind == "repeat":
+        targets.append(copy.deepcopy(t))
+        return "a target repeated"
+    if kind == "quantity":
+        t.pop("point", None)
+        t["quantity"] = draw(st.sampled_from(("roll", "heave", "pitch", "", None)))
+        return f"quantity = {t['quantity']!r}"
+    if kind == "drop":
+        targets.remove(t)
+        return "a target dropped"
+    if kind == "steps":
+        data["steps"] = draw(st.sampled_from((0, -3, "x", 2**70, None)))
+        return f"steps = {data['steps']!r}"
+    if kind == "point_target_without_side":
+        targets.append({"point": "wheel_center", "direction": {"axis": "z"}, "start": 0, "stop": 1})
+        return "a wheel target without side"
+    t[draw(st.sampled_from(UNKNOWN_KEYS))] = 1
+    return "an unknown key"
+
+
+# --------------------------------------------------------------------------- loads
+
+
+LOAD_BASE = yaml.safe_load((EXAMPLES / "loads.yaml").read_text())
+
+
+@st.composite
+def load_cases(draw, axle: bool) -> Inputs:
+    """A loads file (examples/loads.yaml), per wheel for an axle, maybe broken."""
+    data = copy.deepcopy(LOAD_BASE)
+    cases_ = data["cases"][: draw(st.integers(1, 3))]
+    for case in cases_:
+        if chance(draw, 30):
+            case["wheel_center"] = {"fx": draw(small(500)), "fy": 0.0, "fz": draw(small(500))}
+        if chance(draw, 30):
+            case["moment"] = {"mx": 0.0, "my": draw(small(300)), "mz": draw(small(300))}
+        if axle:
+            blocks = {
+                k: case.pop(k) for k in ("contact_patch", "wheel_center", "moment") if k in case
+            }
+            case["left"] = blocks
+            case["right"] = {k: dict(v) for k, v in blocks.items()} if chance(draw, 80) else {}
+    data["cases"] = cases_
+    changes = [f"{len(cases_)} load cases" + (" per wheel" if axle else "")]
+    if chance(draw, 20):
+        kind = draw(
+            st.sampled_from(
+                ("drop_key", "wild", "unknown", "empty", "duplicate_name", "retype", "no_cases")
+            )
+        )
+        if kind == "drop_key":
+            path = draw(st.sampled_from(sorted(paths(data, lambda n: True), key=repr)))
+            del get(data, path[:-1])[path[-1]]
+            changes.append(f"drop {'.'.join(map(str, path))}")
+        elif kind == "wild":
+            numbers = paths(data, _is_number)
+            if numbers:
+                path = draw(st.sampled_from(numbers))
+                put(data, path, draw(wild()))
+                changes.append(f"{'.'.join(map(str, path))} = {get(data, path)!r}")
+        elif kind == "unknown":
+            maps = [()] + paths(data, lambda n: isinstance(n, dict))
+            path = draw(st.sampled_from(sorted(maps, key=repr)))
+            get(data, path)[draw(st.sampled_from(UNKNOWN_KEYS + ("fw", "left")))] = 1.0
+            changes.append(f"an unknown key in {'.'.join(map(str, path)) or 'top'}")
+        elif kind == "empty":
+            data["cases"] = draw(st.sampled_from(([], None, [{}], [{"name": "x"}])))
+            changes.append(f"cases = {data['cases']!r}")
+        elif kind == "duplicate_name":
+            data["cases"].append(copy.deepcopy(data["cases"][0]))
+            changes.append("a case name twice")
+        elif kind == "retype":
+            path = draw(st.sampled_from(sorted(paths(data, _is_leaf), key=repr)))
+            put(data, path, draw(wild()))
+            changes.append(f"{'.'.join(map(str, path))} = {get(data, path)!r}")
+        else:
+            data = {"version": 1}
+            changes.append("no cases")
+    if chance(draw, 2):
+        text = draw(st.sampled_from(GARBAGE))
+        return Inputs(None, text, [*changes, f"garbage {text[:30]!r}"])
+    return Inputs(data, _render(data, draw, changes), changes)
+
+
+# --------------------------------------------------------------------------- studies
+
+
+@st.composite
+def studies(draw, geometry) -> Inputs:
+    """A tiny study of g.yaml through s.yaml (a handful of variants), maybe malformed."""
+    axle = _is_axle_data(geometry)
+    hp = geometry.get("hardpoints") if isinstance(geometry, dict) else None
+    points = []
+    if isinstance(hp, dict):
+        section = hp.get("left") if axle else hp
+        if isinstance(section, dict):
+            points = sorted(n for n in section if _numeric_point(section[n]) is not None)
+    points = points or ["trackrod_inboard"]
+    variables = []
+    if chance(draw, 15):
+        variables = {"all_hardpoints": {"tolerance": draw(st.sampled_from((0.1, 0.5)))}}
+    else:
+        for _ in range(draw(st.integers(1, 2))):
+            r = draw(st.sampled_from((0.2, 1.0, 3.0)))
+            v = {
+                "point": draw(st.sampled_from(points)),
+                "axis": draw(st.sampled_from("xyz")),
+                "range": [-r, r],
+            }
+            if axle:
+                v["side"] = "left"
+            variables.append(v)
+    kind = draw(st.sampled_from(("doe", "doe", "monte_carlo", "optimise")))
+    data = {
+        "version": 1,
+        "geometry": "g.yaml",
+        "sweep": "s.yaml",
+        "variables": variables,
+        "kind": kind,
+    }
+    if kind == "doe":
+        method = draw(st.sampled_from(("full_factorial", "latin_hypercube", "sobol")))
+        data["doe"] = (
+            {"method": method, "levels": 2}
+            if method == "full_factorial" and isinstance(variables, list)
+            else {
+                "method": method if method != "full_factorial" else "sobol",
+                "samples": 2,
+                "seed": 1,
+            }
+        )
+    elif kind == "monte_carlo":
+        data["monte_carlo"] = {
+            "samples": draw(st.integers(2, 3)),
+            "seed": 1,
+            "distribution": draw(st.sampled_from(("normal", "uniform"))),
+        }
+    else:
+        metric = "camber_left" if axle else "camber"
+        data["optimise"] = {
+            "objective": [{"metric": metric, "relative": True, "target": 0.0, "weight": 1}],
+            "starts": 1,
+            "evaluations": 2,
+        }
+    if chance(draw, 30):
+        data["summary"] = ["camber_left", "roll"] if axle else ["camber", "roadwheel_angle"]
+    changes = [f"{kind} study"]
+    if chance(draw, 25):  # malformed
+        for _ in range(draw(st.integers(1, 2))):
+            what = draw(
+                st.sampled_from(
+                    ("drop_key", "unknown_key", "retype", "variable", "count", "files", "kind")
+                )
+            )
+            if what == "drop_key":
+                path = draw(st.sampled_from(sorted(paths(data, lambda n: True), key=repr)))
+                del get(data, path[:-1])[path[-1]]
+                changes.append(f"drop {'.'.join(map(str, path))}")
+            elif what == "unknown_key":
+                maps = [()] + paths(data, lambda n: isinstance(n, dict))
+                path = draw(st.sampled_from(sorted(maps, key=repr)))
+                get(data, path)[draw(st.sampled_from(UNKNOWN_KEYS))] = 1
+                changes.append(f"unknown key in {'.'.join(map(str, path)) or 'top'}")
+            elif what == "retype":
+                path = draw(st.sampled_from(sorted(paths(data, _is_leaf), key=repr)))
+                value = draw(wild())
+                put(data, path, value)
+                changes.append(f"{'.'.join(map(str, path))} = {value!r}")
+            elif what == "variable" and isinstance(variables, list) and variables:
+                v = variables[0]
+                change = draw(st.sampled_from(("point", "axis", "range", "range", "side")))
+                v.update(
+                    {
+                        "point": {"point": draw(st.sampled_from(("hub", "wheel_center", "")))},
+                        "axis": {"axis": draw(st.sampled_from(("w", "X", None)))},
+                        "range": {
+                            "range": draw(
+                                st.sampled_from(([1, -1], [0, 0], [1], [0, 1e300], ["a", 1], None))
+                            )
+                        },
+                        "side": {"side": draw(st.sampled_from(("centre", "right", None)))},
+                    }[change]
+                )
+                changes.append(f"variable {change} = {v.get(change)!r}")
+            elif what == "count":
+                block = data.get(kind) if isinstance(data.get(kind), dict) else None
+                if block is not None:
+                    key = {"doe": "samples", "monte_carlo": "samples", "optimise": "starts"}[kind]
+                    if "levels" in block:
+                        key = "levels"
+                    block[key] = draw(st.sampled_from((0, -1, 1, 2.5, "many", 10**30, 2**64)))
+                    changes.append(f"{kind}.{key} = {block[key]!r}")
+            elif what == "files":
+                key = draw(st.sampled_from(("geometry", "sweep")))
+                data[key] = draw(
+                    st.sampled_from(("missing.yaml", "study.yaml", "", ".", "../g.yaml"))
+                )
+                changes.append(f"{key} = {data[key]!r}")
+            else:
+                data["kind"] = draw(st.sampled_from(("DOE", "grid", None, "optimize")))
+                changes.append(f"kind = {data['kind']!r}")
+    if chance(draw, 2):
+        text = draw(st.sampled_from(GARBAGE))
+        return Inputs(None, text, [*changes, f"garbage {text[:30]!r}"])
+    return Inputs(data, to_yaml(data).encode(), changes)
+
+
+# ---------------------------------------------------------------- reading the outputs
+
+
+def parquet_rows(raw: bytes) -> tuple[list[str], list[list[str]], dict]:
+    """A pin_susp Parquet file as the CSV's header and cells (a null as a blank cell, a
+    bool as True/False, a float by repr: a NaN reads 'nan' and fails as in the CSV),
+    and its schema metadata."""
+    import pyarrow.parquet as pq
+
+    table = pq.read_table(io.BytesIO(raw))
+    header = table.column_names
+    columns = []
+    for name in header:
+        cells = []
+        for v in table.column(name).to_pylist():
+            if v is None:
+                cells.append("")
+            elif isinstance(v, bool):
+                cells.append(str(v))
+            elif isinstance(v, float):
+                cells.append(repr(v))
+            else:
+                cells.append(str(v))
+        columns.append(cells)
+    rows = [list(r) for r in zip(*columns, strict=True)] if columns else []
+    meta = {k.decode(): v.decode() for k, v in (table.schema.metadata or {}).items()}
+    return header, rows, meta

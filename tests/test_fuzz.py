@@ -1,32 +1,41 @@
 """Property-based fuzzing of ``pin-susp`` in process (strategies and invariants: fuzzing.py).
 
-``make test`` runs ``PIN_SUSP_FUZZ_EXAMPLES`` inputs (default 500, about 20 s),
-derandomized: the same inputs every run, no example database and nothing
-written into the repository. ``make fuzz`` runs 10 000 (about 8 min) with a
-fresh seed, printed with the counts per exit code and command.
+``make test`` runs ``PIN_SUSP_FUZZ_EXAMPLES`` inputs (default 500, about 20 s of
+CPU), derandomized: the same inputs every run, no example database and nothing
+written into the repository. ``make fuzz`` runs 10 000 (about 10 min) with a
+fresh seed, printed with the counts per exit code, command and mechanism
+(corners and axles). Both draw every command that takes a geometry (sweep and
+loads to CSV or Parquet, a 10 001-step sweep that streams, setup, sensitivity,
+urdf, mjcf, draw, validate and studies: the slow ones rarely).
 ``PIN_SUSP_FUZZ_SEED=N`` repeats a run; ``PIN_SUSP_FUZZ_FINDINGS=DIR`` saves
 each failing input as files to run by hand (the shrunk one last);
 ``PIN_SUSP_FUZZ_COLLECT=1`` counts failures instead of stopping at them (the
 smallest of each kind saved), for triage while the code is being fixed.
 """
 
+import copy
 import dataclasses
+import io
 import os
 import random
 from pathlib import Path
 
 import hypothesis.configuration
 import pytest
+import yaml
 from fuzzing import (
+    BASES,
     BY_MECHANISM,
     COUNTS,
     FOUND,
+    GEOMETRY_FILES,
     ROOT,
     ROWS_CHECKED,
     SLOWEST,
     Case,
     Inputs,
     Plan,
+    _degenerate_moves,
     bodies,
     cases,
     check_case,
@@ -236,3 +245,64 @@ def test_the_checker_catches_broken_invariants():
         shifted = [dataclasses.replace(p, values=[v + 1e-3 for v in p.values]) for p in case.plans]
         with pytest.raises(AssertionError, match="target"):
             check_case(dataclasses.replace(case, plans=shifted), good)
+
+
+def test_the_checker_reads_parquet_back():
+    """A Parquet output is read back and row-checked as the CSV: a good one passes, one
+    with a row flagged False (or a point off its body) under exit 0 fails."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    case = _known_good_sweep()
+    case = dataclasses.replace(
+        case,
+        argv=[("out.parquet" if a == "out.csv" else a) for a in case.argv],
+        outputs=["out.parquet"],
+    )
+    with run_case(case) as good:
+        check_case(case, good)
+        assert good.code == 0
+        raw = good.texts["out.parquet"]
+        table = pq.read_table(io.BytesIO(raw))
+
+        def tampered(column, row, value):
+            cells = table.column(column).to_pylist()
+            cells[row] = value
+            changed = table.set_column(
+                table.column_names.index(column),
+                column,
+                pa.array(cells, table.schema.field(column).type),
+            )
+            sink = io.BytesIO()
+            pq.write_table(changed, sink)
+            return dataclasses.replace(good, texts={"out.parquet": sink.getvalue()})
+
+        with pytest.raises(AssertionError, match="failed row 1 has cells|flagged False"):
+            check_case(case, tampered("solver_converged", 1, False))
+        with pytest.raises(AssertionError, match="axle_outboard"):
+            check_case(case, tampered("axle_outboard_x", 1, -19.99))
+        with pytest.raises(AssertionError, match="non-finite"):
+            check_case(case, tampered("camber", 0, float("nan")))
+
+
+@pytest.mark.parametrize("geometry_file", GEOMETRY_FILES)
+def test_each_mechanism_refuses_its_degenerate_moves(tmp_path, capsys, geometry_file):
+    """Every degenerate move the fuzzer makes of this mechanism (coincident pivots, a
+    pivot on a spindle point, a zero-length arm) is refused at load: exit 2, one line
+    naming one of its points, nothing written."""
+    from pin_susp.cli import main
+
+    data = BASES[geometry_file]
+    moves = _degenerate_moves(data)
+    assert moves, geometry_file
+    for label, point, a, t, names in moves:
+        moved = copy.deepcopy(data)
+        pa_, pb = (moved["hardpoints"][n] for n in (a, names[-1]))
+        moved["hardpoints"][point] = {k: pa_[k] + t * (pb[k] - pa_[k]) for k in "xyz"}
+        g = tmp_path / "g.yaml"
+        g.write_text(yaml.safe_dump(moved))
+        code = main(["urdf", str(g), "-o", str(tmp_path / "o.urdf")])
+        lines = capsys.readouterr().err.strip().splitlines()
+        assert code == 2 and len(lines) == 1, (label, point, lines)
+        assert any(n in lines[0] for n in names), (label, point, lines)
+        assert not (tmp_path / "o.urdf").exists()

@@ -11,6 +11,7 @@ yourdfpy's forward kinematics and independently computed chiralities.
 import copy
 import io
 import itertools
+import re
 from pathlib import Path
 
 import numpy as np
@@ -976,3 +977,47 @@ def test_the_lock_examples_are_what_they_say():
         assert sv[-1] > 1e-3 * sv[0]  # five independent links: exactly one motion
         # that motion: ω = 0, v = x̂ (a slide), or ω = x̂ with the wheel centre at rest (a roll)
         assert np.linalg.norm(np.array(rows) @ np.array(twist, float)) < 1e-12
+
+
+def _rocker_on_its_own_axis(g):
+    """pushrod_outboard (on the upright) at rocker_axis_a: the pushrod's inner end then
+    turns on a circle about an axis through its outer end, so the rocker spins with the
+    wheel held, and nothing holds it."""
+    g["hardpoints"]["pushrod_outboard"] = dict(g["hardpoints"]["rocker_axis_a"])
+
+
+def _vertical_trailing_arm_pivot(g):
+    g["hardpoints"].update(
+        arm_pivot_inboard={"x": 300, "y": 600, "z": 100},
+        arm_pivot_outboard={"x": 300, "y": 600, "z": 500},
+    )
+
+
+@pytest.mark.parametrize(
+    "geometry, change, named",
+    [
+        ("multilink_rear.yaml", same_line, {"lower_front_link", "lower_rear_link"}),
+        ("pushrod_rocker.yaml", _rocker_on_its_own_axis, {"rocker_axis_a", "rocker_axis_b"}),
+        (
+            "semi_trailing_arm.yaml",
+            _vertical_trailing_arm_pivot,
+            {"arm_pivot_inboard", "arm_pivot_outboard"},
+        ),
+    ],
+    ids=["two links on one line", "pushrod on the rocker axis", "vertical arm pivot"],
+)
+def test_a_linkage_that_does_not_hold_names_its_points(tmp_path, capsys, geometry, change, named):
+    """A linkage left free or locked is refused naming the parts that move with the wheel
+    held (exactly those: the free rocker's axis, the trailing arm's pivots) or the
+    dependent link lines (the two on one line, not the three others)."""
+    data = example(geometry)
+    change(data)
+    gpath = tmp_path / "corner.yaml"
+    gpath.write_text(yaml.safe_dump(data))
+    assert main(["urdf", str(gpath), "-o", str(tmp_path / "x.urdf")]) == 2
+    (line,) = capsys.readouterr().err.strip().splitlines()
+    found = set(re.findall(r"[a-z]+(?:_[a-z]+)+", line.rsplit("(", 1)[1]))
+    if "links" in line:
+        found = {n.removesuffix("_inboard").removesuffix("_outboard") for n in found}
+    assert found == named, line
+    assert not (tmp_path / "x.urdf").exists()

@@ -98,20 +98,20 @@ def prepare(p: dict[str, np.ndarray], o, r) -> None:
     lines = _plucker(p, members)
     rank = np.linalg.matrix_rank(lines, tol=RANK_TOLERANCE * np.linalg.norm(lines, 2))
     if rank < len(members):
-        redundant = next(
-            b
-            for i, (_, b) in enumerate(members)
-            if np.linalg.matrix_rank(
-                np.delete(lines, i, axis=0), tol=RANK_TOLERANCE * np.linalg.norm(lines, 2)
-            )
-            == rank
-        )
+        tol = RANK_TOLERANCE * np.linalg.norm(lines, 2)
+        dependent = [  # the links any one of which the others make redundant
+            i
+            for i in range(len(members))
+            if np.linalg.matrix_rank(np.delete(lines, i, axis=0), tol=tol) == rank
+        ]
+        redundant = members[dependent[0]][1]
+        named = ", ".join(f"{a}→{b}" for a, b in (members[i] for i in dependent))
         r.fail(
             f"hardpoints.{redundant}",
             f"the five links leave the upright free: their lines are dependent (rank {rank} "
             f"of 5; this link adds no constraint the others do not), so the upright has "
             f"{6 - rank} freedoms{' with the rack held' if o.steering == 'rack' else ''}, "
-            "not 1",
+            f"not 1 (the dependent lines: {named})",
         )
 
 
