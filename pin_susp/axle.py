@@ -22,10 +22,10 @@ from .corner import Results
 from .deadcentre import dead_centres, warn_dead_centres
 from .errors import InputError
 from .geometry import DERIVED_POINTS, MM, Geometry, summary_repr, unit
-from .linkage import Built, FrameMotion, Linkage, closure_row
+from .linkage import RACK_HELD, Built, FrameMotion, Linkage, closure_row
 from .mechanisms import axis_foot, xml_name
 from .solver import NewtonSolver, march
-from .sweep import check_held
+from .sweep import Target, check_held
 from .urdf import Body, Closure, Joint, Tree, Visual
 from .yamlio import Reader, load_yaml
 
@@ -323,6 +323,23 @@ class AxleModel:
             )
 
         return summary_repr(self, parts)
+
+    def held_sweep(self, sweep):
+        """The sweep as its steps hold it: on an axle with a rack whose sweep gives every
+        target but the rack's (heave and roll, or a wheel height per side), the rack held
+        at design (rack_displacement 0; the summary says so), as a corner's is
+        (Linkage.held_targets). Any other sweep as given (solve_axle_sweep checks it)."""
+        targets = sweep.targets
+        if "left_trackrod_inboard" not in self.points or len(targets) != self.mobility - 1:
+            return sweep
+        if any(t.point == "trackrod_inboard" for t in targets):
+            return sweep
+        rack = Target("trackrod_inboard", "y", np.zeros(sweep.steps), side="left")
+        return replace(sweep, targets=[*targets, rack])
+
+    def sweep_notes(self, sweep) -> list[str]:
+        """What the summary says of how the sweep's targets were read."""
+        return [RACK_HELD] if self.held_sweep(sweep) is not sweep else []
 
     def run_sweep(self, sweep, progress=None) -> AxleResults:
         """Solve every step of an axle sweep (a path, a dict or a Sweep: heave, roll,
@@ -898,6 +915,7 @@ def solve_axle_sweep(model: AxleModel, sweep, source: str | None = None, progres
     ``progress(done, total)`` is called after each step."""
     source = source or sweep.source
     check_held(sweep)
+    sweep = model.held_sweep(sweep)
     rows = axle_rows(model, sweep.targets, source)
     rigid = model.axle is not None and model.axle.anti_roll_rigid
     for i, t in enumerate(sweep.targets):
@@ -1009,6 +1027,7 @@ def axle_results(model: AxleModel, sweep, solutions: list) -> AxleResults:
     source = model.axle.source if model.axle is not None else "<geometries>"
     sha = model.axle.sha256 if model.axle is not None else None
     meta = AxleResults.solver_meta(solutions, (source, sha), sweep, model)
+    meta["notes"] = model.sweep_notes(sweep)
     return AxleResults(columns, units, meta)
 
 

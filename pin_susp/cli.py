@@ -491,6 +491,8 @@ def _sweep_axle(args) -> int:
             f"wrote {args.output}: {len(results)} steps, {int(ok.sum())} converged, "
             f"max residual {np.nanmax(results['solver_max_residual']):.1e} mm"
         )
+        for note in digest.notes:
+            print(f"  {note}")
         print(f"  {'column':<28}{'unit':>7}{'first':>13}{'last':>13}{'min':>13}{'max':>13}")
         for name in AXLE_SUMMARY:
             if name in results.columns and not np.all(np.isnan(results[name])):

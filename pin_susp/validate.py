@@ -294,8 +294,9 @@ class AxleScope:
 
     def step_targets(self, sweep) -> list[list]:
         model = self.subject
-        values = target_values(model, sweep.targets)
-        return [axle_targets(sweep.targets, v, model.design_positions) for v in values]
+        targets = model.held_sweep(sweep).targets  # the rack at design if not given
+        values = target_values(model, targets)
+        return [axle_targets(targets, v, model.design_positions) for v in values]
 
     def held(self, points: dict) -> list:
         held = [Along(f"{s}_wheel_center", Z, float(points[f"{s}_wheel_center"][2])) for s in SIDES]

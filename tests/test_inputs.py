@@ -273,3 +273,32 @@ def test_a_rack_corner_still_refuses_a_sweep_of_the_rack_alone(tmp_path, corner)
     ]}  # fmt: skip
     with pytest.raises(InputError, match="a wheel target alone holds the rack at design"):
         corner.run_sweep(steer)
+
+
+def test_an_axle_sweep_of_heave_and_roll_alone_holds_the_rack_at_design(tmp_path, capsys):
+    """An axle too: roll.yaml without its rack target gives roll.yaml's rows (which hold
+    the rack at 0 themselves), through sweep, validate and sensitivity, and says so."""
+    explicit = yaml.safe_load((EXAMPLES / "roll.yaml").read_text())
+    assert explicit["targets"][-1]["point"] == "trackrod_inboard"
+    alone = write(tmp_path / "roll_only.yaml", dict(explicit, targets=explicit["targets"][:2]))
+    import pandas as pd
+
+    axle = str(EXAMPLES / "axle_front.yaml")
+    rows = {}
+    for name, sweep in (("alone", alone), ("explicit", EXAMPLES / "roll.yaml")):
+        out = tmp_path / f"{name}.csv"
+        assert main(["sweep", axle, str(sweep), "-o", str(out)]) == 0
+        said = capsys.readouterr().out
+        assert ("rack held at design (the sweep gives no rack target)" in said) == (name == "alone")
+        rows[name] = pd.read_csv(out, comment="#")
+    assert list(rows["alone"].columns) == list(rows["explicit"].columns)
+    for column in rows["explicit"].columns:
+        np.testing.assert_allclose(
+            rows["alone"][column].astype(float),
+            rows["explicit"][column].astype(float),
+            rtol=0,
+            atol=1e-9,
+            err_msg=column,
+        )
+    assert main(["validate", axle, str(alone), "--engine", "pointwise"]) == 0
+    assert main(["sensitivity", axle, "--sweep", str(alone), "-o", str(tmp_path / "s.csv")]) == 0
