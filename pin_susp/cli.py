@@ -473,14 +473,26 @@ def _sweep_axle(args) -> int:
             f"wrote {args.output}: {len(results)} steps, {int(ok.sum())} converged, "
             f"max residual {np.nanmax(results['solver_max_residual']):.1e} mm"
         )
-        print(f"  {'column':<28}{'unit':>7}{'first':>13}{'last':>13}{'min':>13}{'max':>13}")
-        for name in AXLE_SUMMARY:
-            if name in results.columns and not np.all(np.isnan(results[name])):
-                v = results[name]
-                print(
-                    f"  {name:<28}{results.units[name]:>7}{v[0]:>13.6g}{v[-1]:>13.6g}"
-                    f"{np.nanmin(v):>13.6g}{np.nanmax(v):>13.6g}"
-                )
+        shown = [
+            (name, np.asarray(results[name], dtype=float))
+            for name in AXLE_SUMMARY
+            if name in results.columns and not np.all(np.isnan(results[name]))
+        ]
+        some = any(np.isnan(v).any() for _, v in shown)  # a blank cell: say at how many steps
+        head = f"{'first':>13}{'last':>13}{'min':>13}{'max':>13}" + (f"{'blank':>8}" * some)
+        print(f"  {'column':<28}{'unit':>7}{head}")
+        for name, v in shown:
+            empty = int(np.isnan(v).sum())
+            print(
+                f"  {name:<28}{results.units[name]:>7}{_cell(v[0])}{_cell(v[-1])}"
+                f"{_cell(np.nanmin(v))}{_cell(np.nanmax(v))}" + (f"{empty or '':>8}" * some)
+            )
+        failed = len(results) - int(ok.sum())
+        if failed:
+            print(
+                f"  (blank: an empty cell in the CSV; {failed} of {len(results)} steps did not "
+                "converge, and their columns are blank)"
+            )
         print("  (every column of both corners, suffixed _left/_right, is in the CSV)")
         if plot:
             print(f"wrote {args.plot}")
@@ -912,7 +924,8 @@ class Digest:
         self.max_residual = math.nan
         self.iterations = []  # how many steps took each count of iterations
         self.units: dict[str, str] = {}
-        self.stats: dict[str, list] = {}  # name → [first, last, min, max, far step, |far|]
+        # name → [first, last, min, max, far step, |far|, blank steps]
+        self.stats: dict[str, list] = {}
         # Steps are kept as Steps: the first few, and how many (a report names no more).
         self.short = Steps()  # out of reach or past a lock-up
         self.worst_short = 0.0  # their largest residual, mm
@@ -980,8 +993,9 @@ class Digest:
 
         stat = self.stats.get(name)
         if stat is None:
-            stat = self.stats[name] = [v[0], v[-1], np.nan, np.nan, None, 0.0]
+            stat = self.stats[name] = [v[0], v[-1], np.nan, np.nan, None, 0.0, 0]
         stat[1] = v[-1]
+        stat[6] += int(np.isnan(v).sum())  # the CSV's empty cells
         if not np.isnan(v).all():
             stat[2] = np.nanmin(np.r_[stat[2], v])
             stat[3] = np.nanmax(np.r_[stat[3], v])
@@ -1016,23 +1030,37 @@ def _summary(results, path) -> None:
         f"max residual {d.max_residual:.1e} mm, "
         f"{d.iterations_median:g} iterations per step (median)"
     )
-    print(f"  {'metric':<32}{'unit':>7}{'first':>13}{'last':>13}{'min':>13}{'max':>13}")
+    # a cell the CSV leaves empty (a step that did not converge, a value undefined
+    # there) is blank here too, and a column with blanks says at how many steps
+    some = any(0 < stat[6] < d.steps for stat in d.stats.values())
+    head = f"{'first':>13}{'last':>13}{'min':>13}{'max':>13}" + (f"{'blank':>8}" * some)
+    print(f"  {'metric':<32}{'unit':>7}{head}")
     blank = []
-    for name, (first, last, low, high, far, _) in d.stats.items():
-        if low != low:  # NaN at every step
+    for name, (first, last, low, high, far, _, empty) in d.stats.items():
+        if empty == d.steps:  # NaN at every step
             blank.append(name)
             continue
-        line = f"  {name:<32}{d.units[name]:>7}{first:>13.6g}{last:>13.6g}"
+        line = f"  {name:<32}{d.units[name]:>7}{_cell(first)}{_cell(last)}"
         if name in CENTRES and far is not None:
             line += f"   at infinity (instant axis parallel to the view) near step {far}"
         else:
-            line += f"{low:>13.6g}{high:>13.6g}"
+            line += f"{_cell(low)}{_cell(high)}" + (f"{empty or '':>8}" if some else "")
         print(line)
     for name in blank:
         m = METRIC_BY_NAME.get(name)
         why = f"needs {m.needs}" if m is not None and m.needs else "undefined at every step"
         print(f"  {name:<32}{d.units[name]:>7}   (blank: {why})")
+    if d.failed:
+        print(
+            f"  (blank: an empty cell in the CSV; {d.failed} of {d.steps} steps did not "
+            "converge, and their metrics are blank)"
+        )
     print("  (every column, derivatives included, is in the CSV)")
+
+
+def _cell(value: float, width: int = 13) -> str:
+    """A summary figure; an undefined one (NaN) blank, as the CSV's cell."""
+    return f"{'':>{width}}" if value != value else f"{value:>{width}.6g}"
 
 
 def _warn_transmission(results) -> None:

@@ -1,0 +1,91 @@
+"""Issue 24, points 10 and 11: the console summary of failed steps, interrupts of
+`view`, a study that cannot write, tracebacks, and good input refused."""
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+import yaml
+from conftest import EXAMPLES, example
+
+from pin_susp.cli import main
+
+GEOMETRY = str(EXAMPLES / "double_wishbone.yaml")
+BUMP_STEER = str(EXAMPLES / "bump_steer.yaml")
+
+
+def run(argv, capsys):
+    code = main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return code, out.splitlines(), err.splitlines()
+
+
+def write_yaml(path: Path, data) -> Path:
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return path
+
+
+def cli(*argv, **kwargs):
+    """The real command in a new process (its own stdin, stdout, stderr)."""
+    return subprocess.run(
+        [sys.executable, "-m", "pin_susp.cli", *map(str, argv)],
+        capture_output=True,
+        timeout=120,
+        **kwargs,
+    )
+
+
+# -- 10. the summary of a sweep with failed steps -------------------------------------------
+
+
+def _columns(line: str, header: str) -> dict:
+    """A summary line's cells by the header's column ends (a blank cell is '')."""
+    names = header.split()
+    ends = [header.index(n) + len(n) for n in names]
+    starts = [0, *ends[:-1]]
+    return {n: line[a:b].strip() for n, a, b in zip(names, starts, ends, strict=True)}
+
+
+def test_the_summary_prints_the_csv_blank_and_the_count_of_failed_steps(tmp_path, capsys):
+    """Steps past the mechanism's reach: their cells are blank in the summary as in the
+    CSV (never 'nan'), a column says at how many steps, min and max over the others."""
+    sweep = example("bump_steer.yaml")
+    sweep["steps"], sweep["targets"][0]["stop"] = 11, 800  # 800 mm of bump: out of reach
+    path = write_yaml(tmp_path / "far.yaml", sweep)
+    code, out, _ = run(["sweep", GEOMETRY, path, "-o", tmp_path / "r.csv"], capsys)
+    assert code == 1
+    rows = pd.read_csv(tmp_path / "r.csv", comment="#")
+    failed = int((~rows["solver_converged"]).sum())
+    assert 0 < failed < len(rows) and not rows["solver_converged"].iloc[-1]
+    assert not any("nan" in line.lower().split() for line in out), out
+    header = next(line for line in out if line.strip().startswith("metric"))
+    assert header.split()[-1] == "blank"
+    for name in ("camber", "roadwheel_angle", "half_track"):
+        cells = _columns(next(x for x in out if x.split()[0] == name), header)
+        column = rows[name].to_numpy()
+        assert cells["last"] == ""  # the CSV's cell is empty: so is the summary's
+        assert float(cells["first"]) == pytest.approx(column[0], rel=1e-5)
+        assert float(cells["min"]) == pytest.approx(np.nanmin(column), rel=1e-5)
+        assert float(cells["max"]) == pytest.approx(np.nanmax(column), rel=1e-5)
+        assert int(cells["blank"]) == int(np.isnan(column).sum()) == failed
+    assert any(f"{failed} of {len(rows)} steps did not converge" in line for line in out)
+
+
+def test_an_axle_summary_prints_blanks_not_nan(tmp_path, capsys):
+    sweep = yaml.safe_load((EXAMPLES / "roll.yaml").read_text())
+    sweep["targets"][0].update(start=-30, stop=30)  # most of it beyond the axle's roll
+    path = write_yaml(tmp_path / "roll.yaml", sweep)
+    code, out, _ = run(
+        ["sweep", EXAMPLES / "axle_front.yaml", path, "-o", tmp_path / "a.csv"], capsys
+    )
+    assert code == 1
+    rows = pd.read_csv(tmp_path / "a.csv", comment="#")
+    assert not any("nan" in line.lower().split() for line in out), out
+    header = next(line for line in out if line.strip().startswith("column"))
+    cells = _columns(next(x for x in out if x.split()[0] == "roll"), header)
+    assert cells["first"] == cells["last"] == ""
+    assert int(cells["blank"]) == int(np.isnan(rows["roll"]).sum()) > 0
+    assert float(cells["max"]) == pytest.approx(np.nanmax(rows["roll"]), rel=1e-5)
