@@ -200,9 +200,14 @@ def _positive(text: str) -> float:
     return _finite(text, positive=True)
 
 
+COUNT_LIMIT = 999_999  # --top: more entries than any table has hardpoint coordinates
+
+
 def _count(text: str) -> int:
     if not re.fullmatch(r"[0-9]{1,6}", text.strip()):
-        raise argparse.ArgumentTypeError(f"expected a whole number >= 0, got {text!r}")
+        raise argparse.ArgumentTypeError(
+            f"expected a whole number from 0 to {COUNT_LIMIT}, got {text!r}"
+        )
     return int(text)
 
 
@@ -272,12 +277,12 @@ def _sweep_streamed(args, corner, sweep) -> int:
     formatting and numpy leave the GIL): two chunks alive at most."""
     from concurrent.futures import ThreadPoolExecutor
 
-    from .export import CsvStream, ParquetStream
+    from .export import CsvStream, ParquetStream, is_parquet
 
     parts = corner.run_sweep_chunks(sweep, progress=_progress_bar(sweep.steps, args.quiet))
     first = next(parts)
     digest = Digest.of(first)
-    kind = ParquetStream if str(args.output).endswith(".parquet") else CsvStream
+    kind = ParquetStream if is_parquet(args.output) else CsvStream
     with (
         kind(args.output, first.units, first.meta, list(first.columns), sweep.steps) as out,
         ThreadPoolExecutor(1) as writer,
@@ -299,12 +304,12 @@ def _sweep_streamed(args, corner, sweep) -> int:
 def _write_results(args, results) -> bool:
     """The CSV (Parquet for an OUT ending .parquet) and, with --plot, the report: both or
     neither; whether it was drawn."""
-    from .export import all_or_none, csv_text, write_csv, write_text
+    from .export import all_or_none, csv_text, is_parquet, write_csv, write_text
 
     plot = args.plot is not None and results["solver_converged"].any()
     text = csv_text(results) if plot else None  # the report reads the CSV's text
     with all_or_none():
-        if str(args.output).endswith(".parquet"):
+        if is_parquet(args.output):
             from .export import write_parquet
 
             write_parquet(results, args.output)

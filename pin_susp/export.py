@@ -563,6 +563,12 @@ def results_frame(results):
     return frame
 
 
+def is_parquet(path: str | Path) -> bool:
+    """Whether an output is to be Parquet: its name ends .parquet, in any case
+    (X.PARQUET, x.Parquet); anything else is CSV."""
+    return Path(path).suffix.lower() == ".parquet"
+
+
 def write_text(text: str, path: str | Path) -> None:
     with atomic_write(path) as f:
         f.write(text)

@@ -89,3 +89,53 @@ def test_an_axle_summary_prints_blanks_not_nan(tmp_path, capsys):
     assert cells["first"] == cells["last"] == ""
     assert int(cells["blank"]) == int(np.isnan(rows["roll"]).sum()) > 0
     assert float(cells["max"]) == pytest.approx(np.nanmax(rows["roll"]), rel=1e-5)
+
+
+# -- 11. good input refused -------------------------------------------------------------
+
+
+@pytest.mark.parametrize("name", ["r.PARQUET", "r.Parquet"])
+def test_a_parquet_output_is_told_by_its_suffix_in_any_case(tmp_path, capsys, name):
+    import pyarrow.parquet as pq
+
+    code, _, _ = run(["sweep", GEOMETRY, BUMP_STEER, "-o", tmp_path / name, "-q"], capsys)
+    assert code == 0
+    assert (tmp_path / name).read_bytes()[:4] == b"PAR1"
+    table = pq.read_table(tmp_path / name).to_pandas()
+    assert main(["sweep", GEOMETRY, BUMP_STEER, "-o", str(tmp_path / "r.csv"), "-q"]) == 0
+    csv = pd.read_csv(tmp_path / "r.csv", comment="#")
+    assert list(table.columns) == list(csv.columns)
+    assert np.array_equal(table["camber"].to_numpy(), csv["camber"].to_numpy())
+
+
+def test_a_streamed_sweep_onto_an_upper_case_parquet_name_is_parquet(tmp_path, capsys, monkeypatch):
+    from pin_susp import cli as commands
+
+    monkeypatch.setattr(commands, "STREAM_STEPS", 20)  # the 41 steps go the streamed way
+    code, _, _ = run(["sweep", GEOMETRY, BUMP_STEER, "-o", tmp_path / "r.PARQUET", "-q"], capsys)
+    assert code == 0 and (tmp_path / "r.PARQUET").read_bytes()[:4] == b"PAR1"
+
+
+def test_loads_onto_an_upper_case_parquet_name_is_parquet(tmp_path, capsys):
+    code, _, _ = run(
+        [
+            "loads",
+            EXAMPLES / "macpherson.yaml",
+            BUMP_STEER,
+            "--cases",
+            EXAMPLES / "loads.yaml",
+            "-o",
+            tmp_path / "f.PARQUET",
+            "-q",
+        ],
+        capsys,
+    )
+    assert code == 0 and (tmp_path / "f.PARQUET").read_bytes()[:4] == b"PAR1"
+
+
+def test_top_states_its_real_limit(tmp_path, capsys):
+    code, out, _ = run(["sensitivity", GEOMETRY, "--top", "999999", "-q"], capsys)
+    assert code == 0
+    code, _, err = run(["sensitivity", GEOMETRY, "--top", "1000000"], capsys)
+    assert code == 2 and len(err) == 1
+    assert "from 0 to 999999" in err[0] and "'1000000'" in err[0]
