@@ -52,8 +52,11 @@ def main(argv: list[str] | None = None) -> int:
         return exc.code if isinstance(exc.code, int) else EXIT_INPUT
     import numpy as np
 
+    from .yamlio import read_once
+
     with (
         _terminate_as_exit(),
+        read_once(),  # each input read once: a pipe or a FIFO cannot be read twice
         warnings.catch_warnings(record=True) as caught,
         np.errstate(all="ignore"),
     ):
@@ -693,6 +696,7 @@ def _validate(args) -> int:
     from .geometry import load_geometry
     from .sweep import load_sweep
     from .validate import validate
+    from .yamlio import read_input
 
     axle = _is_axle(args.geometry)
     corner = _axle_model(args.geometry) if axle else Corner(load_geometry(args.geometry))
@@ -716,7 +720,7 @@ def _validate(args) -> int:
                 f"--{option}: only {engine} reads it; add --engine {engine} (or --engine all)"
             )
         try:
-            texts[option] = Path(path).read_bytes().decode("utf-8")
+            texts[option] = read_input(path).decode("utf-8")
         except OSError as exc:
             raise PinSuspError(f"{path}: cannot be read ({exc.strerror})") from None
         except UnicodeDecodeError:

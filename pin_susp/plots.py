@@ -64,6 +64,7 @@ from .metrics import (  # noqa: E402
     X,
     Y,
 )
+from .yamlio import read_input  # noqa: E402
 
 EXTRA = (
     "svic_z",
@@ -96,7 +97,7 @@ class ResultsFile:
         self.label = Path(source).stem
         try:
             if raw is None:
-                raw = self.path.read_bytes()
+                raw = read_input(self.path)
         except OSError as exc:
             raise InputError(source, "", f"cannot be read ({exc.strerror})") from None
         if not raw.strip():

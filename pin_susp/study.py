@@ -31,7 +31,7 @@ import yaml
 
 from . import __version__
 from .errors import InputError, PinSuspError
-from .yamlio import Reader, load_yaml
+from .yamlio import Reader, load_yaml, read_once
 
 KINDS = ("doe", "monte_carlo", "optimise")
 DOE_METHODS = ("full_factorial", "latin_hypercube", "sobol")
@@ -168,6 +168,11 @@ class Study:
 def load_study(source: str | Path) -> Study:
     """Read and check a study file; its geometry and sweep are read (and solved at
     design) too, so that every mistake is found before any work."""
+    with read_once():  # each file read once: a FIFO or a pipe can be
+        return _load_study(source)
+
+
+def _load_study(source: str | Path) -> Study:
     data, name, sha = load_yaml(source)
     r = Reader(name)
     r.mapping(data, "", required=("geometry", "sweep", "kind"), optional=STUDY_KEYS)
