@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import errno
 import math
 import os
 import re
@@ -80,6 +81,12 @@ def main(argv: list[str] | None = None) -> int:
         except BrokenPipeError:  # output piped into `head` and the like
             sys.stderr.close()
             return 0
+        except OSError as exc:  # a safety net: each output path is checked before any work
+            if exc.errno != errno.ENAMETOOLONG:
+                raise
+            name = exc.filename if exc.filename is not None else "a path"
+            print(f"pin-susp: error: {name}: a name too long for the file system", file=sys.stderr)
+            return EXIT_INPUT
 
 
 def _unwritten(args) -> str:
@@ -808,12 +815,14 @@ def _demo(args) -> int:
     import yaml
 
     from .corner import Corner
-    from .export import all_or_none, csv_text, write_text
+    from .export import all_or_none, check_folder, csv_text, write_text
     from .geometry import load_geometry
     from .sweep import load_sweep
 
-    out = Path(args.output)
-    if str(args.output).strip() == "" or (out.exists() and not out.is_dir()):
+    if str(args.output).strip() == "":
+        raise PinSuspError(f"{args.output!r}: the demo writes several files: give a folder")
+    out = check_folder(args.output)
+    if out.exists() and not out.is_dir():
         raise PinSuspError(f"{args.output!r}: the demo writes several files: give a folder")
     data = resources.files("pin_susp") / "data"
     inputs = {name: (data / name).read_text() for name in ("demo_geometry.yaml", "demo_sweep.yaml")}

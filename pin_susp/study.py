@@ -1152,7 +1152,10 @@ def _prepare(study: Study, outdir: Path, steps: bool, resume: bool) -> Path:
 def _check_outdir(study: Study, outdir: Path, steps: bool, resume: bool) -> dict:
     """OUTDIR must be new or empty, or hold this study's unfinished run (``resume``);
     nothing is written. The manifest that the run will write."""
+    from .export import check_folder
+
     mine = _fingerprint(study, steps)
+    check_folder(outdir)  # a name too long for the file system: one line, not a traceback
     manifest = outdir / MANIFEST
     if outdir.exists() and not outdir.is_dir():
         raise PinSuspError(f"{outdir}: exists and is not a directory")

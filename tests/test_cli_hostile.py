@@ -231,3 +231,62 @@ def test_a_study_reads_its_geometry_and_sweep_once_from_fifos(tmp_path):
 
     variants = pq.read_table(tmp_path / "out" / "variants.parquet").to_pandas()
     assert len(variants) == 3 and variants["converged"].all()
+
+
+# -- 11. tracebacks: a name too long for the file system ---------------------------------
+
+LONG = "n" * 300  # beyond the 255 bytes of a name on Linux file systems
+
+
+@pytest.fixture
+def small_study(tmp_path):
+    """A 3-variant study of the example corner (its files copied beside it)."""
+    for name in ("double_wishbone.yaml", "bump_rack_held.yaml"):
+        (tmp_path / name).write_bytes((EXAMPLES / name).read_bytes())
+    study = {
+        "version": 1,
+        "geometry": "double_wishbone.yaml",
+        "sweep": "bump_rack_held.yaml",
+        "variables": [{"point": "trackrod_outboard", "axis": "z", "range": [-2, 2]}],
+        "kind": "doe",
+        "doe": {"method": "full_factorial", "levels": 3},
+        "summary": ["roadwheel_angle"],
+        "batch_size": 1,
+    }
+    return write_yaml(tmp_path / "study.yaml", study)
+
+
+WRITERS = {
+    "sweep": ["sweep", GEOMETRY, BUMP_STEER, "-o", "{o}.csv"],
+    "sweep --plot": ["sweep", GEOMETRY, BUMP_STEER, "-o", "r.csv", "--plot", "{o}.png"],
+    "loads": ["loads", EXAMPLES / "macpherson.yaml", BUMP_STEER, "--cases",
+              EXAMPLES / "loads.yaml", "-o", "{o}.csv"],
+    "urdf": ["urdf", GEOMETRY, "-o", "{o}.urdf"],
+    "mjcf": ["mjcf", GEOMETRY, "-o", "{o}.xml"],
+    "setup": ["setup", GEOMETRY, "--csv", "{o}.csv"],
+    "sensitivity": ["sensitivity", GEOMETRY, "-o", "{o}.csv"],
+    "draw": ["draw", GEOMETRY, "-o", "{o}.png"],
+    "view": ["view", GEOMETRY, "--html", "{o}.html"],
+    "demo": ["demo", "-o", "{o}"],
+    "study": ["study", "{study}", "-o", "{o}", "--scheduler", "none"],
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("where", ["name", "folder"])
+@pytest.mark.parametrize("command", list(WRITERS))
+def test_a_name_too_long_is_one_line_and_leaves_nothing(
+    tmp_path, capsys, small_study, command, where
+):
+    """An output whose file name, or a folder on its way, is longer than the file system
+    allows: one line naming it, exit 2, nothing made (not even the folders before it)."""
+    out = tmp_path / "out"
+    out.mkdir()
+    target = out / LONG if where == "name" else out / "a" / LONG / "b"
+    argv = [
+        str(a).replace("{o}", str(target)).replace("{study}", str(small_study))
+        for a in WRITERS[command]
+    ]
+    code, _, err = run(argv, capsys)
+    assert code == 2 and len(err) == 1, err
+    assert err[0].startswith("pin-susp: error: ") and "too long" in err[0], err
+    assert list(out.iterdir()) == []
