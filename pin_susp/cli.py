@@ -1968,6 +1968,7 @@ def _study(args) -> int:
             resume=args.resume,
             progress=_progress_bar(total, args.quiet, minimum=1, label=label),
             announce=None if args.quiet else print,
+            warn=lambda text: args.quiet or print(f"pin-susp: warning: {text}", file=sys.stderr),
         )
     except (KeyboardInterrupt, _Terminated) as exc:
         signal_number = exc.signal if isinstance(exc, _Terminated) else signal.SIGINT

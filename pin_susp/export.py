@@ -37,7 +37,7 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__
-from .errors import PinSuspError
+from .errors import NoRoom, PinSuspError
 
 # The renames a running all_or_none() block has put off: (temporary, final) pairs.
 _PENDING: contextvars.ContextVar[list | None] = contextvars.ContextVar("pending", default=None)
@@ -159,7 +159,7 @@ def _name_max(folder: Path) -> int:
 
 
 # A write that fails for want of room: the disk, a quota, a file-size limit.
-_FULL = {errno.ENOSPC, errno.EFBIG, errno.EDQUOT}
+FULL = _FULL = {errno.ENOSPC, errno.EFBIG, errno.EDQUOT}
 
 
 @contextmanager
@@ -183,7 +183,7 @@ def atomic_write(path: str | Path, binary: bool = False):
         except OSError as exc:
             if exc.errno not in _FULL:
                 raise
-            raise PinSuspError(f"{path}: cannot be written ({exc.strerror})") from None
+            raise NoRoom(path, exc.strerror, "what was sent to it is incomplete") from None
         return
     try:
         target.parent.mkdir(parents=True, exist_ok=True)
@@ -198,9 +198,7 @@ def atomic_write(path: str | Path, binary: bool = False):
     except BaseException as exc:
         os.unlink(tmp)
         if isinstance(exc, OSError) and exc.errno in _FULL:  # the disk, a quota, ulimit -f
-            raise PinSuspError(
-                f"{path}: cannot be written ({exc.strerror}): nothing written"
-            ) from None
+            raise NoRoom(path, exc.strerror) from None
         raise
     pending = _PENDING.get()
     if pending is None:

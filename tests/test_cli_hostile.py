@@ -2,6 +2,7 @@
 `view`, a study that cannot write, tracebacks, and good input refused."""
 
 import os
+import signal
 import subprocess
 import sys
 import threading
@@ -290,3 +291,133 @@ def test_a_name_too_long_is_one_line_and_leaves_nothing(
     assert code == 2 and len(err) == 1, err
     assert err[0].startswith("pin-susp: error: ") and "too long" in err[0], err
     assert list(out.iterdir()) == []
+
+
+# -- 11. a study that cannot write; a damaged part file on --resume ----------------------
+
+
+def _room_for(monkeypatch, parts: int):
+    """Writes run out of room (ENOSPC, a full disk) after ``parts`` part files."""
+    import errno
+
+    from pin_susp import study as studies
+    from pin_susp.export import atomic_write
+
+    real, written = studies._write_parquet, []
+
+    def write(table, path):
+        if len(written) >= parts:
+            with atomic_write(path, binary=True) as f:  # the write itself fails part-way
+                f.write(b"PAR1")
+                raise OSError(errno.ENOSPC, "No space left on device")
+        written.append(path)
+        real(table, path)
+
+    monkeypatch.setattr(studies, "_write_parquet", write)
+    return written
+
+
+def test_a_study_that_runs_out_of_room_keeps_its_finished_batches_and_says_so(
+    tmp_path, capsys, monkeypatch, small_study
+):
+    """A full disk after two of three batches: study.json and the two whole part files
+    stay, the message says so, and --resume (once there is room) finishes the run with the
+    variants an uninterrupted run gives."""
+    import pyarrow.parquet as pq
+
+    written = _room_for(monkeypatch, 2)
+    code, _, err = run(["study", small_study, "-o", tmp_path / "a", "--scheduler", "none"], capsys)
+    assert code == 2 and len(err) == 1, err
+    assert "No space left on device" in err[0], err
+    assert "2 of 3 batches are kept in" in err[0] and "--resume continues" in err[0], err
+    parts = sorted(p.name for p in (tmp_path / "a" / ".parts").iterdir())
+    assert parts == ["variants-000000.parquet", "variants-000001.parquet"]
+    assert sorted(p.name for p in (tmp_path / "a").iterdir()) == [".parts", "study.json"]
+    for p in written:
+        assert pq.read_table(p).num_rows == 1  # whole
+    monkeypatch.undo()
+    code, _, err = run(
+        ["study", small_study, "-o", tmp_path / "a", "--scheduler", "none", "--resume", "-q"],
+        capsys,
+    )
+    assert code == 0, err
+    code, _, _ = run(
+        ["study", small_study, "-o", tmp_path / "b", "--scheduler", "none", "-q"], capsys
+    )
+    resumed = pq.read_table(tmp_path / "a" / "variants.parquet").to_pandas()
+    whole = pq.read_table(tmp_path / "b" / "variants.parquet").to_pandas()
+    assert resumed.drop(columns="seconds", errors="ignore").equals(
+        whole.drop(columns="seconds", errors="ignore")
+    )
+
+
+@pytest.mark.parametrize("folder", ["new", "empty"])
+def test_a_study_that_cannot_write_its_first_batch_leaves_nothing(
+    tmp_path, capsys, monkeypatch, small_study, folder
+):
+    """No batch written: nothing left (the run's study.json and part folder go, and the
+    folder when the run made it), and the message says nothing was written."""
+    out = tmp_path / "a"
+    if folder == "empty":
+        out.mkdir()
+    _room_for(monkeypatch, 0)
+    code, _, err = run(["study", small_study, "-o", out, "--scheduler", "none"], capsys)
+    assert code == 2 and len(err) == 1 and err[0].endswith(": nothing written"), err
+    assert "No space left on device" in err[0]
+    if folder == "new":
+        assert not out.exists()
+    else:
+        assert list(out.iterdir()) == []
+
+
+def test_a_damaged_part_file_is_named_and_its_batch_solved_again_on_resume(
+    tmp_path, capsys, monkeypatch, small_study
+):
+    """--resume over part files cut short, overwritten or holding another batch: each is
+    named on stderr, its batch is solved again, and the variants are those of a whole run."""
+    import shutil
+
+    import pyarrow.parquet as pq
+
+    from pin_susp import study as studies
+
+    def stop(*args):  # every batch written, then Ctrl+C
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(studies, "_assemble", stop)
+    argv = ["study", small_study, "-o", tmp_path / "a", "--scheduler", "none", "--steps"]
+    assert run(argv, capsys)[0] == 128 + signal.SIGINT
+    monkeypatch.undo()
+    parts = tmp_path / "a" / ".parts"
+    names = sorted(p.name for p in parts.iterdir())
+    assert names == [f"{w}-{i:06d}.parquet" for w in ("steps", "variants") for i in range(3)]
+    with open(parts / "variants-000000.parquet", "r+b") as f:
+        f.truncate(300)  # cut short
+    (parts / "steps-000001.parquet").write_bytes(b"not parquet")  # overwritten
+    shutil.copy(parts / "variants-000001.parquet", parts / "variants-000002.parquet")  # batch 1's
+    code, _, err = run(
+        ["study", small_study, "-o", tmp_path / "a", "--scheduler", "none", "--resume"]
+        + ["--steps"],
+        capsys,
+    )
+    assert code == 0, err
+    assert "Traceback" not in "".join(err)
+    for i, name in enumerate(["variants-000000", "steps-000001", "variants-000002"]):
+        line = next(x for x in err if f"{name}.parquet" in x)
+        assert line.startswith("pin-susp: warning: ") and f"batch {i} is solved again" in line
+    code, _, _ = run(
+        ["study", small_study, "-o", tmp_path / "b", "--scheduler", "none", "-q", "--steps"],
+        capsys,
+    )
+    resumed = pq.read_table(tmp_path / "a" / "variants.parquet").to_pandas()
+    whole = pq.read_table(tmp_path / "b" / "variants.parquet").to_pandas()
+    assert resumed.drop(columns="seconds", errors="ignore").equals(
+        whole.drop(columns="seconds", errors="ignore")
+    )
+    steps_a = pd.read_parquet(tmp_path / "a" / "steps.parquet").sort_values(
+        ["variant_id", "step_index"], ignore_index=True
+    )
+    steps_b = pd.read_parquet(tmp_path / "b" / "steps.parquet").sort_values(
+        ["variant_id", "step_index"], ignore_index=True
+    )
+    assert steps_a.equals(steps_b)
