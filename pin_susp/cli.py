@@ -1809,7 +1809,7 @@ def _view(args) -> int:
     from .export import write_text
     from .geometry import load_geometry
     from .sweep import load_sweep
-    from .viz import Scene, force_caption, force_key, roll_centres
+    from .viz import Scene, force_caption, force_key, roll_centres, signals_held
 
     _check_outputs(args, args.html)
     if args.case is not None and args.cases is None:
@@ -1847,7 +1847,7 @@ def _view(args) -> int:
     quiet = io.StringIO()
     with contextlib.redirect_stdout(quiet):  # meshcat announces its server on stdout
         scene = Scene(model)
-    try:
+    try:  # an interrupt before the scene is served is one as in every command: 130, 143
         colours, caption = None, ""
         if forces is not None:
             colours, scale = scene.force_colours(forces, case)
@@ -1861,10 +1861,18 @@ def _view(args) -> int:
             if qs is not None
             else 0
         )
-        if args.html is not None:
-            write_text(scene.html(caption), args.html)
-            print(f"wrote {args.html}" + (f" ({frames} frames)" if frames else ""))
-            return 0 if results is None else _report_failures(results, "are not in the replay")
+        page = scene.html(caption) if args.html is not None else None
+    except BaseException:
+        with contextlib.suppress(KeyboardInterrupt):  # a second Ctrl+C while it stops
+            scene.close()
+        raise
+    if args.html is not None:
+        with signals_held():  # a signal while the server stops: raised once it has
+            scene.close()
+        write_text(page, args.html)  # whole or not at all
+        print(f"wrote {args.html}" + (f" ({frames} frames)" if frames else ""))
+        return 0 if results is None else _report_failures(results, "are not in the replay")
+    try:
         print(
             f"meshcat: {scene.viewer.url()}"
             + (f"  ({frames} frames: press play in Open Controls > Animations)" if frames else "")
@@ -1879,14 +1887,12 @@ def _view(args) -> int:
         print("serving; press Ctrl+C to stop", flush=True)
         while True:
             time.sleep(0.5)
-    except KeyboardInterrupt:
+    except KeyboardInterrupt:  # the way to stop a live scene: it was served, exit 0
         print("stopped")
         return 0
     finally:
-        try:
+        with contextlib.suppress(KeyboardInterrupt):  # a second Ctrl+C while it stops
             scene.close()
-        except KeyboardInterrupt:  # a second Ctrl+C while the server stops
-            pass
 
 
 # ---------------------------------------------------------------- study

@@ -6,6 +6,7 @@ import signal
 import subprocess
 import sys
 import threading
+import time
 from pathlib import Path
 
 import numpy as np
@@ -421,3 +422,117 @@ def test_a_damaged_part_file_is_named_and_its_batch_solved_again_on_resume(
         ["variant_id", "step_index"], ignore_index=True
     )
     assert steps_a.equals(steps_b)
+
+
+# -- 11. Ctrl+C and SIGTERM in `view --html` --------------------------------------------
+
+# `pin-susp view` in a new process, with a signal raised at one moment of its run:
+# import of scipy.optimize (inside trimesh's imports, which swallow an interrupt), the
+# animation being recorded, the page being made, the HTML being written.
+_AT = """
+import importlib.abc, signal, sys
+from pin_susp import cli, export, viz
+number = getattr(signal, sys.argv[2])
+
+def fire():
+    signal.raise_signal(number)
+
+class Finder(importlib.abc.MetaPathFinder):
+    def find_spec(self, name, path, target=None):
+        if name == "scipy.optimize":
+            sys.meta_path.remove(self)
+            fire()
+        return None
+
+def before(cls, name):
+    real = getattr(cls, name)
+    def wrapped(*args, **kwargs):
+        fire()
+        return real(*args, **kwargs)
+    setattr(cls, name, wrapped)
+
+moment = sys.argv[1]
+if moment == "import":
+    sys.meta_path.insert(0, Finder())
+elif moment == "write":
+    real = export.write_text
+    def write_text(text, path):
+        with export.atomic_write(path) as f:
+            f.write(text[: len(text) // 2])
+            fire()
+            f.write(text[len(text) // 2 :])
+    export.write_text = write_text
+else:
+    before(viz.Scene, moment)
+sys.exit(cli.main(sys.argv[3:]))
+"""
+
+
+def _servers_of(pid: int) -> list[int]:
+    """Processes still running meshcat's server for the process ``pid``."""
+    found = []
+    for proc in Path("/proc").iterdir():
+        try:
+            argv = (proc / "cmdline").read_bytes().split(b"\0")
+        except OSError:
+            continue
+        if any(b"zmqserver" in a for a in argv) and str(pid).encode() in argv:
+            found.append(int(proc.name))
+    return found
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="/proc")
+@pytest.mark.parametrize(
+    "moment, sig",
+    [
+        ("import", "SIGINT"),
+        ("animate", "SIGINT"),
+        ("html", "SIGINT"),
+        ("write", "SIGINT"),
+        ("animate", "SIGTERM"),
+        ("write", "SIGTERM"),
+    ],
+)
+def test_view_html_interrupted_at_any_moment_exits_130_or_143_and_leaves_nothing(
+    tmp_path, moment, sig
+):
+    proc = subprocess.Popen(
+        [sys.executable, "-c", _AT, moment, sig, "view", GEOMETRY, BUMP_STEER, "--html", "v.html"],
+        cwd=tmp_path,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
+    out, err = proc.communicate(timeout=120)
+    assert proc.returncode == 128 + getattr(signal, sig), (out, err)
+    assert "stopped" not in out and "wrote" not in out
+    assert err.strip().splitlines() == ["pin-susp: interrupted, nothing written"], err
+    assert list(tmp_path.iterdir()) == []  # no HTML, no temporary
+    deadline = time.time() + 10
+    while _servers_of(proc.pid) and time.time() < deadline:
+        time.sleep(0.1)
+    assert _servers_of(proc.pid) == []
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="/proc")
+@pytest.mark.parametrize("delay", [0.7, 1.5, 3.0])
+def test_ctrl_c_sent_to_a_long_view_html_exits_130_and_leaves_nothing(tmp_path, delay):
+    """The real signal from outside, at moments of a long replay's run (~10 s here)."""
+    sweep = example("bump_steer.yaml")
+    sweep["steps"] = 3000
+    write_yaml(tmp_path / "long.yaml", sweep)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "pin_susp.cli", "view", GEOMETRY, "long.yaml", "--html", "v.html"],
+        cwd=tmp_path,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
+    time.sleep(delay)
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130, (out, err)
+    assert "stopped" not in out and "wrote" not in out
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["long.yaml"]
