@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import errno
 import math
 import os
 import re
@@ -52,8 +53,11 @@ def main(argv: list[str] | None = None) -> int:
         return exc.code if isinstance(exc.code, int) else EXIT_INPUT
     import numpy as np
 
+    from .yamlio import read_once
+
     with (
         _terminate_as_exit(),
+        read_once(),  # each input read once: a pipe or a FIFO cannot be read twice
         warnings.catch_warnings(record=True) as caught,
         np.errstate(all="ignore"),
     ):
@@ -77,6 +81,12 @@ def main(argv: list[str] | None = None) -> int:
         except BrokenPipeError:  # output piped into `head` and the like
             sys.stderr.close()
             return 0
+        except OSError as exc:  # a safety net: each output path is checked before any work
+            if exc.errno != errno.ENAMETOOLONG:
+                raise
+            name = exc.filename if exc.filename is not None else "a path"
+            print(f"pin-susp: error: {name}: a name too long for the file system", file=sys.stderr)
+            return EXIT_INPUT
 
 
 def _unwritten(args) -> str:
@@ -200,9 +210,14 @@ def _positive(text: str) -> float:
     return _finite(text, positive=True)
 
 
+COUNT_LIMIT = 999_999  # --top: more entries than any table has hardpoint coordinates
+
+
 def _count(text: str) -> int:
     if not re.fullmatch(r"[0-9]{1,6}", text.strip()):
-        raise argparse.ArgumentTypeError(f"expected a whole number >= 0, got {text!r}")
+        raise argparse.ArgumentTypeError(
+            f"expected a whole number from 0 to {COUNT_LIMIT}, got {text!r}"
+        )
     return int(text)
 
 
@@ -272,12 +287,12 @@ def _sweep_streamed(args, corner, sweep) -> int:
     formatting and numpy leave the GIL): two chunks alive at most."""
     from concurrent.futures import ThreadPoolExecutor
 
-    from .export import CsvStream, ParquetStream
+    from .export import CsvStream, ParquetStream, is_parquet
 
     parts = corner.run_sweep_chunks(sweep, progress=_progress_bar(sweep.steps, args.quiet))
     first = next(parts)
     digest = Digest.of(first)
-    kind = ParquetStream if str(args.output).endswith(".parquet") else CsvStream
+    kind = ParquetStream if is_parquet(args.output) else CsvStream
     with (
         kind(args.output, first.units, first.meta, list(first.columns), sweep.steps) as out,
         ThreadPoolExecutor(1) as writer,
@@ -299,12 +314,12 @@ def _sweep_streamed(args, corner, sweep) -> int:
 def _write_results(args, results) -> bool:
     """The CSV (Parquet for an OUT ending .parquet) and, with --plot, the report: both or
     neither; whether it was drawn."""
-    from .export import all_or_none, csv_text, write_csv, write_text
+    from .export import all_or_none, csv_text, is_parquet, write_csv, write_text
 
     plot = args.plot is not None and results["solver_converged"].any()
     text = csv_text(results) if plot else None  # the report reads the CSV's text
     with all_or_none():
-        if str(args.output).endswith(".parquet"):
+        if is_parquet(args.output):
             from .export import write_parquet
 
             write_parquet(results, args.output)
@@ -493,14 +508,26 @@ def _sweep_axle(args) -> int:
         )
         for note in digest.notes:
             print(f"  {note}")
-        print(f"  {'column':<28}{'unit':>7}{'first':>13}{'last':>13}{'min':>13}{'max':>13}")
-        for name in AXLE_SUMMARY:
-            if name in results.columns and not np.all(np.isnan(results[name])):
-                v = results[name]
-                print(
-                    f"  {name:<28}{results.units[name]:>7}{v[0]:>13.6g}{v[-1]:>13.6g}"
-                    f"{np.nanmin(v):>13.6g}{np.nanmax(v):>13.6g}"
-                )
+        shown = [
+            (name, np.asarray(results[name], dtype=float))
+            for name in AXLE_SUMMARY
+            if name in results.columns and not np.all(np.isnan(results[name]))
+        ]
+        some = any(np.isnan(v).any() for _, v in shown)  # a blank cell: say at how many steps
+        head = f"{'first':>13}{'last':>13}{'min':>13}{'max':>13}" + (f"{'blank':>8}" * some)
+        print(f"  {'column':<28}{'unit':>7}{head}")
+        for name, v in shown:
+            empty = int(np.isnan(v).sum())
+            print(
+                f"  {name:<28}{results.units[name]:>7}{_cell(v[0])}{_cell(v[-1])}"
+                f"{_cell(np.nanmin(v))}{_cell(np.nanmax(v))}" + (f"{empty or '':>8}" * some)
+            )
+        failed = len(results) - int(ok.sum())
+        if failed:
+            print(
+                f"  (blank: an empty cell in the CSV; {failed} of {len(results)} steps did not "
+                "converge, and their columns are blank)"
+            )
         print("  (every column of both corners, suffixed _left/_right, is in the CSV)")
         if plot:
             print(f"wrote {args.plot}")
@@ -696,6 +723,7 @@ def _validate(args) -> int:
     from .geometry import load_geometry
     from .sweep import load_sweep
     from .validate import validate
+    from .yamlio import read_input
 
     axle = _is_axle(args.geometry)
     corner = _axle_model(args.geometry) if axle else Corner(load_geometry(args.geometry))
@@ -719,7 +747,7 @@ def _validate(args) -> int:
                 f"--{option}: only {engine} reads it; add --engine {engine} (or --engine all)"
             )
         try:
-            texts[option] = Path(path).read_bytes().decode("utf-8")
+            texts[option] = read_input(path).decode("utf-8")
         except OSError as exc:
             raise PinSuspError(f"{path}: cannot be read ({exc.strerror})") from None
         except UnicodeDecodeError:
@@ -844,12 +872,14 @@ def _demo(args) -> int:
     import yaml
 
     from .corner import Corner
-    from .export import all_or_none, csv_text, write_text
+    from .export import all_or_none, check_folder, csv_text, write_text
     from .geometry import load_geometry
     from .sweep import load_sweep
 
-    out = Path(args.output)
-    if str(args.output).strip() == "" or (out.exists() and not out.is_dir()):
+    if str(args.output).strip() == "":
+        raise PinSuspError(f"{args.output!r}: the demo writes several files: give a folder")
+    out = check_folder(args.output)
+    if out.exists() and not out.is_dir():
         raise PinSuspError(f"{args.output!r}: the demo writes several files: give a folder")
     data = resources.files("pin_susp") / "data"
     inputs = {name: (data / name).read_text() for name in ("demo_geometry.yaml", "demo_sweep.yaml")}
@@ -969,7 +999,8 @@ class Digest:
         self.max_residual = math.nan
         self.iterations = []  # how many steps took each count of iterations
         self.units: dict[str, str] = {}
-        self.stats: dict[str, list] = {}  # name → [first, last, min, max, far step, |far|]
+        # name → [first, last, min, max, far step, |far|, blank steps]
+        self.stats: dict[str, list] = {}
         # Steps are kept as Steps: the first few, and how many (a report names no more).
         self.short = Steps()  # out of reach or past a lock-up
         self.worst_short = 0.0  # their largest residual, mm
@@ -1070,8 +1101,9 @@ class Digest:
 
         stat = self.stats.get(name)
         if stat is None:
-            stat = self.stats[name] = [v[0], v[-1], np.nan, np.nan, None, 0.0]
+            stat = self.stats[name] = [v[0], v[-1], np.nan, np.nan, None, 0.0, 0]
         stat[1] = v[-1]
+        stat[6] += int(np.isnan(v).sum())  # the CSV's empty cells
         if not np.isnan(v).all():
             stat[2] = np.nanmin(np.r_[stat[2], v])
             stat[3] = np.nanmax(np.r_[stat[3], v])
@@ -1108,23 +1140,37 @@ def _summary(results, path) -> None:
     )
     for note in d.notes:
         print(f"  {note}")
-    print(f"  {'metric':<32}{'unit':>7}{'first':>13}{'last':>13}{'min':>13}{'max':>13}")
+    # a cell the CSV leaves empty (a step that did not converge, a value undefined
+    # there) is blank here too, and a column with blanks says at how many steps
+    some = any(0 < stat[6] < d.steps for stat in d.stats.values())
+    head = f"{'first':>13}{'last':>13}{'min':>13}{'max':>13}" + (f"{'blank':>8}" * some)
+    print(f"  {'metric':<32}{'unit':>7}{head}")
     blank = []
-    for name, (first, last, low, high, far, _) in d.stats.items():
-        if low != low:  # NaN at every step
+    for name, (first, last, low, high, far, _, empty) in d.stats.items():
+        if empty == d.steps:  # NaN at every step
             blank.append(name)
             continue
-        line = f"  {name:<32}{d.units[name]:>7}{first:>13.6g}{last:>13.6g}"
+        line = f"  {name:<32}{d.units[name]:>7}{_cell(first)}{_cell(last)}"
         if name in CENTRES and far is not None:
             line += f"   at infinity (instant axis parallel to the view) near step {far}"
         else:
-            line += f"{low:>13.6g}{high:>13.6g}"
+            line += f"{_cell(low)}{_cell(high)}" + (f"{empty or '':>8}" if some else "")
         print(line)
     for name in blank:
         m = METRIC_BY_NAME.get(name)
         why = f"needs {m.needs}" if m is not None and m.needs else "undefined at every step"
         print(f"  {name:<32}{d.units[name]:>7}   (blank: {why})")
+    if d.failed:
+        print(
+            f"  (blank: an empty cell in the CSV; {d.failed} of {d.steps} steps did not "
+            "converge, and their metrics are blank)"
+        )
     print("  (every column, derivatives included, is in the CSV)")
+
+
+def _cell(value: float, width: int = 13) -> str:
+    """A summary figure; an undefined one (NaN) blank, as the CSV's cell."""
+    return f"{'':>{width}}" if value != value else f"{value:>{width}.6g}"
 
 
 def _warn_transmission(results) -> None:
@@ -1899,7 +1945,7 @@ def _view(args) -> int:
     from .export import write_text
     from .geometry import load_geometry
     from .sweep import load_sweep
-    from .viz import Scene, force_caption, force_key, roll_centres
+    from .viz import Scene, force_caption, force_key, roll_centres, signals_held
 
     _check_outputs(args, args.html)
     if args.case is not None and args.cases is None:
@@ -1937,7 +1983,7 @@ def _view(args) -> int:
     quiet = io.StringIO()
     with contextlib.redirect_stdout(quiet):  # meshcat announces its server on stdout
         scene = Scene(model)
-    try:
+    try:  # an interrupt before the scene is served is one as in every command: 130, 143
         colours, caption = None, ""
         if forces is not None:
             colours, scale = scene.force_colours(forces, case)
@@ -1952,10 +1998,18 @@ def _view(args) -> int:
             if qs is not None
             else 0
         )
-        if args.html is not None:
-            write_text(scene.html(caption), args.html)
-            print(f"wrote {args.html}" + (f" ({frames} frames)" if frames else ""))
-            return 0 if results is None else _report_failures(results, "are not in the replay")
+        page = scene.html(caption) if args.html is not None else None
+    except BaseException:
+        with contextlib.suppress(KeyboardInterrupt):  # a second Ctrl+C while it stops
+            scene.close()
+        raise
+    if args.html is not None:
+        with signals_held():  # a signal while the server stops: raised once it has
+            scene.close()
+        write_text(page, args.html)  # whole or not at all
+        print(f"wrote {args.html}" + (f" ({frames} frames)" if frames else ""))
+        return 0 if results is None else _report_failures(results, "are not in the replay")
+    try:
         print(
             f"meshcat: {scene.viewer.url()}"
             + (f"  ({frames} frames: press play in Open Controls > Animations)" if frames else "")
@@ -1970,14 +2024,12 @@ def _view(args) -> int:
         print("serving; press Ctrl+C to stop", flush=True)
         while True:
             time.sleep(0.5)
-    except KeyboardInterrupt:
+    except KeyboardInterrupt:  # the way to stop a live scene: it was served, exit 0
         print("stopped")
         return 0
     finally:
-        try:
+        with contextlib.suppress(KeyboardInterrupt):  # a second Ctrl+C while it stops
             scene.close()
-        except KeyboardInterrupt:  # a second Ctrl+C while the server stops
-            pass
 
 
 # ---------------------------------------------------------------- study
@@ -2059,6 +2111,7 @@ def _study(args) -> int:
             resume=args.resume,
             progress=_progress_bar(total, args.quiet, minimum=1, label=label),
             announce=None if args.quiet else print,
+            warn=lambda text: args.quiet or print(f"pin-susp: warning: {text}", file=sys.stderr),
         )
     except (KeyboardInterrupt, _Terminated) as exc:
         signal_number = exc.signal if isinstance(exc, _Terminated) else signal.SIGINT

@@ -26,6 +26,15 @@ class InputError(PinSuspError):
         super().__init__(f"{where}: {problem}")
 
 
+class NoRoom(PinSuspError):
+    """An output that ran out of room (a full disk, a quota, ``ulimit -f``) part-way:
+    ``path`` the file, ``why`` the system's words; what is left is the raiser's to say."""
+
+    def __init__(self, path, why: str, left: str = "nothing written"):
+        self.path, self.why = str(path), why
+        super().__init__(f"{path}: cannot be written ({why}): {left}")
+
+
 class PlausibilityWarning(UserWarning):
     """A value that is valid but outside what a car has (docs/geometry.md, plausible
     ranges): usually a unit mistake. The CLI prints one line each on stderr."""

@@ -37,7 +37,7 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__
-from .errors import PinSuspError
+from .errors import NoRoom, PinSuspError
 
 # The renames a running all_or_none() block has put off: (temporary, final) pairs.
 _PENDING: contextvars.ContextVar[list | None] = contextvars.ContextVar("pending", default=None)
@@ -57,9 +57,38 @@ def check_output(path: str | Path, what: str = "output") -> Path:
         raise PinSuspError(f"{text}: cannot write here ({exc.strerror})") from None
 
 
+def check_folder(path: str | Path, what: str = "output folder") -> Path:
+    """Refuse an output folder whose path cannot be made (a name too long for the
+    file system, a file on the way), before any work; the path."""
+    text = os.fspath(path)
+    if text.strip() == "":
+        raise PinSuspError(f"the {what}'s path is empty: give a folder")
+    folder = Path(text)
+    _names_fit(folder, text)
+    try:
+        folder.exists()
+    except OSError as exc:
+        raise PinSuspError(f"{text}: cannot write here ({exc.strerror})") from None
+    return folder
+
+
+def _names_fit(folder: Path, text: str) -> None:
+    """Each name in a folder's path within the file system's limit (a missing folder
+    hides a longer name below it from the kernel's checks, until it is made)."""
+    for part in reversed((folder, *folder.parents)):  # from the top: none stat'd past one
+        if len(part.name.encode()) > _name_max(_existing_ancestor(part.parent)):
+            name = _short_name(part.name)
+            raise PinSuspError(f"{text}: the name {name} is too long for this file system")
+
+
+def _short_name(name: str) -> str:
+    return repr(name) if len(name) <= 40 else repr(name[:20] + "..." + name[-10:])
+
+
 def _checked(path: Path, text: str, what: str) -> Path:
     if len(path.name.encode()) > _name_max(_existing_ancestor(path.parent)):
         raise PinSuspError(f"{text}: the file name is too long for this file system")
+    _names_fit(path.parent, text)  # and every folder's on the way (made before the write)
     if text.endswith(os.sep) or path.is_dir():
         raise PinSuspError(f"{text}: is a directory; the {what} needs a file name")
     if is_stream(path):  # /dev/stdout and friends: write through the link, never rename
@@ -110,9 +139,16 @@ def _open_fd(path: Path) -> int | None:
 
 def _existing_ancestor(folder: Path) -> Path:
     folder = folder if str(folder) else Path(".")
-    while not folder.exists() and folder != folder.parent:
+    while not _exists(folder) and folder != folder.parent:
         folder = folder.parent
     return folder
+
+
+def _exists(path: Path) -> bool:
+    try:
+        return path.exists()
+    except OSError:  # a name too long, a loop of links: not a folder to write in
+        return False
 
 
 def _name_max(folder: Path) -> int:
@@ -123,7 +159,7 @@ def _name_max(folder: Path) -> int:
 
 
 # A write that fails for want of room: the disk, a quota, a file-size limit.
-_FULL = {errno.ENOSPC, errno.EFBIG, errno.EDQUOT}
+FULL = _FULL = {errno.ENOSPC, errno.EFBIG, errno.EDQUOT}
 
 
 @contextmanager
@@ -147,7 +183,7 @@ def atomic_write(path: str | Path, binary: bool = False):
         except OSError as exc:
             if exc.errno not in _FULL:
                 raise
-            raise PinSuspError(f"{path}: cannot be written ({exc.strerror})") from None
+            raise NoRoom(path, exc.strerror, "what was sent to it is incomplete") from None
         return
     try:
         target.parent.mkdir(parents=True, exist_ok=True)
@@ -162,9 +198,7 @@ def atomic_write(path: str | Path, binary: bool = False):
     except BaseException as exc:
         os.unlink(tmp)
         if isinstance(exc, OSError) and exc.errno in _FULL:  # the disk, a quota, ulimit -f
-            raise PinSuspError(
-                f"{path}: cannot be written ({exc.strerror}): nothing written"
-            ) from None
+            raise NoRoom(path, exc.strerror) from None
         raise
     pending = _PENDING.get()
     if pending is None:
@@ -561,6 +595,12 @@ def results_frame(results):
     frame = pd.DataFrame({k: np.asarray(v) for k, v in results.columns.items()})
     frame.attrs["units"] = {k: u for k, u in results.units.items() if u}
     return frame
+
+
+def is_parquet(path: str | Path) -> bool:
+    """Whether an output is to be Parquet: its name ends .parquet, in any case
+    (X.PARQUET, x.Parquet); anything else is CSV."""
+    return Path(path).suffix.lower() == ".parquet"
 
 
 def write_text(text: str, path: str | Path) -> None:

@@ -62,7 +62,7 @@ import numpy as np  # noqa: E402
 from matplotlib.transforms import Bbox  # noqa: E402
 
 from .errors import InputError, PinSuspError  # noqa: E402
-from .export import atomic_write  # noqa: E402
+from .export import FULL, atomic_write  # noqa: E402
 from .geometry import unit, wheel_down  # noqa: E402
 from .metrics import (  # noqa: E402
     HUB_Z,
@@ -74,6 +74,7 @@ from .metrics import (  # noqa: E402
     X,
     Y,
 )
+from .yamlio import read_input  # noqa: E402
 
 EXTRA = (
     "svic_z",
@@ -116,7 +117,7 @@ class ResultsFile:
         self.label = Path(source).stem
         try:
             if raw is None:
-                raw = self.path.read_bytes()
+                raw = read_input(self.path)
         except OSError as exc:
             raise InputError(source, "", f"cannot be read ({exc.strerror})") from None
         if not raw.strip():
@@ -1403,6 +1404,8 @@ def save_figure(fig, path: str | Path) -> None:
             try:
                 fig.savefig(f, format=_extension(path), dpi=110)
             except OSError as exc:
+                if exc.errno in FULL:  # the disk, a quota, ulimit -f: as atomic_write says it
+                    raise
                 raise PinSuspError(f"{path}: cannot write ({exc.strerror or exc})") from None
             except (ValueError, OverflowError) as exc:  # e.g. a cell of 1e308: no axis scale
                 raise PinSuspError(f"{path}: cannot draw these values ({exc})") from None

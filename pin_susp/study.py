@@ -18,6 +18,7 @@ Execution: ``scheduler=None`` runs in this process, one batch after another;
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import json
 import math
@@ -30,8 +31,8 @@ import numpy as np
 import yaml
 
 from . import __version__
-from .errors import InputError, PinSuspError
-from .yamlio import Reader, load_yaml
+from .errors import InputError, NoRoom, PinSuspError
+from .yamlio import Reader, load_yaml, read_once
 
 KINDS = ("doe", "monte_carlo", "optimise")
 DOE_METHODS = ("full_factorial", "latin_hypercube", "sobol")
@@ -168,6 +169,11 @@ class Study:
 def load_study(source: str | Path) -> Study:
     """Read and check a study file; its geometry and sweep are read (and solved at
     design) too, so that every mistake is found before any work."""
+    with read_once():  # each file read once: a FIFO or a pipe can be
+        return _load_study(source)
+
+
+def _load_study(source: str | Path) -> Study:
     data, name, sha = load_yaml(source)
     r = Reader(name)
     r.mapping(data, "", required=("geometry", "sweep", "kind"), optional=STUDY_KEYS)
@@ -901,29 +907,77 @@ def run_study(
     resume: bool = False,
     progress=None,
     announce=None,
+    warn=None,
 ) -> Outcome:
     """Run a study into ``outdir`` (docs/studies.md); see the module's docstring.
 
     ``progress(done, total)`` after each batch; ``announce(text)`` for a line worth
-    printing before the work (the Dask dashboard's address).
+    printing before the work (the Dask dashboard's address); ``warn(text)`` for a
+    damaged part file that a resumed run solves again (default: warnings.warn).
+
+    A run that stops (an interrupt, an error, a write that runs out of room) leaves
+    OUTDIR with what ``resume`` needs — its study.json and the part files of the
+    batches finished, each whole — or, before any batch is finished, as it found it
+    (a new run's study.json and part folder removed). A write that runs out of room
+    raises NoRoom saying which (docs/studies.md).
     """
     if not isinstance(study, Study):
         study = load_study(study)
     outdir = Path(outdir)
     _check_outdir(study, outdir, steps, resume)  # before any connection or file
-    if scheduler is None or scheduler == "none":
-        return _run(study, outdir, None, steps, resume, progress, None)
-    with _client(scheduler, workers) as client:  # a scheduler that answers, before any file
-        dashboard = _dashboard(client, local=scheduler == "local")
-        if announce is not None and dashboard:
-            announce(f"Dask dashboard: {dashboard}")
-        return _run(study, outdir, client, steps, resume, progress, dashboard)
+    fresh = not outdir.exists()
+    try:
+        if scheduler is None or scheduler == "none":
+            return _run(study, outdir, None, steps, resume, progress, None, warn)
+        with _client(scheduler, workers) as client:  # a scheduler that answers, before any file
+            dashboard = _dashboard(client, local=scheduler == "local")
+            if announce is not None and dashboard:
+                announce(f"Dask dashboard: {dashboard}")
+            return _run(study, outdir, client, steps, resume, progress, dashboard, warn)
+    except BaseException as exc:
+        kept = _left(outdir, fresh, resume)
+        if isinstance(exc, NoRoom):
+            total = len(batches(study))
+            left = (
+                f"{kept} of {total} batches are kept in {outdir}: the same command with "
+                "--resume continues (once there is room)"
+                if kept
+                else "nothing written"
+            )
+            raise NoRoom(exc.path, exc.why, left) from None
+        raise
 
 
-def _run(study, outdir, client, steps, resume, progress, dashboard) -> Outcome:
+def _left(outdir: Path, fresh: bool, resume: bool) -> int:
+    """After a run that stopped: the batches kept for --resume; with none, a new run's
+    study.json and part folder go (and OUTDIR, made by it)."""
+    kept = finished_batches(outdir) or 0
+    if kept or resume:  # a resumed run leaves the directory at least as it found it
+        return kept
+    parts = outdir / PARTS
+    with contextlib.suppress(OSError):
+        if parts.is_dir():
+            for p in parts.iterdir():  # a batch's steps part, without its variants part
+                p.unlink()
+            parts.rmdir()
+        (outdir / MANIFEST).unlink(missing_ok=True)
+        if fresh:
+            outdir.rmdir()  # only if empty
+    return 0
+
+
+def _run(study, outdir, client, steps, resume, progress, dashboard, warn=None) -> Outcome:
     table = variant_table(study)
     parts = _prepare(study, outdir, steps, resume)
     cut = batches(study)
+    if resume:  # a part cut short or damaged since (a disk error, an editor): solved again
+        for i in range(len(cut)):
+            why = _damaged(parts, i, cut[i], steps)
+            if why is not None:
+                for what in ("variants", "steps"):
+                    (parts / f"{what}-{i:06d}.parquet").unlink(missing_ok=True)
+                message = f"{why}: batch {i} is solved again"
+                warnings.warn(message, stacklevel=2) if warn is None else warn(message)
     todo = [i for i in range(len(cut)) if not (parts / f"variants-{i:06d}.parquet").exists()]
     job = study.job()
     task = run_start if study.kind == "optimise" else run_batch
@@ -953,7 +1007,7 @@ def _run(study, outdir, client, steps, resume, progress, dashboard) -> Outcome:
         for name, values in outcome.linear.items():
             table = table.append_column(f"{name}_linear", pa.array(values, from_pandas=True))
         outcome.variants = variants = table.to_pandas()
-    curves = None
+    curves = comment = None
     if study.kind == "optimise" and variants["converged"].any():
         row = best_row(variants)
         best = np.array([row[v.name] for v in study.variables], dtype=float)
@@ -964,16 +1018,20 @@ def _run(study, outdir, client, steps, resume, progress, dashboard) -> Outcome:
             + "".join(f"{v.name} = {float(row[v.name])!r} mm\n" for v in study.variables)
         )
         outcome.best = outdir / "best.yaml"
-        write_geometry(study, best, outcome.best, comment.rstrip())
         curves = curves_of(study, best)
     outcome.lines = summary_lines(study, variants, outcome.linear, curves)
-    if variants["converged"].any():
-        from .plots import save_figure
-        from .study_plots import study_figure
+    from .export import all_or_none
 
-        outcome.figure = outdir / "study.png"
-        save_figure(study_figure(study, variants, outcome.linear, curves), outcome.figure)
-    _write_parquet(table, outdir / "variants.parquet")  # last: it marks the run finished
+    with all_or_none():  # best.yaml, study.png, variants.parquet: together, or none of them
+        if outcome.best is not None:
+            write_geometry(study, best, outcome.best, comment.rstrip())
+        if variants["converged"].any():
+            from .plots import save_figure
+            from .study_plots import study_figure
+
+            outcome.figure = outdir / "study.png"
+            save_figure(study_figure(study, variants, outcome.linear, curves), outcome.figure)
+        _write_parquet(table, outdir / "variants.parquet")  # last: it marks the run finished
     _drop_parts(parts)
     return outcome
 
@@ -1149,7 +1207,10 @@ def _prepare(study: Study, outdir: Path, steps: bool, resume: bool) -> Path:
 def _check_outdir(study: Study, outdir: Path, steps: bool, resume: bool) -> dict:
     """OUTDIR must be new or empty, or hold this study's unfinished run (``resume``);
     nothing is written. The manifest that the run will write."""
+    from .export import check_folder
+
     mine = _fingerprint(study, steps)
+    check_folder(outdir)  # a name too long for the file system: one line, not a traceback
     manifest = outdir / MANIFEST
     if outdir.exists() and not outdir.is_dir():
         raise PinSuspError(f"{outdir}: exists and is not a directory")
@@ -1209,13 +1270,50 @@ def finished_batches(outdir: str | Path) -> int | None:
 
 def _write_part(parts: Path, result: dict) -> None:
     """A batch's part files, each written whole; the variants' part last: its
-    presence marks the batch done."""
+    presence marks the batch done (a steps part without it goes)."""
     i = result["index"]
     parts.mkdir(exist_ok=True)
     order = [("steps", result["steps"]), ("variants", result["variants"])]
-    for what, data in order:
-        if data is not None:
-            _write_parquet(_from_ipc(data), parts / f"{what}-{i:06d}.parquet")
+    try:
+        for what, data in order:
+            if data is not None:
+                _write_parquet(_from_ipc(data), parts / f"{what}-{i:06d}.parquet")
+    except BaseException:
+        (parts / f"steps-{i:06d}.parquet").unlink(missing_ok=True)
+        raise
+
+
+def _damaged(parts: Path, i: int, ids: np.ndarray, steps: bool) -> str | None:
+    """What is wrong with batch ``i``'s part files (None: nothing, or not written):
+    each must read whole, its variants part holding the batch's variants."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    path = parts / f"variants-{i:06d}.parquet"
+    if not path.exists():
+        return None
+    names = [path] + [parts / f"steps-{i:06d}.parquet"] * steps
+    for name in names:
+        if not name.exists():
+            continue  # a batch none of whose variants converged has no steps
+        try:
+            table = pq.read_table(name)
+        except (pa.ArrowException, OSError, ValueError) as exc:
+            return f"{name}: damaged ({_first_line(exc)})"
+        if name == path:
+            got = (
+                np.sort(table.column("variant_id").to_numpy())
+                if "variant_id" in (table.column_names)
+                else None
+            )
+            if got is None or not np.array_equal(got, ids):
+                return f"{name}: does not hold batch {i}'s variants"
+    return None
+
+
+def _first_line(exc: BaseException) -> str:
+    text = str(exc).strip().splitlines()
+    return text[0][:200] if text else type(exc).__name__
 
 
 def _write_parquet(table, path: Path) -> None:
@@ -1240,7 +1338,15 @@ def _assemble(study: Study, outdir: Path, parts: Path, n: int, steps: bool):
             f"{parts}: the part files of {len(missing)} batches went missing while the study "
             "ran (removed by another program?): --resume solves them again"
         )
-    tables = [pq.read_table(parts / f"variants-{i:06d}.parquet") for i in range(n)]
+    tables = []
+    for i in range(n):
+        path = parts / f"variants-{i:06d}.parquet"
+        try:
+            tables.append(pq.read_table(path))
+        except (pa.ArrowException, OSError, ValueError) as exc:  # damaged while the run ran
+            raise PinSuspError(
+                f"{path}: damaged ({_first_line(exc)}): --resume solves its batch again"
+            ) from None
     variants = pa.concat_tables(tables, promote_options="permissive").sort_by("variant_id")
     units = {v.name: "mm" for v in study.variables}
     meta = {

@@ -46,9 +46,12 @@ player.
 
 from __future__ import annotations
 
+import contextlib
 import os
+import signal
 import subprocess
 import sys
+import threading
 
 import numpy as np
 import pinocchio as pin
@@ -273,6 +276,41 @@ main()
 """
 
 
+@contextlib.contextmanager
+def signals_held(signals=(signal.SIGINT, signal.SIGTERM, signal.SIGHUP)):
+    """Inside, these signals wait; the first that came is handled once the block ends,
+    as it would have been (Ctrl+C: KeyboardInterrupt). For code that must not lose one:
+    an import that swallows KeyboardInterrupt (pinocchio.visualize imports trimesh,
+    whose imports catch BaseException), a server being stopped. Main thread only."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    came = []
+    previous = {}
+    for s in signals:
+        if signal.getsignal(s) is not None:  # None: a handler Python did not install
+            previous[s] = signal.signal(s, lambda number, _: came.append(number))
+    try:
+        yield
+    finally:
+        for s, handler in previous.items():
+            signal.signal(s, handler)
+        if came:
+            handler = previous[came[0]]
+            if callable(handler):
+                handler(came[0], None)  # raises, as it would have inside
+            elif handler == signal.SIG_DFL:
+                signal.raise_signal(came[0])
+
+
+def _meshcat_visualizer():
+    """Pinocchio's MeshcatVisualizer, imported with Ctrl+C held: its package imports
+    trimesh, which swallows an interrupt that comes while it loads."""
+    with signals_held():
+        from pinocchio.visualize import MeshcatVisualizer
+    return MeshcatVisualizer
+
+
 def start_server() -> tuple[subprocess.Popen, str]:
     """A meshcat server on 127.0.0.1 that ends with this process (even on SIGKILL).
 
@@ -286,13 +324,28 @@ def start_server() -> tuple[subprocess.Popen, str]:
         stderr=subprocess.DEVNULL,
         start_new_session=True,  # a Ctrl+C is ours to handle: we stop it in close()
     )
-    line = ""
-    while "zmq_url" not in line:
-        line = proc.stdout.readline().decode("utf-8", "replace")
-        if not line and proc.poll() is not None:
-            raise RuntimeError(f"the meshcat server exited at start (code {proc.returncode})")
-    proc.stdout.readline()  # its web URL: the viewer asks for it over ZMQ
+    try:
+        line = ""
+        while "zmq_url" not in line:
+            line = proc.stdout.readline().decode("utf-8", "replace")
+            if not line and proc.poll() is not None:
+                raise RuntimeError(f"the meshcat server exited at start (code {proc.returncode})")
+        proc.stdout.readline()  # its web URL: the viewer asks for it over ZMQ
+    except BaseException:  # an interrupt while it starts: it goes with us
+        _stop(proc)
+        raise
     return proc, match_zmq_url(line.strip())
+
+
+def _stop(proc: subprocess.Popen) -> None:
+    """End a server process, at once if it does not end within 10 s."""
+    if proc.poll() is None:
+        proc.terminate()
+        try:
+            proc.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
 
 
 def _rod_transform(p0: np.ndarray, p1: np.ndarray) -> np.ndarray:
@@ -318,12 +371,20 @@ class Scene:
         import meshcat.geometry as mg
 
         self.model = model
-        self.server = None
+        self.server = self.viewer = None
         self.not_two_force: list[str] = []  # legs force_colours found no two-force member
         if viewer is None:
             self.server, zmq_url = start_server()
-            viewer = meshcat.Visualizer(zmq_url=zmq_url)
-        self.viewer = viewer
+        try:
+            if viewer is None:
+                viewer = meshcat.Visualizer(zmq_url=zmq_url)
+            self.viewer = viewer
+            self._build(model, mg)
+        except BaseException:  # an interrupt while it is built: the server goes with it
+            self.close()
+            raise
+
+    def _build(self, model, mg) -> None:
         self.viewer[ROOT].delete()
         self.robots = []
         drawn = as_drawn(model)
@@ -358,8 +419,7 @@ class Scene:
         self.show()
 
     def _robot(self, model, name, colour):
-        from pinocchio.visualize import MeshcatVisualizer
-
+        MeshcatVisualizer = _meshcat_visualizer()
         visual = pin.buildGeomFromUrdfString(model.model, model.urdf, pin.GeometryType.VISUAL)
         viz = MeshcatVisualizer(model.model, visual, visual)
         viz.initViewer(viewer=self.viewer, loadModel=False)
@@ -573,16 +633,11 @@ class Scene:
         proc = self.server
         if proc is None:
             return
-        socket = getattr(self.viewer.window, "zmq_socket", None)
+        window = getattr(self.viewer, "window", None)
+        socket = getattr(window, "zmq_socket", None)
         if socket is not None and not socket.closed:
             socket.close(linger=0)
-        if proc.poll() is None:
-            proc.terminate()
-            try:
-                proc.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                proc.kill()
-                proc.wait()
+        _stop(proc)
 
 
 CornerScene = Scene  # its name from before axles

@@ -7,11 +7,15 @@ reads like the format it accepts.
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import copy
 import functools
 import hashlib
 import math
+import os
 import re
+import stat
 from pathlib import Path
 from typing import Any
 
@@ -139,7 +143,7 @@ def load_yaml(source: str | Path | dict) -> tuple[dict, str, str | None]:
         return source, "<dict>", None
     path = Path(source)
     try:
-        raw = path.read_bytes()
+        raw = read_input(path)
     except FileNotFoundError:
         raise InputError(str(path), "", "file not found") from None
     except IsADirectoryError:
@@ -174,10 +178,49 @@ def load_yaml(source: str | Path | dict) -> tuple[dict, str, str | None]:
     return data, str(path), hashlib.sha256(raw).hexdigest()
 
 
+# Inside read_once(): the bytes of every input read so far, by what the file is.
+_READ: contextvars.ContextVar[dict | None] = contextvars.ContextVar("read", default=None)
+
+
+@contextlib.contextmanager
+def read_once():
+    """Inside, every input is read from its file once: a second read of it (the CLI asks
+    a geometry's scope, then loads it; a study reads its sweep, then solves it) gets the
+    same bytes. A pipe or a FIFO (``cat g.yaml | pin-susp sweep /dev/stdin ...``) can
+    only be read once, and a file edited while a command runs is still one file to it.
+    Nested blocks share the outer one's reads."""
+    if _READ.get() is not None:
+        yield
+        return
+    token = _READ.set({})
+    try:
+        yield
+    finally:
+        _READ.reset(token)
+
+
+def read_input(path: str | Path) -> bytes:
+    """The bytes of an input file (once per file inside read_once()). OSError as open()
+    raises it; a directory: IsADirectoryError."""
+    path = Path(path)
+    cache = _READ.get()
+    if cache is None:
+        return path.read_bytes()
+    st = os.stat(path)
+    if stat.S_ISDIR(st.st_mode):
+        raise IsADirectoryError(21, "Is a directory", str(path))
+    key = (st.st_dev, st.st_ino)
+    if stat.S_ISREG(st.st_mode):  # a regular file: the same one unchanged
+        key += (st.st_size, st.st_mtime_ns)
+    if key not in cache:
+        cache[key] = path.read_bytes()
+    return cache[key]
+
+
 @functools.lru_cache(maxsize=8)
 def _parse(raw: bytes) -> Any:
-    """A file's YAML, parsed once per content: a command reads its geometry twice (the
-    CLI asks its scope, then loads it), and pure-Python YAML is the slow part of that."""
+    """A file's YAML, parsed once per content: pure-Python YAML is the slow part of
+    reading a file, and a study's variants are built from the same text many times."""
     return yaml.load(raw, Loader=_Loader)  # _Loader is a SafeLoader: no arbitrary objects
 
 
