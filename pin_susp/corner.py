@@ -42,17 +42,7 @@ class Corner(Linkage):
     def __repr__(self) -> str:
         def parts():
             g = self.geometry
-            return (
-                g.source,
-                g.name,
-                g.type,
-                g.side,
-                g.steering,
-                "pushrod_rocker" if g.actuation == "pushrod_rocker" else "",
-                "" if g.spring == "none" else g.spring,
-                "as set" if g.drawn is not None else "",
-                f"{self.mobility} inputs",
-            )
+            return (g.source, g.name, *g.choices(), f"{self.mobility} inputs")
 
         return summary_repr(self, parts)
 

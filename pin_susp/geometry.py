@@ -198,6 +198,18 @@ class Geometry:
         design condition, in mm (as ``hardpoints_mm``)."""
         return {name: to_mm(p) for name, p in self.design_points().items()}
 
+    def choices(self) -> tuple[str, ...]:
+        """The choices that decide the mechanism, as the reprs list them (blank: the
+        default left out): type, side, steering, pushrod-rocker, spring, as set."""
+        return (
+            self.type,
+            self.side,
+            self.steering,
+            "pushrod_rocker" if self.actuation == "pushrod_rocker" else "",
+            "" if self.spring == "none" else self.spring,
+            "as set" if self.drawn is not None else "",
+        )
+
     def __repr__(self) -> str:
         """One line: the file, the name and the choices that decide the mechanism."""
         return summary_repr(
@@ -205,12 +217,7 @@ class Geometry:
             lambda: (
                 self.source,
                 self.name,
-                self.type,
-                self.side,
-                self.steering,
-                "pushrod_rocker" if self.actuation == "pushrod_rocker" else "",
-                "" if self.spring == "none" else self.spring,
-                "as set" if self.drawn is not None else "",
+                *self.choices(),
                 f"{len(self.hardpoints)} hardpoints",
             ),
         )
