@@ -15,24 +15,34 @@ import pytest
 from golden import run
 
 GOLDEN = Path(__file__).resolve().parent / "data" / "golden"
-NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|nan|inf")
+TOKENS = re.compile(r"([,\s:;={}\[\]()\"']+)")  # a text's separators, kept
 TOLERANCE = 1e-12
 
 
 def _close(a: float, b: float) -> bool:
-    if math.isnan(a) or math.isnan(b):
-        return math.isnan(a) and math.isnan(b)
+    if a == b or (math.isnan(a) and math.isnan(b)):
+        return True
     return abs(a - b) <= TOLERANCE * max(abs(a), abs(b)) + TOLERANCE
 
 
+def _number(token: str) -> float | None:
+    try:
+        return float(token)
+    except ValueError:
+        return None
+
+
 def _same_text(old: str, new: str, name: str) -> None:
-    """Equal but for numbers within the tolerance: the tokens between numbers equal."""
-    old_parts, new_parts = NUMBER.split(old), NUMBER.split(new)
-    assert old_parts == new_parts, f"{name}: text differs beyond its numbers"
-    old_numbers, new_numbers = NUMBER.findall(old), NUMBER.findall(new)
-    assert len(old_numbers) == len(new_numbers), name
-    for a, b in zip(old_numbers, new_numbers, strict=True):
-        assert _close(float(a), float(b)), f"{name}: {a} became {b}"
+    """Equal but for numbers within the tolerance: token by token (split at the
+    separators of CSV, YAML, JSON and XML text), a differing pair must be two numbers."""
+    old_tokens, new_tokens = TOKENS.split(old), TOKENS.split(new)
+    assert len(old_tokens) == len(new_tokens), f"{name}: a different number of tokens"
+    for a, b in zip(old_tokens, new_tokens, strict=True):
+        if a == b:
+            continue
+        x, y = _number(a), _number(b)
+        assert x is not None and y is not None, f"{name}: {a!r} became {b!r}"
+        assert _close(x, y), f"{name}: {a} became {b}"
 
 
 def _same_parquet(old: Path, new: Path, name: str) -> None:
