@@ -40,10 +40,6 @@ CIRCLES = {
     frozenset({"axle", "corner", "loads", "plots", "setup", "viz"}),
     # the closure rows, the Newton solve and the many-corner solve call each other
     frozenset({"bulk", "closures", "solver"}),
-    # a geometry asks its mechanism for names and checks; a mechanism uses geometry's maths
-    frozenset({"geometry", "mechanisms"}),
-    # the study draws its plots; the plots read the study's tables and names
-    frozenset({"study", "study_plots"}),
 }
 
 # Today's private names taken across modules: (importer, source module, name).
