@@ -1440,26 +1440,6 @@ def best_row(variants):
     return variants[variants["converged"]].sort_values("objective").iloc[0]
 
 
-def best_deltas(study: Study, variants) -> np.ndarray:
-    """The variables of the best start (best_row)."""
-    best = best_row(variants)
-    return np.array([best[v.name] for v in study.variables], dtype=float)
-
-
-def reswept_objective(path: str | Path, study: Study) -> float:
-    """The objective of a geometry file (best.yaml) swept afresh: what the study reported."""
-    from .sweep import load_sweep
-
-    data, name, _ = load_yaml(path)
-    job = study.job()
-    job.geometry = data
-    job.variables = []
-    v = Variant(job, np.zeros(0), load_sweep(study.sweep_data))
-    if v.results is None:
-        raise PinSuspError(f"{name}: {v.error}")
-    return float(np.linalg.norm(v.residuals()))
-
-
 def curves_of(study: Study, deltas) -> list[dict]:
     """Per objective term: the metric over the sweep before (design) and after (the
     variables at ``deltas``), and the target — for the figure."""
