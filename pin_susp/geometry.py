@@ -283,7 +283,7 @@ def load_geometry(source: str | Path | dict) -> Geometry:
     about a link near dead centre at design (docs/geometry.md, "Dead centres").
     """
     data, name, sha = load_yaml(source)
-    g = _parse(data, Reader(name), sha)
+    g = parse_geometry(data, Reader(name), sha)
     warn_implausible(g)
     warn_dead_centres(g)
     return g
@@ -336,7 +336,11 @@ def warn_outside(what: str, value: float, low: float, high: float, unit_text: st
         )
 
 
-def _parse(data: dict, r: Reader, sha: str | None) -> Geometry:
+def parse_geometry(data: dict, r: Reader, sha: str | None) -> Geometry:
+    """The Geometry of a geometry file's data (mm) already read, its errors through
+    ``r`` (naming the file and key); ``sha`` the file's hash. No plausibility
+    warnings: :func:`load_geometry` adds them, and an axle's corners or a study's
+    variants, read from data they hold, warn (or not) for themselves."""
     from . import mechanisms
 
     if isinstance(data, dict) and data.get("scope") != "axle":

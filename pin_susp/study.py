@@ -468,9 +468,9 @@ def variant_data(base: dict, variables: list[Variable], deltas, axle: bool) -> d
     if axle:
         points = data["hardpoints"]
         if "right" not in points or points["right"] is None:  # mirrored: made explicit
-            from .axle import _mirror
+            from .axle import mirror_corner
 
-            points["right"] = _mirror({"hardpoints": points["left"]})["hardpoints"]
+            points["right"] = mirror_corner({"hardpoints": points["left"]})["hardpoints"]
     for v, d in zip(variables, deltas, strict=True):
         if d == 0.0:
             continue
@@ -494,9 +494,9 @@ def build(data: dict, source: str, axle: bool, variant: bool = False):
 
             return AxleModel(load_axle(data, None if variant else source))
         from .corner import Corner
-        from .geometry import _parse, warn_dead_centres
+        from .geometry import parse_geometry, warn_dead_centres
 
-        geometry = _parse(data, Reader("<dict>"), None)
+        geometry = parse_geometry(data, Reader("<dict>"), None)
         if not variant:  # a link near dead centre, as every command says
             warn_dead_centres(geometry, source)
         return Corner(geometry, warn=not variant, visuals=not variant)
@@ -1251,9 +1251,9 @@ def _check_outdir(study: Study, outdir: Path, steps: bool, resume: bool) -> dict
     elif resume:
         raise PinSuspError(f"{outdir}: no unfinished run of this study to resume")
     else:
-        from .export import _existing_ancestor
+        from .export import existing_ancestor
 
-        folder = _existing_ancestor(outdir.absolute())
+        folder = existing_ancestor(outdir.absolute())
         if not folder.is_dir():
             raise PinSuspError(f"{outdir}: cannot write here ({folder} is not a directory)")
         if not os.access(folder, os.W_OK | os.X_OK):

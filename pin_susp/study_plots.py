@@ -35,7 +35,7 @@ from matplotlib.patches import Patch
 
 from .errors import PinSuspError
 from .metrics import METRIC_BY_NAME, Derivative
-from .plots import _lone
+from .plots import lone_marker
 from .study_summary import main_effects
 
 TOP = 8  # main effects drawn per panel: the largest
@@ -478,7 +478,7 @@ def _curve_panel(ax, entry: dict) -> None:
         if target is not None:
             targets.append((x, np.asarray(target, dtype=float)))
             name += f", RMS miss {rms_miss(y, target):.3g} {unit}".rstrip()
-        ax.plot(x, y, "-", color=colour, lw=lw, marker=_lone(y), label=name, gid=which)
+        ax.plot(x, y, "-", color=colour, lw=lw, marker=lone_marker(y), label=name, gid=which)
     if targets:
         x = np.concatenate([t[0] for t in targets])
         t = np.concatenate([t[1] for t in targets])

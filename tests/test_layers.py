@@ -44,14 +44,8 @@ CIRCLES = {
 
 # Today's private names taken across modules: (importer, source module, name).
 PRIVATE = {
-    ("axle", "geometry", "_parse"),
+    # the model files' number text: left for the rename of urdf.py (issue 25, point 4)
     ("mjcf", "urdf", "_fmt"),
-    ("study", "axle", "_mirror"),
-    ("study", "export", "_existing_ancestor"),
-    ("study", "geometry", "_parse"),
-    ("study_plots", "plots", "_lone"),
-    ("sweep", "yamlio", "_short"),
-    ("validate", "deadcentre", "_point_name"),
 }
 
 
