@@ -508,7 +508,7 @@ class AxleReader(Reader):
 def load_axle(source, warn_as: str | None = None) -> AxleGeometry:
     """Read and validate an axle file (``scope: axle``, docs/axle.md): a path or a dict
     (``warn_as``: the file a dict came from, for the warnings; its errors say <dict>)."""
-    from .geometry import _parse, warn_implausible
+    from .geometry import parse_geometry, warn_implausible
 
     data, name, sha = load_yaml(source)
     r = Reader(name)
@@ -618,9 +618,9 @@ def load_axle(source, warn_as: str | None = None) -> AxleGeometry:
         if side == "right":
             corner["side"] = "right"
             if mirrored:
-                corner = _mirror(corner)
+                corner = mirror_corner(corner)
         reader = AxleReader(name, "left" if side == "left" or mirrored else "right")
-        corners[side] = _parse(corner, reader, sha)
+        corners[side] = parse_geometry(corner, reader, sha)
         sign = 1.0 if side == "left" else -1.0
         side_points[side] = {
             k: reader.point(points[k], f"{key}.{k}")
@@ -729,7 +729,7 @@ def _check_t_bar(hub: np.ndarray, side_points: dict, mirrored: bool, r: Reader) 
         )
 
 
-def _mirror(corner: dict) -> dict:
+def mirror_corner(corner: dict) -> dict:
     """A corner dict mirrored through y = 0: points' y and the shim normal's y negated."""
     out = copy.deepcopy(corner)
 

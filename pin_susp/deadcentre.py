@@ -148,13 +148,13 @@ def _transmission(name, end, other, body, joint, tree, driven: bool) -> Transmis
     angle = math.degrees(abs(math.atan2(sine, float(arm @ rod))))
     rod_length = float(np.linalg.norm(rod))
     miss = abs(sine) / rod_length if rod_length > 0.0 else 0.0  # |arm| · sin(angle)
-    axis = tuple(_point_name(n, body, tree) for n in joint.defined_by)
+    axis = tuple(tree_point_name(n, body, tree) for n in joint.defined_by)
     return Transmission(
         name, end, other, body, axis, angle, miss, float(np.linalg.norm(arm)), driven
     )
 
 
-def _point_name(name: str, body: str, tree) -> str:
+def tree_point_name(name: str, body: str, tree) -> str:
     """A joint's defining point as the tree names it (an axle's are ``left_…``)."""
     if name in tree.points:
         return name

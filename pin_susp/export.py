@@ -76,7 +76,7 @@ def _names_fit(folder: Path, text: str) -> None:
     """Each name in a folder's path within the file system's limit (a missing folder
     hides a longer name below it from the kernel's checks, until it is made)."""
     for part in reversed((folder, *folder.parents)):  # from the top: none stat'd past one
-        if len(part.name.encode()) > _name_max(_existing_ancestor(part.parent)):
+        if len(part.name.encode()) > _name_max(existing_ancestor(part.parent)):
             name = _short_name(part.name)
             raise PinSuspError(f"{text}: the name {name} is too long for this file system")
 
@@ -86,7 +86,7 @@ def _short_name(name: str) -> str:
 
 
 def _checked(path: Path, text: str, what: str) -> Path:
-    if len(path.name.encode()) > _name_max(_existing_ancestor(path.parent)):
+    if len(path.name.encode()) > _name_max(existing_ancestor(path.parent)):
         raise PinSuspError(f"{text}: the file name is too long for this file system")
     _names_fit(path.parent, text)  # and every folder's on the way (made before the write)
     if text.endswith(os.sep) or path.is_dir():
@@ -96,7 +96,7 @@ def _checked(path: Path, text: str, what: str) -> Path:
     target = _target(path)
     if is_stream(target):
         return target
-    folder = _existing_ancestor(target.parent)
+    folder = existing_ancestor(target.parent)
     if not folder.is_dir():
         raise PinSuspError(f"{text}: cannot write here ({folder} is not a directory)")
     if not os.access(folder, os.W_OK | os.X_OK):
@@ -137,7 +137,9 @@ def _open_fd(path: Path) -> int | None:
     return None
 
 
-def _existing_ancestor(folder: Path) -> Path:
+def existing_ancestor(folder: Path) -> Path:
+    """The nearest folder of ``folder`` (itself or a parent) that exists: where a
+    name's length limit and the free room are measured before it is made."""
     folder = folder if str(folder) else Path(".")
     while not _exists(folder) and folder != folder.parent:
         folder = folder.parent

@@ -14,18 +14,11 @@ from pathlib import Path
 import numpy as np
 
 from .errors import PlausibilityWarning
+from .vectors import COINCIDENT, direction, unit
 from .yamlio import MAX_LENGTH_MM, Reader, load_yaml
 
 MM = 1e-3
 INCH = 0.0254
-
-STEERING_POINTS = {
-    "rack": ("trackrod_inboard", "trackrod_outboard"),
-    "none": ("toe_link_inboard", "toe_link_outboard"),
-}
-AXLE_POINTS = ("axle_inboard", "axle_outboard")
-COILOVER_POINTS = ("strut_top", "strut_bottom")
-PUSHROD_ROCKER_POINTS = ("pushrod_outboard", "pushrod_inboard", "rocker_axis_a", "rocker_axis_b")
 
 # Points computed from the upright's hardpoints and the wheel (docs/geometry.md, "Derived
 # points").
@@ -36,9 +29,6 @@ DERIVED_POINTS = (
     "wheel_outboard",
     "contact_patch_center",
 )
-
-# Anything closer than this is "the same point" for an axis or a link.
-COINCIDENT = 1e-6  # m
 
 # Valid but implausible for a car (docs/geometry.md): a warning each, never an error.
 # key path → (low, high, unit as written in the file)
@@ -246,22 +236,6 @@ def summary_repr(obj, parts) -> str:
         return f"<{kind}>"
 
 
-def unit(v: np.ndarray) -> np.ndarray:
-    """v / |v| along the last axis."""
-    return v / np.linalg.norm(v, axis=-1, keepdims=True)
-
-
-def direction(v) -> np.ndarray | None:
-    """The unit vector along v, None for the zero vector; safe for any finite v
-    (scaled first, so that neither 1e300 nor 1e-300 over- or underflows)."""
-    v = np.asarray(v, dtype=float)
-    biggest = np.max(np.abs(v))
-    if not biggest > 0.0:
-        return None
-    v = v / biggest
-    return v / np.linalg.norm(v)
-
-
 def wheel_points(
     axle_inboard: np.ndarray, axle_outboard: np.ndarray, wheel: Wheel
 ) -> dict[str, np.ndarray]:
@@ -309,7 +283,7 @@ def load_geometry(source: str | Path | dict) -> Geometry:
     about a link near dead centre at design (docs/geometry.md, "Dead centres").
     """
     data, name, sha = load_yaml(source)
-    g = _parse(data, Reader(name), sha)
+    g = parse_geometry(data, Reader(name), sha)
     warn_implausible(g)
     warn_dead_centres(g)
     return g
@@ -362,7 +336,11 @@ def warn_outside(what: str, value: float, low: float, high: float, unit_text: st
         )
 
 
-def _parse(data: dict, r: Reader, sha: str | None) -> Geometry:
+def parse_geometry(data: dict, r: Reader, sha: str | None) -> Geometry:
+    """The Geometry of a geometry file's data (mm) already read, its errors through
+    ``r`` (naming the file and key); ``sha`` the file's hash. No plausibility
+    warnings: :func:`load_geometry` adds them, and an axle's corners or a study's
+    variants, read from data they hold, warn (or not) for themselves."""
     from . import mechanisms
 
     if isinstance(data, dict) and data.get("scope") != "axle":
@@ -726,7 +704,7 @@ def _unknown_point_hint(key: str, o: Options, names: tuple[str, ...]) -> str:
         return (
             "not a point of this corner (pushrod and rocker points need actuation pushrod_rocker)"
         )
-    if key in STEERING_POINTS["rack"] + STEERING_POINTS["none"]:
+    if key in mechanisms.STEERING_POINTS["rack"] + mechanisms.STEERING_POINTS["none"]:
         return f"not a point of a {o.type} corner (it has no trackrod or toe link)"
     for other in mechanisms.NAMES:
         if other != o.type and key in points(mechanisms.get(other), other):

@@ -446,7 +446,7 @@ def input_panels(results: list[ResultsFile], xname: str) -> list[Panel]:
                 rows = r["load_case"] == r["load_case"][0]
             who = r.label if len(results) > 1 and not r.forces else "_nolegend_"
             x, y = r[xname][rows], r[column][rows]
-            panel.lines.append((x, y, who, "-", "0.25" if r.forces else _colour(k), _lone(y)))
+            panel.lines.append((x, y, who, "-", "0.25" if r.forces else _colour(k), lone_marker(y)))
         out.append(panel)
     return out
 
@@ -660,10 +660,10 @@ def _axle_panel(results, title: str, names: tuple, xlabel: str, x) -> Panel:
 
 
 def _marker(r: ResultsFile, name: str) -> str | None:
-    return _lone(r[name])
+    return lone_marker(r[name])
 
 
-def _lone(y: np.ndarray) -> str | None:
+def lone_marker(y: np.ndarray) -> str | None:
     """A dot marker when some value has no finite neighbour (a line would not show it)."""
     finite = np.isfinite(y)
     lone = finite & ~np.r_[False, finite[:-1]] & ~np.r_[finite[1:], False]
@@ -724,7 +724,7 @@ def force_panels(results: list[ResultsFile], xname: str, xlabel: str) -> list[Pa
                 colour = f"C{cases.index(case) % 10}"
                 y = y_all[rows]
                 style = STYLES[k % len(STYLES)]
-                panel.lines.append((r[xname][rows], y, who, style, colour, _lone(y)))
+                panel.lines.append((r[xname][rows], y, who, style, colour, lone_marker(y)))
         if any(np.any(np.isfinite(line[1])) for line in panel.lines):
             out.append(panel)
     if not out:  # every step at a toggle or failed: the members' panels, empty, and the note

@@ -10,7 +10,7 @@
   deviation. Each panel notes the sampled and the predicted standard deviation.
 - DOE: the main effects on every summary column (the same grid): per variable
   the column's mean over the variants in each slice of its range
-  (``study.main_effects``), against the variable (mm from design). With more
+  (``study_summary.main_effects``), against the variable (mm from design). With more
   than ``TOP`` variables each panel shows the ``TOP`` largest effects (the
   spread of the means) and says so; the legend lists them largest first.
 - Optimise: a panel per objective term: the metric over the sweep for the
@@ -35,7 +35,8 @@ from matplotlib.patches import Patch
 
 from .errors import PinSuspError
 from .metrics import METRIC_BY_NAME, Derivative
-from .plots import _lone
+from .plots import lone_marker
+from .study_summary import main_effects
 
 TOP = 8  # main effects drawn per panel: the largest
 STATS = (
@@ -328,8 +329,6 @@ def _skew_right(x: np.ndarray) -> bool:
 
 
 def _main_effects(study, variants, heading: str) -> Figure:
-    from .study import main_effects
-
     rows = _summary_columns(study, variants)
     cols = max(len(r) for r in rows)
     names = study.names
@@ -479,7 +478,7 @@ def _curve_panel(ax, entry: dict) -> None:
         if target is not None:
             targets.append((x, np.asarray(target, dtype=float)))
             name += f", RMS miss {rms_miss(y, target):.3g} {unit}".rstrip()
-        ax.plot(x, y, "-", color=colour, lw=lw, marker=_lone(y), label=name, gid=which)
+        ax.plot(x, y, "-", color=colour, lw=lw, marker=lone_marker(y), label=name, gid=which)
     if targets:
         x = np.concatenate([t[0] for t in targets])
         t = np.concatenate([t[1] for t in targets])

@@ -15,7 +15,7 @@ import numpy as np
 
 from .errors import InputError
 from .geometry import direction
-from .yamlio import Reader, _short, load_yaml
+from .yamlio import Reader, load_yaml, short_repr
 
 # Memory a solved step holds while a sweep is held whole (configuration, tangents,
 # every column, the CSV's text), bytes: measured 12.5 KB on a 200 000-step sweep.
@@ -91,7 +91,7 @@ def load_sweep(source: str | Path | dict) -> Sweep:
         if isinstance(steps, float) and steps.is_integer():  # 1e3 written for 1000
             steps = int(steps)
         if isinstance(steps, bool) or not isinstance(steps, int) or steps < 1:
-            r.fail("steps", f"expected a whole number >= 1, got {_short(steps)}")
+            r.fail("steps", f"expected a whole number >= 1, got {short_repr(steps)}")
         _check_memory(steps, r)
     raw_targets = data["targets"]
     if not isinstance(raw_targets, list) or not raw_targets:

@@ -127,7 +127,7 @@ class Branches:
 
     def __init__(self, tree):
         from .closures import MEASURES, LoopBranch, chirality, pick_branch
-        from .deadcentre import _point_name
+        from .deadcentre import tree_point_name
 
         design = {name: p.tolist() for name, (_, p) in tree.points.items()}
         self.checks = []  # (what flipped, measure, four point names, sign at design)
@@ -144,7 +144,7 @@ class Branches:
         for b in tree.bodies:
             if b.joint is None:
                 continue
-            own = [_point_name(n, b.name, tree) for n in b.joint.defined_by]
+            own = [tree_point_name(n, b.name, tree) for n in b.joint.defined_by]
             names = list(dict.fromkeys([n for n in own if n in design] + on.get(b.name, [])))
             quads = list(itertools.combinations(names[:8], 4))
             if not quads:

@@ -75,7 +75,7 @@ class _Loader(yaml.SafeLoader):
             return super().construct_object(node, deep)
         except (ValueError, TypeError, AttributeError, OverflowError):
             kind = node.tag.rsplit(":", 1)[-1]
-            problem = f"cannot read {_short(node.value)} as {kind}"
+            problem = f"cannot read {short_repr(node.value)} as {kind}"
             raise yaml.constructor.ConstructorError(None, None, problem, node.start_mark) from None
 
     def construct_sequence(self, node, deep=False):
@@ -290,7 +290,7 @@ class Reader:
 
     def choice(self, value: Any, key: str, options: tuple[str, ...]) -> str:
         if not isinstance(value, str) or value not in options:
-            self.fail(key, f"expected one of {', '.join(options)}, got {_short(value)}")
+            self.fail(key, f"expected one of {', '.join(options)}, got {short_repr(value)}")
         return value
 
     def vector(self, value: Any, key: str, *, limit: float | None = None) -> np.ndarray:
@@ -324,15 +324,15 @@ def _kind(value: Any) -> str:
     if isinstance(value, bool):
         return f"a boolean ({value})"
     if isinstance(value, str):
-        return f"text {_short(value)}"
+        return f"text {short_repr(value)}"
     if isinstance(value, dict):
         return "a mapping"
     if isinstance(value, list):
         return "a list"
-    return f"{type(value).__name__} {_short(value)}"
+    return f"{type(value).__name__} {short_repr(value)}"
 
 
-def _short(value: Any) -> str:
+def short_repr(value: Any) -> str:
     """repr() cut to one readable line: hostile files hold megabyte strings."""
     text = repr(value)
     return text if len(text) <= 60 else text[:50] + "..." + text[-5:]

@@ -27,8 +27,10 @@ Each module has:
   links, point-on-line conditions.
 
 ``o`` is a :class:`pin_susp.geometry.Options` (steering, actuation, mount,
-spring, side); ``ps`` a :class:`pin_susp.metrics.PointSet`. Shared helpers
-for trees and visuals are below.
+spring, side); ``ps`` a :class:`pin_susp.metrics.PointSet`. Shared point
+names and helpers for trees and visuals are below. The mechanisms sit under the
+geometry reader (it asks them which points a file must have) and import nothing
+of it: their maths is :mod:`pin_susp.vectors`.
 """
 
 from __future__ import annotations
@@ -39,8 +41,16 @@ from types import ModuleType
 
 import numpy as np
 
-from ..geometry import unit
 from ..urdf import DAMPER, DENSITY, Joint, Spring, Visual
+from ..vectors import unit
+
+# Hardpoint names that more than one mechanism has (docs/geometry.md)
+STEERING_POINTS = {  # by config.steering.type
+    "rack": ("trackrod_inboard", "trackrod_outboard"),
+    "none": ("toe_link_inboard", "toe_link_outboard"),
+}
+AXLE_POINTS = ("axle_inboard", "axle_outboard")
+COILOVER_POINTS = ("strut_top", "strut_bottom")
 
 MATERIALS = {
     "chassis": (0.35, 0.35, 0.38, 1.0),

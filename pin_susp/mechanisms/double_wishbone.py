@@ -20,10 +20,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..geometry import COINCIDENT, STEERING_POINTS, unit
 from ..urdf import Body, Closure, Joint, Tree
+from ..vectors import COINCIDENT, unit
 from . import (
     MATERIALS,
+    STEERING_POINTS,
     Pointwise,
     axis_foot,
     pivot,

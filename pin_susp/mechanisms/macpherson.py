@@ -20,10 +20,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..geometry import AXLE_POINTS, STEERING_POINTS, unit
 from ..urdf import Body, Closure, Joint, Tree
+from ..vectors import unit
 from . import (
+    AXLE_POINTS,
     MATERIALS,
+    STEERING_POINTS,
     Pointwise,
     pivot,
     rack_joint,

@@ -24,10 +24,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..geometry import AXLE_POINTS, COILOVER_POINTS, STEERING_POINTS, unit
 from ..urdf import Body, Closure, Joint, Tree
+from ..vectors import unit
 from . import (
+    AXLE_POINTS,
+    COILOVER_POINTS,
     MATERIALS,
+    STEERING_POINTS,
     Pointwise,
     common_perpendicular_midpoint,
     rack_joint,

@@ -14,9 +14,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..geometry import AXLE_POINTS, COILOVER_POINTS
 from ..urdf import Body, Tree
 from . import (
+    AXLE_POINTS,
+    COILOVER_POINTS,
     MATERIALS,
     Pointwise,
     axis_foot,
