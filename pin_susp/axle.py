@@ -10,14 +10,20 @@ is parsed from the composed URDF like a corner's (:class:`linkage.Built`).
 from __future__ import annotations
 
 import copy
-import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pinocchio as pin
 
 from . import __version__
-from .closures import WORLD, ContactPatchPoint, JointTarget, PointTarget
+from .constraints import (
+    WORLD,
+    ContactPatchPoint,
+    HeaveTarget,
+    JointTarget,
+    PointTarget,
+    RollTarget,
+)
 from .corner import Results
 from .deadcentre import dead_centres, warn_dead_centres
 from .errors import InputError
@@ -756,90 +762,6 @@ def mirror_corner(corner: dict) -> dict:
 # ---------------------------------------------------------------- sweeps
 
 Z = np.array([0.0, 0.0, 1.0])
-
-
-class _FrameRow:
-    """A target row computed from frames' positions and Jacobians (``from_frames``),
-    so that the solver's batch reads each frame once for every row."""
-
-    size = 1
-
-    def residual(self, kin) -> np.ndarray:
-        return self.from_frames([p.position(kin) for p in self.frame_points])[0]
-
-    def jacobian(self, kin) -> np.ndarray:
-        P = [p.position(kin) for p in self.frame_points]
-        return self.from_frames(P, [p.jacobian(kin) for p in self.frame_points])[1]
-
-
-class HeaveTarget(_FrameRow):
-    """½(ΔWC_z,L + ΔWC_z,R) held at a value (m): 1 row."""
-
-    name = "target heave"
-
-    def __init__(self, left, right, design: float, value: float = 0.0):
-        self.frame_points = (left, right)
-        self.design, self.value = design, value
-
-    def from_frames(self, P, J=None) -> tuple:
-        r = np.array([0.5 * (P[0][2] + P[1][2]) - self.design - self.value])
-        return r, None if J is None else (0.5 * (J[0][2] + J[1][2]))[None]
-
-
-class RollTarget(_FrameRow):
-    """atan2(ΔWC_z,L − ΔWC_z,R, CP_y,L − CP_y,R) held at a value (rad): 1 row
-    (open-kinematics' roll: + = the left wheel higher relative to the chassis)."""
-
-    name = "target roll"
-    angular = True  # from_frames gets the wheel centres' placements and 6-row Jacobians
-
-    def __init__(self, wheels, radii, kin, design: float, value: float = 0.0, spin=None):
-        self.frame_points = tuple(wheels)  # (left, right) wheel centres
-        self.radii = radii
-        self.design, self.value = design, value  # design: ΔWC_z,L − ΔWC_z,R offset (m)
-        # each spin axis AI → AO in its wheel-centre frame (it turns with the upright)
-        self.spin = [
-            kin.data.oMf[w.frame_id].rotation.T @ a for w, a in zip(wheels, spin, strict=True)
-        ]
-
-    def residual(self, kin) -> np.ndarray:
-        return self.from_frames([kin.data.oMf[p.frame_id] for p in self.frame_points])[0]
-
-    def jacobian(self, kin) -> np.ndarray:
-        placements = [kin.data.oMf[p.frame_id] for p in self.frame_points]
-        return self.from_frames(
-            placements, [kin.frame_jacobian(p.frame_id) for p in self.frame_points]
-        )[1]
-
-    def from_frames(self, M, J=None) -> tuple:
-        """From the wheel centres' placements M and Jacobians J (6 rows). A hot path: a
-        contact patch's y alone, in closed form — with â the spin axis and
-        s = √(1 − a_z²), CP_y = WC_y + R·a_z·a_y/s (ContactPatchPoint's d̂ = unit(a_z·â −
-        Ẑ), its y row), and â turning with the upright, dâ = ω × â, so
-        dCP_y = dWC_y + R·((a_z/s)·da_y + (a_y/s³)·da_z): a fixed combination of the
-        wheel-centre frame's Jacobian rows, and so is the row's."""
-        y, z, c = [0.0, 0.0], [0.0, 0.0], [None, None]
-        for k in (0, 1):  # Python floats: numpy's scalars cost more than the arithmetic
-            ax, ay, az = (M[k].rotation @ self.spin[k]).tolist()
-            _, wy, z[k] = M[k].translation.tolist()
-            s = math.sqrt(1.0 - az * az)
-            R = self.radii[k]
-            y[k] = wy + R * az * ay / s
-            # dCP_y = row 1 + R·(c_x ω_x + c_y ω_y + c_z ω_z), da = ω × â
-            c[k] = (R * (ay * ay / s**3 - az * az / s), -R * ax * ay / s**3, R * az * ax / s)
-        a = z[0] - z[1] - self.design
-        b = y[0] - y[1]
-        r = np.array([math.atan2(a, b) - self.value])
-        if J is None:
-            return r, None
-        # d atan2(a, b) = (b·da − a·db)/(a² + b²): one row of weights per wheel centre
-        scale = 1.0 / (a * a + b * b)
-        rise, k = b * scale, a * scale
-        (lx, ly, lz), (rx, ry, rz) = c
-        w = np.array(
-            [[0.0, -k, rise, -k * lx, -k * ly, -k * lz], [0.0, k, -rise, k * rx, k * ry, k * rz]]
-        )
-        return r, (w[0] @ J[0] + w[1] @ J[1])[None]
 
 
 def axle_rows(model: AxleModel, targets, source: str = "<targets>") -> list:

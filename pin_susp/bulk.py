@@ -23,8 +23,8 @@ Each step must meet the same tolerance and stay on every loop's design
 branch; if any step does not, the sweep is solved step by step instead
 (solver.march), so a difficult sweep is never worse off than before.
 Only joints with one degree of freedom (revolute or prismatic, aligned or
-not) and rows of the common kinds (ball and distance closures, targets on
-frame points, held joints) are handled here; anything else goes step by step.
+not) are handled here (a model with another kind goes step by step); every row
+kind has its batched form (constraints/: Row.fill_many), stacked by ``Rows``.
 """
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from .closures import BallClosure, DistanceClosure, FramePoint, JointTarget, PointTarget
+from .constraints import ManyFrames
 from .jet import cross
 
 # A sweep shorter than this is marched step by step (the coarse pass would be most of it).
@@ -135,6 +135,15 @@ class Tree:
             J[:, :, vs] = a[ks].transpose(1, 2, 0)
         return J
 
+    def angular_jacobian(self, joint: int, a: np.ndarray) -> np.ndarray:
+        """d(ω)/dv (n, 3, nv) of ``joint``'s body: the axes of the revolute joints among
+        its supports."""
+        J = np.zeros((a.shape[1], 3, self.nv))
+        ks, vs = self._moves[joint][0]
+        if ks:
+            J[:, :, vs] = a[ks].transpose(1, 2, 0)
+        return J
+
     def twist_jacobian(self, joint: int, o: np.ndarray, a: np.ndarray) -> np.ndarray:
         """The joint frame's LOCAL_WORLD_ALIGNED Jacobian (n, 6, nv): the velocity of its
         origin, then its angular velocity."""
@@ -214,6 +223,7 @@ class Frames:
         self.ids = list(frame_ids)
         self.joint = [model.frames[f].parentJoint for f in self.ids]
         self.offset = [model.frames[f].placement.translation.copy() for f in self.ids]
+        self.turn = [model.frames[f].placement.rotation.copy() for f in self.ids]
 
     def evaluate(self, q: np.ndarray, jacobians: bool = True, placed=None):
         """Positions (list of (n, 3)) and Jacobians (list of (n, 3, nv), or None);
@@ -230,6 +240,14 @@ class Frames:
         """Each frame's position (n, 3) from the joints' placements (Tree.placements)."""
         return [o[j] + _apply(R[j], x) for j, x in zip(self.joint, self.offset, strict=True)]
 
+    def rotations(self, R: np.ndarray) -> list[np.ndarray]:
+        """Each frame's world rotation (n, 3, 3) from the joints' (Tree.placements)."""
+        return [_times(R[j], t) for j, t in zip(self.joint, self.turn, strict=True)]
+
+    def angular_jacobians(self, a: np.ndarray) -> list[np.ndarray]:
+        """Each frame's angular Jacobian rows (n, 3, nv): its joint's (Tree.axes: a)."""
+        return [self.tree.angular_jacobian(j, a) for j in self.joint]
+
     def motion(self, P: list, o: np.ndarray, state) -> tuple[list, list]:
         """Each frame's velocity and classical acceleration (n, 3) in a Tree.motion state."""
         out = [point_motion(j, p, o, state) for j, p in zip(self.joint, P, strict=True)]
@@ -237,96 +255,65 @@ class Frames:
 
 
 class Rows:
-    """A solver's stacked rows (closures, then one row per target) for many steps."""
+    """A solver's stacked rows (closures, then one row per target) for many steps: each
+    row's batched form (Row.fill_many) on the frames it names, every frame evaluated
+    once for all rows. Knows no row kind."""
 
     def __init__(self, tree: Tree, rows: list, ntargets: int):
         self.tree = tree
-        self.supported = tree.supported
+        self.supported = tree.supported and all(row.batched for row in rows)
         frames: list[int] = []
-
-        def frame(point) -> int:
-            if point.frame_id not in frames:
-                frames.append(point.frame_id)
-            return frames.index(point.frame_id)
-
-        self.items = []
+        self.items = []  # (row, its frames' indices, its first row)
         i = 0
         for row in rows:
-            if isinstance(row, BallClosure) and _framed(row.a, row.b):
-                self.items.append(("ball", i, frame(row.a), frame(row.b), None))
-            elif isinstance(row, DistanceClosure) and _framed(row.a, row.b):
-                self.items.append(("distance", i, frame(row.a), frame(row.b), row.length))
-            elif isinstance(row, PointTarget) and _framed(row.point):
-                self.items.append(("target", i, frame(row.point), None, row.direction.copy()))
-            elif isinstance(row, JointTarget):
-                self.items.append(("joint", i, row.index_q, row.index_v, None))
-            else:
-                self.supported = False
+            k = []
+            for point in row.frames:
+                if point.frame_id not in frames:
+                    frames.append(point.frame_id)
+                k.append(frames.index(point.frame_id))
+            self.items.append((row, tuple(k), i))
             i += row.size
         self.nrows = i
         self.first_target = i - ntargets
+        self.angular = any(row.angular for row in rows)
         self.frames = Frames(tree, frames)
+
+    def _at(self, q, P, Jp, R) -> ManyFrames:
+        """The frames' data for the rows (rotations and angular Jacobians if any row
+        reads them); R: the joints' world rotations (Tree.placements)."""
+        rotations = angular = None
+        if self.angular:
+            rotations = self.frames.rotations(R)
+            if Jp is not None:
+                angular = self.frames.angular_jacobians(self.tree.axes(R))
+        return ManyFrames(P, Jp, rotations, angular, q, self.tree.nv)
 
     def evaluate(self, q: np.ndarray, values: np.ndarray, jacobian: bool = True, placed=None):
         """Residuals (n, nrows) and Jacobians (n, nrows, nv) at q (n, nq) with the target
         values (n, ntargets); a target row's value is its column of ``values``;
         ``placed``: Tree.placements(q) when the caller has it already."""
         n = q.shape[0]
-        P, Jf = self.frames.evaluate(q, jacobian, placed)
+        placed = self.tree.placements(q) if placed is None else placed
+        P, Jp = self.frames.evaluate(q, jacobian, placed)
+        at = self._at(q, P, Jp, placed[0])
         r = np.empty((n, self.nrows))
         J = np.zeros((n, self.nrows, self.tree.nv)) if jacobian else None
-        for kind, i, a, b, extra in self.items:
-            if kind == "ball":
-                r[:, i : i + 3] = P[b] - P[a]
-                if jacobian:
-                    J[:, i : i + 3] = Jf[b] - Jf[a]
-            elif kind == "distance":
-                d = P[b] - P[a]
-                length = np.sqrt(np.einsum("ni,ni->n", d, d))
-                r[:, i] = length - extra
-                if jacobian:
-                    J[:, i] = np.einsum("ni,niv->nv", d / length[:, None], Jf[b] - Jf[a])
-            elif kind == "target":
-                value = values[:, i - self.first_target]
-                r[:, i] = P[a] @ extra - value
-                if jacobian:
-                    J[:, i] = np.einsum("i,niv->nv", extra, Jf[a])
-            else:  # a held joint: a is its index in q, b in v
-                r[:, i] = q[:, a] - values[:, i - self.first_target]
-                if jacobian:
-                    J[:, i, b] = 1.0
+        first = self.first_target
+        for row, k, i in self.items:
+            value = values[:, i - first] if i >= first else None
+            row.fill_many(at, k, value, r, J, i)
         return r, J
 
     def second(self, R, o, P, state, qdd: np.ndarray) -> np.ndarray:
         """Every row's second time derivative (n, nrows) in a Tree.motion state (at q with
         velocity q̇ and acceleration ``qdd``; P: the frames' positions): with q̈ = 0, the
-        drift J̇·q̇ of the second-order closure solve J·q̈ = −J̇·q̇."""
+        drift J̇·q̇ of the second-order closure solve J·q̈ = −J̇·q̇ (Row.drift_many)."""
         V, A = self.frames.motion(P, o, state)
+        at = self._at(None, P, None, R)
         out = np.empty((len(qdd), self.nrows))
-        for kind, i, a, b, extra in self.items:
-            if kind == "ball":
-                out[:, i : i + 3] = A[b] - A[a]
-            elif kind == "distance":
-                out[:, i] = length_rates(P[b] - P[a], V[b] - V[a], A[b] - A[a])[2]
-            elif kind == "target":
-                out[:, i] = A[a] @ extra
-            else:
-                out[:, i] = qdd[:, b]
+        for row, k, i in self.items:
+            row.drift_many(at, k, V, A, qdd, out, i)
         return out
-
-
-def length_rates(d: np.ndarray, dv: np.ndarray, da: np.ndarray) -> tuple:
-    """|d| and its first and second time derivatives (each (n,)) from d, d′, d″ (n, 3):
-    |d|′ = u·d′ and |d|″ = u·d″ + (|d′|² − (u·d′)²)/|d|, u = d/|d|."""
-    length = np.sqrt(np.einsum("ni,ni->n", d, d))
-    u = d / length[:, None]
-    along = np.einsum("ni,ni->n", u, dv)
-    second = np.einsum("ni,ni->n", u, da) + (np.einsum("ni,ni->n", dv, dv) - along * along) / length
-    return length, along, second
-
-
-def _framed(*points) -> bool:
-    return all(type(p) is FramePoint for p in points)
 
 
 def solve_sweep(solver, values: np.ndarray, q: np.ndarray, previous: np.ndarray, progress=None):
@@ -460,37 +447,10 @@ def solve_all(J: np.ndarray, rhs: np.ndarray) -> np.ndarray | None:
 
 
 def _on_branches(solver, qs: np.ndarray) -> bool:
-    """Every step on every loop's design assembly (closures.BranchGuard, for all steps)."""
+    """Every step on every loop's design assembly (constraints.BranchGuard, all steps)."""
     guard = solver.branches
     if not guard.loops:
         return True
-    ids = sorted({p.frame_id for loop in guard.loops for p in loop.points})
-    frames = Frames(solver.bulk.tree, ids)
-    P, _ = frames.evaluate(qs, jacobians=False)
-    at = dict(zip(ids, P, strict=True))
-    for loop in guard.loops:
-        points = [at[p.frame_id] for p in loop.points]
-        if np.any(MEASURES[loop.measure.__name__](*points) * loop.sign <= 0.0):
-            return False
-    return True
-
-
-def chirality(a, b, c, d) -> np.ndarray:
-    """closures.chirality for arrays of points (n, 3)."""
-    u, v, w = b - a, c - a, d - a
-    det = np.einsum("ni,ni->n", u, cross(v, w))
-    scale = np.sqrt(
-        np.einsum("ni,ni->n", u, u) * np.einsum("ni,ni->n", v, v) * np.einsum("ni,ni->n", w, w)
-    )
-    return np.where(scale > 0.0, det / np.where(scale > 0.0, scale, 1.0), 0.0)
-
-
-def alignment(a, b, c, d) -> np.ndarray:
-    """closures.alignment for arrays of points (n, 3)."""
-    u, w = b - a, d - c
-    scale = np.sqrt(np.einsum("ni,ni->n", u, u) * np.einsum("ni,ni->n", w, w))
-    dot = np.einsum("ni,ni->n", u, w)
-    return np.where(scale > 0.0, dot / np.where(scale > 0.0, scale, 1.0), 0.0)
-
-
-MEASURES = {"chirality": chirality, "alignment": alignment}
+    ids = guard.frame_ids
+    P, _ = Frames(solver.bulk.tree, ids).evaluate(qs, jacobians=False)
+    return guard.holds_many(dict(zip(ids, P, strict=True)))

@@ -12,7 +12,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from .closures import PointTarget
+from .constraints import PointTarget
 from .errors import InputError
 from .geometry import Geometry, load_geometry, summary_repr, warn_outside
 from .linkage import Linkage

@@ -18,7 +18,7 @@ import pinocchio as pin
 
 from . import __version__
 from .bulk import solve_all
-from .closures import (
+from .constraints import (
     BallClosure,
     ContactPatchPoint,
     DistanceClosure,

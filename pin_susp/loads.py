@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from .closures import BallClosure, DistanceClosure, JointTarget
+from .constraints import BallClosure, BarTwist, DistanceClosure, JointTarget, RockerTurn
 from .errors import PinSuspError, PlausibilityWarning
 from .solver import NewtonSolver
 from .sweep import Sweep
@@ -290,7 +290,7 @@ class Statics:
                 held.append(DistanceClosure(f"{prefix}spring", top, bottom, 0.0))
                 stiffness = None if g.spring_rate is None else g.spring_rate * 1e3  # N/m
             else:  # a torsion bar: the rocker's turn about its axis
-                turn = _RockerTurn(subject, prefix)
+                turn = RockerTurn(subject, prefix)
                 # + resisting bump, as the sweep's spring_torque: bump turns the rocker
                 # about a→b in the sense s·spring_sense (motion_ratio > 0 at design)
                 sense = subject.spring_sense[side] if self.axle else subject.spring_sense
@@ -305,7 +305,7 @@ class Statics:
                 if bar.anti_roll == "u_bar"
                 else ["t_bar_pivot_b"]
             )
-            held.append(_Twist(self.model, joints))
+            held.append(BarTwist(self.model, joints))
             k = bar.anti_roll_stiffness
             compliance.append(None if k is None else k * 180 / np.pi)  # N·m/rad
         if "rack_slide" in [self.model.names[j] for j in range(self.model.njoints)]:
@@ -354,10 +354,10 @@ class Statics:
                 self.ends += [(col, 1, row.b, 1.0, row.a), (col, 1, row.a, -1.0, row.b)]
                 spring = row.name.endswith("spring")  # compression +, a link's tension +
                 self.direct.append((f"force_{row.name}", col, 1, 1.0 if spring else -1.0))
-            elif isinstance(row, _RockerTurn):
+            elif isinstance(row, RockerTurn):
                 self.couples.append((col, row))
                 self.direct.append((f"torque_{row.prefix}spring", col, 1, row.resisting))
-            elif isinstance(row, _Twist):
+            elif isinstance(row, BarTwist):
                 self.direct.append(("torque_arb", col, 1, 1.0))
             else:  # the rack, held by the steering: the trackrods' pull on it is −λ
                 self.direct.append(("force_rack", col, 1, -1.0))
@@ -712,47 +712,6 @@ def _xyz(name: str) -> list[str]:
     return [f"{name}_{a}" for a in "xyz"]
 
 
-class _RockerTurn:
-    """A torsion bar's row: the rocker's turn about its axis a→b (rad per dq)."""
-
-    size = 1
-
-    def __init__(self, subject, prefix: str = ""):
-        self.subject, self.prefix = subject, prefix
-        self.name = f"{prefix}spring"
-        self.point = subject.points[f"{prefix}pushrod_inboard"]  # any frame on the rocker
-
-    def residual(self, kin) -> np.ndarray:  # a held row: only its Jacobian counts
-        return np.zeros(1)
-
-    def axis(self, kin) -> np.ndarray:
-        p, prefix = self.subject.points, self.prefix
-        a, b = p[f"{prefix}rocker_axis_a"].position(kin), p[f"{prefix}rocker_axis_b"].position(kin)
-        return (b - a) / np.linalg.norm(b - a)
-
-    def jacobian(self, kin) -> np.ndarray:
-        return (self.axis(kin) @ kin.frame_jacobian(self.point.frame_id)[3:])[None]
-
-
-class _Twist:
-    """An anti-roll bar's twist row (rad per dq): a U-bar's left arm's turn minus the
-    right's (both about the bar's axis), a T-bar's crossbar turn about its stem."""
-
-    size = 1
-    name = "arb"
-
-    def __init__(self, model, joints: list[str]):
-        self.row = np.zeros((1, model.nv))
-        for sign, joint in zip((1.0, -1.0), joints, strict=False):
-            self.row[0, model.joints[model.getJointId(joint)].idx_v] = sign
-
-    def residual(self, kin) -> np.ndarray:
-        return np.zeros(1)
-
-    def jacobian(self, kin) -> np.ndarray:
-        return self.row
-
-
 def _at(side: str, point: str) -> str:
     return f"{side}_{point}" if side else point
 
@@ -802,7 +761,7 @@ class SpringRates:
         self.solver = corner._drive  # closures + hub z (+ the rack held)
         self.torsion = g.spring == "torsion_bar"
         if self.torsion:
-            self.turn = _RockerTurn(corner)
+            self.turn = RockerTurn(corner)
             self.sense = 1.0
             self.sense = 1.0 if self.derivatives(corner.q_design)[1] >= 0.0 else -1.0
         else:
@@ -866,7 +825,8 @@ class SpringRates:
         """``derivatives`` for every configuration at once, on the model's tree (bulk.py):
         arrays (x, ẋ, ẍ) with NaN where q is None; None where the tree or the rows are
         not of the kinds handled there (then each is computed by ``derivatives``)."""
-        from .bulk import Frames, length_rates, solve_all
+        from .bulk import Frames, solve_all
+        from .constraints import length_rates
 
         tree, rows = self.corner.kin.tree, self.solver.bulk
         if not (tree.supported and rows.supported and rows.nrows == self.model.nv):

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from .closures import (
+from .constraints import (
     BallClosure,
     ContactPatchPoint,
     DistanceClosure,

@@ -25,7 +25,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import pinocchio as pin
 
-from .closures import (
+from .constraints import (
     MEASURES,
     DistanceClosure,
     JointTarget,

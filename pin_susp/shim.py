@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from .closures import DistanceClosure, FaceAlignment, FramePoint, Kinematics, ShimGap
+from .constraints import DistanceClosure, FaceAlignment, FramePoint, Kinematics, ShimGap
 from .errors import InputError
 from .geometry import Geometry, unit
 from .mechanisms.double_wishbone import upright_mounts

@@ -10,12 +10,10 @@ least-squares step instead, with λ = μ·|r|² so that convergence stays
 quadratic near the solution. A step that does not converge is retried as
 two half steps (continuation) before it is reported as failed.
 
-Speed: rows of the common kinds (ball and distance closures, targets on
-frame points, held joints) are evaluated together — one Pinocchio call per
-frame they need, numpy on stacked arrays — and the small square system goes
-to LAPACK's gesv (numpy.linalg.solve). Other rows (the shim's, a contact-patch target)
-take their own ``residual``/``jacobian``, or are computed from their frames
-(``from_frames``: an axle's heave and roll). A sweep (``march``) also predicts each step
+Speed: every row (constraints/, one kind per module) is evaluated by its fast
+form (``Row.fill``) from the frames it names — one Pinocchio call per frame the
+rows need, read once for all of them — and the small square system goes to
+LAPACK's gesv (numpy.linalg.solve). A sweep (``march``) also predicts each step
 from the last two solutions and the tangent (see ``predict``), so that one
 Newton iteration usually suffices. A long sweep can instead be solved for all its
 steps at once (``march(..., bulk=True)``, see bulk.py): this march on a coarse
@@ -31,16 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from .closures import (
-    WORLD,
-    BallClosure,
-    BranchGuard,
-    DistanceClosure,
-    FramePoint,
-    JointTarget,
-    Kinematics,
-    PointTarget,
-)
+from .constraints import WORLD, BranchGuard, Kinematics, StepFrames
 
 try:  # numpy's LAPACK gesv kernels: one right-hand side, several (see _solve)
     from numpy.linalg import _umath_linalg
@@ -82,7 +71,7 @@ class Solution:
 class NewtonSolver:
     """Solves r(q) = 0 for the stacked rows of ``closures`` and ``targets``.
 
-    ``branches`` (closures.LoopBranch): a converged pose off the design
+    ``branches`` (constraints.LoopBranch): a converged pose off the design
     assembly of any of these loops is refused — not converged, ``branch``
     naming the loop — so that continuation halves the step and retries.
     """
@@ -120,10 +109,6 @@ class NewtonSolver:
         else:
             self.kin.update_positions(q)
         self.batch.fill(self.kin, q, self.residual, self.jacobian if jacobian else None)
-        for i, row in self.batch.others:
-            self.residual[i : i + row.size] = row.residual(self.kin)
-            if jacobian:
-                self.jacobian[i : i + row.size] = row.jacobian(self.kin)
 
     def tangent(self, rhs: np.ndarray | None = None) -> np.ndarray:
         """dq per unit of each target value, at the last evaluated state: J·T = [0; I]
@@ -365,98 +350,49 @@ class Predictor:
 
 
 class _Batch:
-    """The rows of common kinds, evaluated from each needed frame read once.
+    """The rows' fast forms (Row.fill), each frame they read fetched once per evaluation.
 
     With a handful of rows, plain per-row numpy beats stacking and fancy
     indexing (tried: slower): the cost is numpy's and the bindings' per-call
     overhead, so every row does as few calls as it can (an axis-aligned
-    target reads one coordinate).
+    target reads one coordinate). The batch knows no row kind: each row names its
+    frames (``frames``) and whether it reads their rotations (``angular``).
     """
 
     def __init__(self, model: pin.Model, rows: list):
         self.model = model
         self.frames: list[int] = []
         index = {}
-
-        def frame(point) -> int:
-            if point.frame_id not in index:
-                index[point.frame_id] = len(self.frames)
-                self.frames.append(point.frame_id)
-            return index[point.frame_id]
-
-        self.balls, self.distances, self.targets, self.joints = [], [], [], []
-        self.composite, self.others = [], []  # rows of frames' positions and Jacobians
+        self.rows = []  # (row, its frames' indices in self.frames, its first row)
         i = 0
         for row in rows:
-            if isinstance(row, BallClosure) and _framed(row.a, row.b):
-                self.balls.append((slice(i, i + 3), frame(row.a), frame(row.b)))
-            elif isinstance(row, DistanceClosure) and _framed(row.a, row.b):
-                self.distances.append((i, frame(row.a), frame(row.b), row))
-            elif isinstance(row, PointTarget) and _framed(row.point):
-                d = row.direction
-                axis = int(np.argmax(np.abs(d))) if np.count_nonzero(d) == 1 else None
-                self.targets.append((i, frame(row.point), d, axis, row))
-            elif isinstance(row, JointTarget):
-                self.joints.append((i, row.index_q, row))
-            elif hasattr(row, "from_frames") and _framed(*row.frame_points):
-                frames = [frame(p) for p in row.frame_points]
-                self.composite.append((i, row, frames, getattr(row, "angular", False)))
-            else:
-                self.others.append((i, row))
+            k = []
+            for point in row.frames:
+                if point.frame_id not in index:
+                    index[point.frame_id] = len(self.frames)
+                    self.frames.append(point.frame_id)
+                k.append(index[point.frame_id])
+            self.rows.append((row, tuple(k), i))
             i += row.size
+        self.angular = any(row.angular for row in rows)
         self.fixed = [model.frames[f].parentJoint == 0 for f in self.frames]
         self.zero6 = np.zeros((6, model.nv))
-        self.zero = self.zero6[:3]
+        self.at = StepFrames(self.fixed)
 
     def fill(self, kin: Kinematics, q: np.ndarray, r: np.ndarray, J: np.ndarray | None) -> None:
         """Residual rows, and their Jacobian rows unless J is None."""
-        model, data = self.model, kin.data
+        model, data, at = self.model, kin.data, self.at
         oMf = data.oMf
-        P = [oMf[f].translation for f in self.frames]  # fresh arrays: no copy needed
+        at.q, at.kin = q, kin
+        at.P = [oMf[f].translation for f in self.frames]  # fresh arrays: no copy needed
+        if self.angular:
+            at.M = [oMf[f] for f in self.frames]
         if J is not None:  # a frame on the chassis does not move: its Jacobian is zero
             J6 = [
                 self.zero6 if fixed else pin.getFrameJacobian(model, data, f, WORLD)
                 for f, fixed in zip(self.frames, self.fixed, strict=True)
             ]
-            Jf = [j[:3] for j in J6]
-        for rows, a, b in self.balls:
-            r[rows] = P[b] - P[a]
-            if J is not None:
-                J[rows] = Jf[b] - Jf[a]
-        fixed = self.fixed
-        for i, a, b, row in self.distances:
-            d = P[b] - P[a]
-            n = math.sqrt(d @ d)
-            r[i] = n - row.length
-            if J is not None:  # an end on the chassis adds nothing to the row
-                J[i] = (d / n) @ (Jf[b] if fixed[a] else Jf[b] - Jf[a] if not fixed[b] else -Jf[a])
-        for i, f, d, axis, row in self.targets:
-            if axis is None:
-                r[i] = d @ P[f] - row.value
-                if J is not None:
-                    J[i] = d @ Jf[f]
-            else:
-                r[i] = d[axis] * P[f][axis] - row.value
-                if J is not None:
-                    J[i] = d[axis] * Jf[f][axis]
-        for i, k, row in self.joints:
-            r[i] = q[k] - row.value
-            if J is not None:
-                J[i] = row.row[0]
-        for i, row, frames, angular in self.composite:
-            if angular:  # the frames' placements and 6-row Jacobians (with ω)
-                value, jacobian = row.from_frames(
-                    [oMf[self.frames[k]] for k in frames],
-                    None if J is None else [J6[k] for k in frames],
-                )
-            else:
-                value, jacobian = row.from_frames(
-                    [P[k] for k in frames], None if J is None else [Jf[k] for k in frames]
-                )
-            r[i : i + row.size] = value
-            if J is not None:
-                J[i : i + row.size] = jacobian
-
-
-def _framed(*points) -> bool:
-    return all(type(p) is FramePoint for p in points)
+            at.J6 = J6
+            at.Jp = [j[:3] for j in J6]
+        for row, k, i in self.rows:
+            row.fill(at, k, r, J, i)

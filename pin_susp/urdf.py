@@ -114,7 +114,7 @@ class Closure:
     anchors: tuple[tuple[str, np.ndarray], tuple[str, np.ndarray]]
     points: tuple[str, str] = ()  # the named points the anchors sit at
     # Four named points whose chirality tells this loop's two assemblies apart
-    # (closures.LoopBranch): the pose keeps the sign it has at design. With
+    # (constraints.LoopBranch): the pose keeps the sign it has at design. With
     # branch_kind "alignment": the sign of (b − a)·(d − c) instead.
     branch: tuple[str, str, str, str] | tuple[()] = ()
     branch_kind: str = "chirality"
@@ -125,7 +125,7 @@ class Closure:
 
     @property
     def branch_candidates(self) -> list[tuple[str, ...]]:
-        """The branch's point sets in order of preference (closures.pick_branch)."""
+        """The branch's point sets in order of preference (constraints.pick_branch)."""
         return [b for b in (self.branch, self.branch_fallback) if b]
 
 

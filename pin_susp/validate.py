@@ -40,7 +40,7 @@ from .axle import (
     solve_axle_sweep,
     target_values,
 )
-from .closures import ContactPatchPoint
+from .constraints import ContactPatchPoint
 from .errors import PinSuspError
 from .jet import Dual
 from .jet import value as plain
@@ -121,12 +121,12 @@ def compare(
 class Branches:
     """pin_susp's assembly at design, to tell an engine's pose on another branch of the
     mechanism: each loop's side (the chirality of its closure's branch points, which
-    pin_susp's solver keeps, closures.LoopBranch) and each body's handedness (four of
+    pin_susp's solver keeps, constraints.LoopBranch) and each body's handedness (four of
     its points, its joint's among them: a rigid body turns but is never mirrored — a
     point-based solve, which only keeps distances, can mirror one)."""
 
     def __init__(self, tree):
-        from .closures import MEASURES, LoopBranch, chirality, pick_branch
+        from .constraints import MEASURES, LoopBranch, chirality, pick_branch
         from .deadcentre import tree_point_name
 
         design = {name: p.tolist() for name, (_, p) in tree.points.items()}

@@ -831,7 +831,8 @@ def test_sensitivity_says_what_it_does_not_cover(tmp_path, capsys):
 def test_the_roll_rows_jacobian_is_its_residuals_derivative(tmp_path):
     """The roll target's row (closed form, from the wheel centres' frames) against
     central differences of its residual along random configuration directions."""
-    from pin_susp.axle import RollTarget, axle_rows
+    from pin_susp.axle import axle_rows
+    from pin_susp.constraints import RollTarget
 
     model = AxleModel(load_axle(axle_file(tmp_path)))
     (roll,) = [r for r in axle_rows(model, roll_sweep().targets) if isinstance(r, RollTarget)]

@@ -182,11 +182,11 @@ def test_a_branch_flip_inside_a_coarse_segment_is_refused():
 
 
 def test_vectorised_branch_measures_match_the_scalar_ones():
-    from pin_susp.closures import alignment, chirality
+    from pin_susp.constraints import alignment, alignment_many, chirality, chirality_many
 
     rng = np.random.default_rng(3)
     points = rng.normal(size=(4, 50, 3))
-    for mine, theirs in ((bulk.chirality, chirality), (bulk.alignment, alignment)):
+    for mine, theirs in ((chirality_many, chirality), (alignment_many, alignment)):
         values = mine(*points)
         for n in range(50):
             assert values[n] == pytest.approx(theirs(*(p[n].tolist() for p in points)), abs=1e-15)

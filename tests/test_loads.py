@@ -7,7 +7,7 @@ import pytest
 from conftest import EXAMPLES
 
 import pin_susp
-from pin_susp.closures import DistanceClosure, JointTarget
+from pin_susp.constraints import DistanceClosure, JointTarget, Row
 from pin_susp.errors import InputError, PinSuspError
 from pin_susp.loads import LoadCase, Statics, load_cases
 from pin_susp.solver import NewtonSolver
@@ -100,7 +100,7 @@ def test_virtual_work_of_a_member_lengthened_is_its_tension(rocker):
 def _held(spring, corner, q):
     """The spring's length held at its value at q (a target row)."""
 
-    class Length:
+    class Length(Row):
         size, name = 1, "spring length"
 
         def __init__(self):

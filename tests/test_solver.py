@@ -8,7 +8,7 @@ from conftest import EXAMPLES, example
 from pointwise import PointwiseCorner, spec_metrics
 
 import pin_susp
-from pin_susp.closures import PointTarget
+from pin_susp.constraints import PointTarget
 
 
 def test_bump_steer_sweep_matches_pointwise_formulation(corner):

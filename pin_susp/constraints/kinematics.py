@@ -1,0 +1,41 @@
+"""The state every row reads: a Pinocchio model and its data at one configuration."""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+WORLD = pin.LOCAL_WORLD_ALIGNED
+
+
+class Kinematics:
+    """Pinocchio model + data; ``update(q)`` computes every frame and Jacobian."""
+
+    def __init__(self, model: pin.Model):
+        self.model = model
+        self.data = model.createData()
+        self._tree = None
+
+    @property
+    def tree(self):
+        """The model's tree as arrays, for many configurations at once (bulk.Tree)."""
+        if self._tree is None:
+            from ..bulk import Tree
+
+            self._tree = Tree(self.model)
+        return self._tree
+
+    def update(self, q: np.ndarray) -> None:
+        self.q = q
+        pin.computeJointJacobians(self.model, self.data, q)
+        pin.updateFramePlacements(self.model, self.data)
+
+    def update_positions(self, q: np.ndarray) -> None:
+        """Frame placements only (no Jacobians): enough for residuals."""
+        self.q = q
+        pin.framesForwardKinematics(self.model, self.data, q)
+
+    def frame_jacobian(self, frame_id: int) -> np.ndarray:
+        """6×nv: linear velocity of the frame origin, then angular velocity, world axes.
+        (Pinocchio returns a 6-vector when nv = 1: reshaped.)"""
+        return pin.getFrameJacobian(self.model, self.data, frame_id, WORLD).reshape(6, -1)
