@@ -234,12 +234,12 @@ def long_sweep(rounds: int, steps: int, baseline_steps: int) -> dict:
     import tempfile
 
     import pin_susp.corner
-    from pin_susp import solver
+    from pin_susp import march as marching
     from pin_susp.export import csv_text, write_parquet
 
     corner = pin_susp.Corner(EXAMPLES / "double_wishbone.yaml")
     sweep = issue_sweep(steps)
-    march = solver.march
+    march = marching.march
 
     def step_by_step():
         pin_susp.corner.march = lambda *a, **k: march(*a, **{**k, "bulk": False})

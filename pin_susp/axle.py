@@ -29,8 +29,9 @@ from .deadcentre import dead_centres, warn_dead_centres
 from .errors import InputError
 from .geometry import DERIVED_POINTS, MM, Geometry, summary_repr, unit
 from .linkage import RACK_HELD, Built, FrameMotion, Linkage, closure_row
+from .march import march
 from .mechanisms import axis_foot, xml_name
-from .solver import NewtonSolver, march
+from .solver import NewtonSolver
 from .sweep import Target, check_held
 from .urdf import Body, Closure, Joint, Tree, Visual
 from .yamlio import Reader, load_yaml
@@ -1014,7 +1015,7 @@ def _motion(model: AxleModel, qs: list, solutions: list | None = None) -> dict:
     solver = NewtonSolver(model.kin, model.closures, drive, model.branches)
     # each side's columns: its hub z, then the rack, or its fixed toe link's length (the
     # steer of a toe-link corner: a column of 1 on that closure's row, as Linkage's)
-    rhs, columns = solver._unit_rhs, {}
+    rhs, columns = solver.unit_rhs, {}
     for c, (side, g) in enumerate(model.geometries.items()):
         columns[side] = [c, 2] if rack else [c]
         if g.steering == "none" and g.steering_points:

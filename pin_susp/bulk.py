@@ -9,9 +9,9 @@ and evaluates it for n configurations at once with numpy: joint placements
 quantities ``pin.computeJointJacobians`` / ``getFrameJacobian`` give (a test
 checks them against Pinocchio on every example to 1e-15 m).
 
-A long sweep is then solved in two passes (``solve_sweep``):
+A long sweep is then solved in two passes (march.solve_sweep):
 
-1. Pinocchio's Newton solver (solver.march) marches a coarse path — every
+1. Pinocchio's Newton solver (march.march) marches a coarse path — every
    s-th step, with its continuation and branch checks — and gives the exact
    tangent dq/dv at each coarse solution;
 2. every step's configuration is predicted from its two coarse neighbours
@@ -21,7 +21,7 @@ A long sweep is then solved in two passes (``solve_sweep``):
 
 Each step must meet the same tolerance and stay on every loop's design
 branch; if any step does not, the sweep is solved step by step instead
-(solver.march), so a difficult sweep is never worse off than before.
+(march.march), so a difficult sweep is never worse off than before.
 Only joints with one degree of freedom (revolute or prismatic, aligned or
 not) are handled here (a model with another kind goes step by step); every row
 kind has its batched form (constraints/: Row.fill_many), stacked by ``Rows``.
@@ -29,16 +29,39 @@ kind has its batched form (constraints/: Row.fill_many), stacked by ``Rows``.
 
 from __future__ import annotations
 
+import weakref
+
 import numpy as np
 import pinocchio as pin
 
 from .constraints import ManyFrames
 from .jet import cross
+from .solver import MAX_STEP
 
 # A sweep shorter than this is marched step by step (the coarse pass would be most of it).
 MIN_STEPS = 200
 COARSE_STEPS = 32  # about this many coarse steps, whatever the sweep's length
 MAX_ITERATIONS = 8
+
+_TREES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+_ROWS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def tree_of(kin):
+    """A Kinematics' model tree as arrays (Tree), built when first asked for."""
+    tree = _TREES.get(kin)
+    if tree is None:
+        tree = _TREES[kin] = Tree(kin.model)
+    return tree
+
+
+def rows_of(solver):
+    """A NewtonSolver's rows for many configurations at once (Rows), built when first
+    asked for."""
+    rows = _ROWS.get(solver)
+    if rows is None:
+        rows = _ROWS[solver] = Rows(tree_of(solver.kin), solver.rows, len(solver.targets))
+    return rows
 
 
 class Tree:
@@ -316,90 +339,9 @@ class Rows:
         return out
 
 
-def solve_sweep(solver, values: np.ndarray, q: np.ndarray, previous: np.ndarray, progress=None):
-    """Every step of a sweep, or None when it must be marched step by step.
-
-    Returns (solutions, tangents (n, nv, ntargets)) with every step converged and on
-    its design branches; None when the solver's rows or the model are not of the
-    kinds handled here, the sweep is short, or any step fails here.
-    """
-    from .solver import TOLERANCE, Solution, march
-
-    n = values.shape[0]
-    if n < MIN_STEPS or not getattr(solver, "bulk", None) or not solver.bulk.supported:
-        return None
-    rows = solver.bulk
-    if len(solver.targets) != values.shape[1] or rows.nrows != solver.kin.model.nv:
-        return None
-    stride = max(2, n // COARSE_STEPS)
-    coarse = np.unique(np.r_[np.arange(stride - 1, n, stride), n - 1])
-    keep = solver.keep_jacobian
-    solver.keep_jacobian = True  # exact tangents at the coarse solutions
-    try:
-        tangents: list = []
-        marched = march(solver, values[coarse], q, previous, tangents=tangents)
-    finally:
-        solver.keep_jacobian = keep
-    if not all(s.converged for s in marched):
-        return None
-    # the predictions: cubic Hermite between coarse neighbours (the design state, or the
-    # given start, before the first)
-    q0 = np.vstack([q[None], np.array([s.q for s in marched])])
-    v0 = np.vstack([previous[None], values[coarse]])
-    start_tangent = _tangent_at(solver, q, previous)
-    if start_tangent is None:
-        return None
-    T0 = np.stack([start_tangent, *tangents])  # (m + 1, nv, k)
-    segment = np.searchsorted(coarse, np.arange(n))  # step i lies in (coarse[s-1], coarse[s]]
-    guess = _hermite(q0, v0, T0, segment, values)
-    qs, T, iterations, error = _newton(rows, guess, values, TOLERANCE)
-    if qs is None:
-        return None
-    if not _on_branches(solver, qs):
-        return None
-    solutions = list(map(Solution, qs, [True] * n, iterations.tolist(), error.tolist()))
-    if progress is not None:
-        progress(n, n)
-    return solutions, T
-
-
-def _tangent_at(solver, q: np.ndarray, values: np.ndarray) -> np.ndarray | None:
-    """The exact tangent at a solved q (its targets' values ``values``)."""
-    r, J = solver.bulk.evaluate(q[None], values[None])
-    T = solve_all(J, solver._unit_rhs)
-    return None if T is None else T[0]
-
-
-def _hermite(q0, v0, T0, segment, values) -> np.ndarray:
-    """Each step's configuration predicted along its coarse segment: t is where its
-    values project onto the segment; the cubic Hermite curve through both ends with
-    their slopes, plus the near end's tangent times any part off the segment's line."""
-    qa, qb = q0[segment], q0[segment + 1]
-    va, vb = v0[segment], v0[segment + 1]
-    Ta, Tb = T0[segment], T0[segment + 1]
-    step = vb - va
-    length2 = np.einsum("ni,ni->n", step, step)
-    t = np.where(
-        length2 > 0,
-        np.einsum("ni,ni->n", values - va, step) / np.where(length2 > 0, length2, 1.0),
-        1.0,
-    )
-    t2, t3 = t * t, t * t * t
-    h00, h10 = 2 * t3 - 3 * t2 + 1, t3 - 2 * t2 + t
-    h01, h11 = -2 * t3 + 3 * t2, t3 - t2
-    slope_a = np.einsum("nvk,nk->nv", Ta, step)
-    slope_b = np.einsum("nvk,nk->nv", Tb, step)
-    guess = h00[:, None] * qa + h10[:, None] * slope_a + h01[:, None] * qb + h11[:, None] * slope_b
-    off = values - (va + t[:, None] * step)
-    near = np.where((t < 0.5)[:, None, None], Ta, Tb)
-    return guess + np.einsum("nvk,nk->nv", near, off)
-
-
-def _newton(rows: Rows, q: np.ndarray, values: np.ndarray, tolerance: float):
+def newton_all(rows: Rows, q: np.ndarray, values: np.ndarray, tolerance: float):
     """Newton iterations for every step at once: (q, tangents, iterations, max |r|) or
     (None, ...) if any step does not converge to ``tolerance`` (or takes a wild step)."""
-    from .solver import MAX_STEP
-
     n = q.shape[0]
     q = q.copy()
     iterations = np.zeros(n, dtype=int)
@@ -446,11 +388,11 @@ def solve_all(J: np.ndarray, rhs: np.ndarray) -> np.ndarray | None:
     return x if np.isfinite(x).all() else None
 
 
-def _on_branches(solver, qs: np.ndarray) -> bool:
+def on_branches(solver, qs: np.ndarray) -> bool:
     """Every step on every loop's design assembly (constraints.BranchGuard, all steps)."""
     guard = solver.branches
     if not guard.loops:
         return True
     ids = guard.frame_ids
-    P, _ = Frames(solver.bulk.tree, ids).evaluate(qs, jacobians=False)
+    P, _ = Frames(tree_of(solver.kin), ids).evaluate(qs, jacobians=False)
     return guard.holds_many(dict(zip(ids, P, strict=True)))

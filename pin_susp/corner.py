@@ -16,8 +16,9 @@ from .constraints import PointTarget
 from .errors import InputError
 from .geometry import Geometry, load_geometry, summary_repr, warn_outside
 from .linkage import Linkage
+from .march import march
 from .metrics import METRICS, TOE_LINK, Pose, metric_columns, point_columns
-from .solver import NewtonSolver, Solution, march
+from .solver import NewtonSolver, Solution
 from .sweep import Sweep, Target, check_held, load_sweep
 
 CHUNK = 10_000  # steps solved and written at a time by a streamed sweep

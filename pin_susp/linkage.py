@@ -17,7 +17,7 @@ import numpy as np
 import pinocchio as pin
 
 from . import __version__
-from .bulk import solve_all
+from .bulk import rows_of, solve_all, tree_of
 from .constraints import (
     BallClosure,
     ContactPatchPoint,
@@ -129,9 +129,9 @@ class FrameMotion:
         Pinocchio call after another.
         """
         solved = [i for i, q in enumerate(qs) if q is not None]
-        if tangents is not None and self.kin.tree.supported and solved:
+        if tangents is not None and tree_of(self.kin).supported and solved:
             Q = np.array([qs[i] for i in solved]).reshape(len(solved), self.kin.model.nq)
-            placed = self.kin.tree.placements(Q)
+            placed = tree_of(self.kin).placements(Q)
             T = tangents(Q, solved, placed)
             if T is not None:
                 return self._at_once(len(qs), solved, placed, T, k)
@@ -174,7 +174,7 @@ class FrameMotion:
     def _at_once(self, n: int, solved: list, placed: tuple, T: np.ndarray, k: int):
         """__call__ for every solved configuration at once (``placed``: the tree's
         placements there, T: their tangents)."""
-        tree = self.kin.tree
+        tree = tree_of(self.kin)
         R, o = placed
         a = tree.axes(R)
         count = len(T)
@@ -239,12 +239,12 @@ class Linkage:
         self._drive = NewtonSolver(self.kin, self.closures, drive, self.branches)
         self._check_mobility()
         self.drivers = (HUB_Z, RACK) if geometry.steering == "rack" else (HUB_Z,)
-        self.drive_rhs = self._drive._unit_rhs
+        self.drive_rhs = self._drive.unit_rhs
         if geometry.steering == "none" and geometry.steering_points:
             self.drivers = (HUB_Z, TOE_LINK)
             toe = np.zeros((self._drive.nrows, 1))
             toe[closure_row(self.closures, "toe_link")] = 1.0
-            self.drive_rhs = np.hstack([self._drive._unit_rhs, toe])
+            self.drive_rhs = np.hstack([self._drive.unit_rhs, toe])
         frames = [name for name in self.point_names if name != "contact_patch_center"]
         self._frame_motion = FrameMotion(self.kin, frames, self.points, self.design_positions)
         # The sense in which bump winds a torsion bar at design (motion_ratio's sign).
@@ -344,7 +344,7 @@ class Linkage:
         def at_once(Q: np.ndarray, steps: list, placed: tuple) -> np.ndarray | None:
             if tangents is not None and all(tangents[i] is not None for i in steps):
                 return np.array([tangents[i] for i in steps])
-            rows = self._drive.bulk
+            rows = rows_of(self._drive)
             if not rows.supported or rows.nrows != self.model.nv:
                 return None
             zero = np.zeros((len(Q), len(self._drive.targets)))

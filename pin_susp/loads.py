@@ -825,10 +825,10 @@ class SpringRates:
         """``derivatives`` for every configuration at once, on the model's tree (bulk.py):
         arrays (x, ẋ, ẍ) with NaN where q is None; None where the tree or the rows are
         not of the kinds handled there (then each is computed by ``derivatives``)."""
-        from .bulk import Frames, solve_all
+        from .bulk import Frames, rows_of, solve_all, tree_of
         from .constraints import length_rates
 
-        tree, rows = self.corner.kin.tree, self.solver.bulk
+        tree, rows = tree_of(self.corner.kin), rows_of(self.solver)
         if not (tree.supported and rows.supported and rows.nrows == self.model.nv):
             return None
         solved = [i for i, q in enumerate(qs) if q is not None]
@@ -839,7 +839,7 @@ class SpringRates:
         R, o = tree.placements(Q)
         a = tree.axes(R)
         _, J = rows.evaluate(Q, np.zeros((n, len(self.solver.targets))), placed=(R, o))
-        T = solve_all(J, self.solver._unit_rhs)
+        T = solve_all(J, self.solver.unit_rhs)
         if T is None:
             return None
         v, zero = T[:, :, 0], np.zeros((n, self.model.nv))  # dq/dz, the other drivers held

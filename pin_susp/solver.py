@@ -13,17 +13,14 @@ two half steps (continuation) before it is reported as failed.
 Speed: every row (constraints/, one kind per module) is evaluated by its fast
 form (``Row.fill``) from the frames it names — one Pinocchio call per frame the
 rows need, read once for all of them — and the small square system goes to
-LAPACK's gesv (numpy.linalg.solve). A sweep (``march``) also predicts each step
-from the last two solutions and the tangent (see ``predict``), so that one
-Newton iteration usually suffices. A long sweep can instead be solved for all its
-steps at once (``march(..., bulk=True)``, see bulk.py): this march on a coarse
-path, then batched Newton iterations on Pinocchio's model evaluated in numpy.
+LAPACK's gesv (numpy.linalg.solve). A sweep's steps are marched in
+march.py (each predicted from the last solutions, so that one Newton iteration
+usually suffices), or solved all at once on a long sweep (bulk.py's batched rows).
 """
 
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -89,18 +86,8 @@ class NewtonSolver:
         # True: Newton ends on a full evaluation, so self.jacobian belongs to the solution
         # (its tangent is exact); False: it checks the last iterate's residual alone.
         self.keep_jacobian = False
-        self._unit_rhs = np.zeros((self.nrows, len(self.targets)))
-        self._unit_rhs[self.target_rows, np.arange(len(self.targets))] = 1.0
-        self._bulk = None
-
-    @property
-    def bulk(self):
-        """The rows for many configurations at once (bulk.Rows), built when first used."""
-        if self._bulk is None:
-            from .bulk import Rows
-
-            self._bulk = Rows(self.kin.tree, self.rows, len(self.targets))
-        return self._bulk
+        self.unit_rhs = np.zeros((self.nrows, len(self.targets)))
+        self.unit_rhs[self.target_rows, np.arange(len(self.targets))] = 1.0
 
     def evaluate(self, q: np.ndarray, jacobian: bool = True) -> None:
         """Fill self.residual, and self.jacobian unless ``jacobian`` is False, at q."""
@@ -113,7 +100,7 @@ class NewtonSolver:
     def tangent(self, rhs: np.ndarray | None = None) -> np.ndarray:
         """dq per unit of each target value, at the last evaluated state: J·T = [0; I]
         (or J·T = ``rhs``: a column per change of the rows' values, e.g. a link's length)."""
-        rhs = self._unit_rhs if rhs is None else rhs
+        rhs = self.unit_rhs if rhs is None else rhs
         if self.jacobian.shape[0] != self.jacobian.shape[1]:  # more rows than freedoms
             # a column whose system is consistent has its exact tangent (e.g. the rack of
             # an axle with a rigid bar); the others (a wheel moved alone) have none: NaN
@@ -228,125 +215,6 @@ def _solve(J: np.ndarray, b: np.ndarray) -> np.ndarray | None:
             return None
     x = _gesv[b.ndim](J, b)
     return x if math.isfinite(x.sum()) else None
-
-
-def march(
-    solver: NewtonSolver,
-    values: np.ndarray,
-    q: np.ndarray,
-    previous: np.ndarray,
-    progress=None,
-    step_times=None,
-    tangents: list | None = None,
-    keep=None,
-    bulk: bool = False,
-) -> list[Solution]:
-    """Solve a sweep's steps (``values``: a row of target values each) in order, each
-    from a prediction off the last solutions (halving toward it on failure).
-
-    ``q``, ``previous``: a solved configuration and its target values to start from;
-    ``progress(done, total)`` after each step; ``step_times``: a list that receives
-    each step's solve time (s); ``tangents``: a list that receives each step's exact
-    tangent (solver.keep_jacobian must be set), or ``keep(tangent)`` if given — called
-    with the kinematics (Jacobians too) at the solution. ``bulk``: a long sweep may be
-    solved for all its steps at once (bulk.solve_sweep: the same solutions, to the
-    tolerance), and ``keep`` is then called once with every step's tangent stacked
-    (n, nv, k): it must act on the last axes alone; the sweep is marched step by step
-    when that does not apply or any step fails there.
-    """
-    if bulk and step_times is None:
-        from .bulk import solve_sweep
-
-        solved = solve_sweep(solver, values, q, previous, progress)
-        if solved is not None:
-            solutions, T = solved
-            if tangents is not None:
-                tangents.extend(T if keep is None else keep(T))
-            return solutions
-    predictor = Predictor(solver.kin.model)
-    # which steps repeat the one before (a uniform sweep): worked out once for all
-    steps = np.diff(np.vstack([previous, values]), axis=0)
-    repeats = np.r_[False, np.abs(np.diff(steps, axis=0)).max(axis=1) <= 1e-15]
-    n = values.shape[0]
-    solutions = []
-    clock = time.perf_counter
-    with np.errstate(invalid="ignore", divide="ignore"):  # a singular J: NaN, handled
-        for i in range(n):
-            started = clock()
-            solution = guessed = None
-            # After a failed step the predictor's last solution is not the step before:
-            # its step is no repeat (the parabola would assume one), and the guess is
-            # checked like any other solution — on the design branch or refused.
-            follows = i == 0 or solutions[-1].converged
-            repeat = follows and bool(repeats[i]) and predictor.before is not None
-            guess = predictor.guess(values[i], repeat)
-            if guess is not None:  # one Newton iteration from a good guess, usually
-                solver.set_targets(values[i])
-                solution = guessed = solver.newton(guess)
-            if solution is None or not solution.converged:
-                solution = explained(solver.solve(q, previous, values[i]), guessed)
-                if guessed is not None:
-                    solution.iterations += guessed.iterations
-            tangent = None
-            if solution.converged:
-                q, previous = solution.q, values[i]
-                # exact when keep_jacobian; else J of the last iterate: good enough to predict
-                tangent = solver.tangent()
-                predictor.add(q, previous, tangent, exact=solver.keep_jacobian)
-            if tangents is not None:
-                tangents.append(tangent if keep is None or tangent is None else keep(tangent))
-            if step_times is not None:
-                step_times.append(clock() - started)
-            solutions.append(solution)
-            if progress is not None:
-                progress(i + 1, n)
-    return solutions
-
-
-class Predictor:
-    """The next step's starting configuration from the last solutions and the tangent.
-
-    q(v) along the sweep is smooth in the target values v. From the last
-    solution q₁ (at v₁, with tangent T = dq/dv there) the first-order guess
-    is q₁ + T·Δv. When the step repeats the last one (a uniform sweep), the
-    parabola through q₀ and q₁ with slope T·Δv at q₁ gives q₀ + 2·T·Δv,
-    accurate to O(Δv³): one Newton iteration then meets the tolerance. When
-    both tangents are exact (J at each solution), the cubic Hermite curve
-    through q₀, q₁ with slopes T₀·Δv, T₁·Δv, extended one step, gives
-    5·q₀ − 4·q₁ + (2·T₀ + 4·T₁)·Δv, accurate to O(Δv⁴).
-    (q is a vector space here: every joint has one degree of freedom.)
-    """
-
-    def __init__(self, model: pin.Model):
-        self.model = model
-        self.last = None  # (q, values, tangent)
-        self.before = None  # (q, values)
-
-    def add(
-        self, q: np.ndarray, values: np.ndarray, tangent: np.ndarray, exact: bool = False
-    ) -> None:
-        if not np.isfinite(tangent).all():  # a singular state: no prediction from here
-            self.last = self.before = None
-            return
-        self.before = self.last
-        self.last = (q, values, tangent, exact)
-
-    def guess(self, values: np.ndarray, repeats: bool | None = None) -> np.ndarray | None:
-        """``repeats``: whether this step repeats the last one (worked out here if None)."""
-        if self.last is None:
-            return None
-        q, v, T, exact = self.last
-        step = values - v
-        if self.before is not None:
-            if repeats is None:
-                repeat = v - self.before[1] - step
-                repeats = max(repeat.max(), -repeat.min()) <= 1e-15
-            if repeats:
-                q0, _, T0, exact0 = self.before
-                if exact and exact0:
-                    return 5.0 * q0 - 4.0 * q + (2.0 * T0 + 4.0 * T) @ step
-                return pin.integrate(self.model, q0, 2.0 * (T @ step))
-        return pin.integrate(self.model, q, T @ step)
 
 
 class _Batch:

@@ -16,9 +16,10 @@ import yaml
 from conftest import EXAMPLES, example
 
 import pin_susp
-from pin_susp.bulk import _on_branches
+from pin_susp.bulk import on_branches
 from pin_susp.cli import main
-from pin_susp.solver import NewtonSolver, march
+from pin_susp.march import march
+from pin_susp.solver import NewtonSolver
 from pin_susp.sweep import load_sweep
 
 LBJ = {"x": 0, "y": 900, "z": 200}  # the example's lower ball joint
@@ -172,8 +173,8 @@ def test_the_loop_of_a_pivot_on_the_lbj_is_guarded_by_its_other_crank(tmp_path):
     assert loop.chirality(corner.kin) * loop.sign < -0.05  # the upright upside down
     p = corner.motion([flipped.q])
     assert p["upper_wishbone_outboard"].val[0][2] < p["lower_wishbone_outboard"].val[0][2]
-    assert _on_branches(solver, np.array([q19, q20]))
-    assert not _on_branches(solver, flipped.q[None])  # the batched check
+    assert on_branches(solver, np.array([q19, q20]))
+    assert not on_branches(solver, flipped.q[None])  # the batched check
     solver.set_targets(values[35])
     assert solver.newton(flipped.q).branch == "upper_ball_joint"  # the step-by-step one
 

@@ -18,7 +18,7 @@ from conftest import EXAMPLES, ROOT, torsion_bar
 import pin_susp
 import pin_susp.constraints
 from pin_susp.axle import AxleModel, axle_rows, load_axle
-from pin_susp.bulk import Rows
+from pin_susp.bulk import Rows, tree_of
 from pin_susp.constraints import (
     BarTwist,
     FaceAlignment,
@@ -142,7 +142,7 @@ def test_plain_fast_and_batched_forms_agree_and_the_jacobian_is_the_derivative(c
     nv = kin.model.nv
     for row in rows:
         target = hasattr(row, "value")
-        bulk = Rows(kin.tree, [row], 1 if target else 0)
+        bulk = Rows(tree_of(kin), [row], 1 if target else 0)
         assert bulk.supported
         values = np.full((len(qs), 1), getattr(row, "value", 0.0))
         r_many, J_many = bulk.evaluate(qs, values)
@@ -176,7 +176,7 @@ def test_a_target_rows_batched_value_is_its_column():
     """The batched form reads a target's value from the sweep's column, not the row."""
     kin, q0, rows = CASES[0]
     target = next(r for r in rows if isinstance(r, PointTarget))
-    bulk = Rows(kin.tree, [target], 1)
+    bulk = Rows(tree_of(kin), [target], 1)
     r, _ = bulk.evaluate(q0[None], np.array([[target.value + 0.25]]))
     kin.update(q0)
     assert r[0, 0] == pytest.approx(target.residual(kin)[0] - 0.25, abs=1e-15)

@@ -38,8 +38,6 @@ CIRCLES = {
     # the corner builds its loads, setup and plots; they build corners and axles (and
     # the plots and the 3D view draw axles, which draw through them)
     frozenset({"axle", "corner", "loads", "plots", "setup", "viz"}),
-    # the closure rows, the Newton solve and the many-corner solve call each other
-    frozenset({"bulk", "closures", "solver"}),
 }
 
 # Today's private names taken across modules: (importer, source module, name).

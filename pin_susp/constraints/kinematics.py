@@ -14,16 +14,6 @@ class Kinematics:
     def __init__(self, model: pin.Model):
         self.model = model
         self.data = model.createData()
-        self._tree = None
-
-    @property
-    def tree(self):
-        """The model's tree as arrays, for many configurations at once (bulk.Tree)."""
-        if self._tree is None:
-            from ..bulk import Tree
-
-            self._tree = Tree(self.model)
-        return self._tree
 
     def update(self, q: np.ndarray) -> None:
         self.q = q
