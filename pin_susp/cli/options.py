@@ -120,9 +120,10 @@ def check_outputs(args, *paths) -> None:
 
     inputs = [getattr(args, name, None) for name in ("geometry", "sweep", "mjcf", "cases")]
     inputs += list(getattr(args, "results", None) or ())
-    at = getattr(args, "at", None)
-    if at:
-        inputs.append(at.rpartition(":")[0])
+    for option in ("at", "from_results"):  # SWEEP:STEP, RESULTS.csv:STEP
+        at = getattr(args, option, None)
+        if at:
+            inputs.append(at.rpartition(":")[0])
     inputs = [Path(p) for p in inputs if p]
     seen = {}
     for path in (p for p in paths if p is not None):
