@@ -1058,7 +1058,7 @@ COMMANDS += ("mjcf",) * 5 + ("setup",) * 13 + ("loads",) * 12 + ("study",) * 2
 # Commands that take an axle (scope: axle) as well as a corner; validate is drawn apart.
 AXLE_COMMANDS = {"sweep", "sensitivity", "urdf", "mjcf", "setup", "loads", "draw"}
 AXLE_COMMANDS |= {"validate", "study"}
-STREAM_STEPS = 10_000  # pin_susp.cli.STREAM_STEPS: a longer corner sweep is streamed
+STREAM_STEPS = 10_000  # cli.commands.sweep.STREAM_STEPS: a longer corner sweep is streamed
 
 
 def _long_sweep(geometry) -> tuple[Inputs, list[Plan]]:

@@ -113,9 +113,9 @@ def test_a_parquet_output_is_told_by_its_suffix_in_any_case(tmp_path, capsys, na
 
 
 def test_a_streamed_sweep_onto_an_upper_case_parquet_name_is_parquet(tmp_path, capsys, monkeypatch):
-    from pin_susp import cli as commands
+    from pin_susp.cli.commands import sweep as sweep_command
 
-    monkeypatch.setattr(commands, "STREAM_STEPS", 20)  # the 41 steps go the streamed way
+    monkeypatch.setattr(sweep_command, "STREAM_STEPS", 20)  # the 41 steps go the streamed way
     code, _, _ = run(["sweep", GEOMETRY, BUMP_STEER, "-o", tmp_path / "r.PARQUET", "-q"], capsys)
     assert code == 0 and (tmp_path / "r.PARQUET").read_bytes()[:4] == b"PAR1"
 

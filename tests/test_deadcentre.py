@@ -196,7 +196,8 @@ def test_the_motion_ratio_goes_the_way_the_warning_says(tmp_path, capsys):
 def test_over_centre_band_says_the_way_of_the_motion_ratio_by_the_numbers():
     """The sweep's band warning: 'rises toward infinity' where |motion ratio| at the
     worst angle is above it at the angle nearest 90°, else 'falls toward zero'."""
-    from pin_susp.cli import Digest, _warn_transmission
+    from pin_susp.cli.report import Digest
+    from pin_susp.cli.report import warn_transmission as _warn_transmission
     from pin_susp.errors import PlausibilityWarning
 
     class Part:

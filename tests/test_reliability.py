@@ -614,7 +614,7 @@ def test_an_interrupt_says_a_stream_output_is_incomplete(tmp_path):
     """-o onto a pipe: what was sent before an interrupt is out, and the message says so."""
     from argparse import Namespace
 
-    from pin_susp.cli import _unwritten
+    from pin_susp.cli.run import unwritten as _unwritten
 
     pipe = tmp_path / "pipe"
     os.mkfifo(pipe)

@@ -13,8 +13,9 @@ from conftest import EXAMPLES
 
 import pin_susp
 import pin_susp.corner
-from pin_susp import cli
-from pin_susp.cli import Digest, main
+from pin_susp.cli import main
+from pin_susp.cli.commands import sweep as sweep_command
+from pin_susp.cli.report import Digest
 
 GEOMETRY = EXAMPLES / "double_wishbone.yaml"
 
@@ -33,7 +34,7 @@ def sweep_file(tmp_path, steps: int, stop: float = 120.0):
 def small_chunks(monkeypatch):
     """Stream sweeps longer than 300 steps, 250 steps at a time (the real sizes are
     10 000: the same code, at a test's length)."""
-    monkeypatch.setattr(cli, "STREAM_STEPS", 300)
+    monkeypatch.setattr(sweep_command, "STREAM_STEPS", 300)
     monkeypatch.setattr(pin_susp.corner, "CHUNK", 250)
     monkeypatch.setattr(pin_susp.corner.Corner.run_sweep_chunks, "__defaults__", (250, None))
 
@@ -48,7 +49,7 @@ def test_a_streamed_sweep_writes_the_held_sweeps_rows_and_summary(tmp_path, caps
     sweep = sweep_file(tmp_path, 700)
     code, held_out, _ = run(["sweep", GEOMETRY, sweep, "-o", tmp_path / "held.csv"], capsys)
     assert code == 0
-    monkeypatch.setattr(cli, "STREAM_STEPS", 300)
+    monkeypatch.setattr(sweep_command, "STREAM_STEPS", 300)
     monkeypatch.setattr(pin_susp.corner.Corner.run_sweep_chunks, "__defaults__", (250, None))
     seen = []
     chunks = pin_susp.corner.Corner.run_sweep_chunks
@@ -93,7 +94,7 @@ def test_steps_out_of_reach_are_reported_as_for_a_held_sweep(tmp_path, capsys, m
     sweep = sweep_file(tmp_path, 700, stop=1000.0)
     code, out, held_err = run(["sweep", GEOMETRY, sweep, "-o", tmp_path / "held.csv"], capsys)
     assert code == 1 and "did not converge" in held_err
-    monkeypatch.setattr(cli, "STREAM_STEPS", 300)
+    monkeypatch.setattr(sweep_command, "STREAM_STEPS", 300)
     monkeypatch.setattr(pin_susp.corner.Corner.run_sweep_chunks, "__defaults__", (250, None))
     code, _, err = run(["sweep", GEOMETRY, sweep, "-o", tmp_path / "streamed.csv"], capsys)
     assert code == 1 and err == held_err

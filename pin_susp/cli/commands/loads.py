@@ -1,0 +1,143 @@
+"""`pin-susp loads`: a sweep's quasi-static member and joint forces under each load case
+(README, Loads and rates), one row per step and case; the largest tension and
+compression of each member printed. Its inputs and solve are shared with `view
+--cases`."""
+
+from __future__ import annotations
+
+from ..options import axle_model, check_image, check_outputs, is_axle, run_arguments
+from ..report import progress_bar, report_failures
+from .sweep import write_results
+
+DESCRIPTION = (
+    "Solve SWEEP on GEOMETRY (a corner or an axle) and, at every step, the "
+    "quasi-static "
+    "forces under each load case of CASES (README, Loads and rates): the tension in every "
+    "two-force member (wishbone legs, trackrod or toe link, pushrod, links), the "
+    "spring's force, the rack's, and the load at every ball joint and pivot bushing "
+    "(a wishbone's also along each leg: a wishbone carrying the pushrod is no "
+    "two-force member, its legs blank and said so). "
+    "One CSV row per step and case, then the sweep's own columns. Exit code 1 if a "
+    "step did not converge."
+)
+
+
+def arguments(parser) -> None:
+    run_arguments(
+        parser,
+        "forces CSV",
+        "also draw the force report: each member's force and each joint's load "
+        "against wheel travel (or rack), a line per load case",
+        cases=True,
+    )
+
+
+def run(args) -> int:
+    import numpy as np
+
+    check_outputs(args, args.output, args.plot)
+    if args.plot is not None:
+        check_image(args.plot)
+    corner, sweep, cases = load_inputs(args.geometry, args.sweep, args.cases)
+    results, forces = solve_forces(corner, sweep, cases, args.quiet)
+    plot = write_results(args, forces)
+    if not args.quiet:
+        unbounded = int(np.nansum(forces["loads_unbounded"]))
+        print(
+            f"wrote {args.output}: {len(results)} steps x {len(cases)} load cases"
+            + (f"; {unbounded} row(s) at a toggle (forces unbounded: blank)" if unbounded else "")
+        )
+        for note in results.meta.get("notes", ()):
+            print(f"  {note}")
+        _force_summary(forces)
+        if plot:
+            print(f"wrote {args.plot}")
+    return report_failures(results)
+
+
+def load_inputs(geometry, sweep, cases):
+    """A corner or an axle, its sweep and load cases, every input error said before any
+    work."""
+    from ...corner import Corner
+    from ...geometry import load_geometry
+    from ...loads import Statics, load_cases
+    from ...sweep import load_sweep
+
+    if is_axle(geometry):
+        from ...axle import axle_rows
+
+        model = axle_model(geometry)
+        sweep = load_sweep(sweep)
+        cases = load_cases(cases, axle=True)
+        axle_rows(model, sweep.targets, sweep.source)  # target errors before any work
+        Statics(model)  # no load path, or a bar without its stiffness
+        return model, sweep, cases
+    corner = Corner(load_geometry(geometry))
+    sweep = load_sweep(sweep)
+    cases = load_cases(cases)
+    corner.solver_for(sweep.targets, sweep.source)  # target errors before any work
+    Statics(corner)  # a corner without a load path
+    return corner, sweep, cases
+
+
+def solve_forces(corner, sweep, cases, quiet: bool):
+    """The sweep's results and, at every step and load case, the forces."""
+    from ...corner import Corner, Results
+    from ...loads import member_forces
+
+    if not isinstance(corner, Corner):  # an axle
+        from ...axle import axle_results, solve_axle_sweep
+
+        solutions = solve_axle_sweep(corner, sweep, progress=progress_bar(sweep.steps, quiet))
+        results = axle_results(corner, sweep, solutions)
+        return results, member_forces(corner, sweep, cases, solutions, results)
+    tangents = []
+    solutions = corner.solve_steps(
+        sweep, progress=progress_bar(sweep.steps, quiet), tangents=tangents
+    )
+    results = Results.from_solutions(corner, solutions, sweep, tangents or None)
+    return results, member_forces(corner, sweep, cases, solutions, results)
+
+
+def chosen_case(path, cases, name: str | None) -> str:
+    """The load case to show: the one named (it must be in the file), else the first."""
+    from ...errors import InputError
+
+    names = [c.name for c in cases]
+    if name is not None and name not in names:
+        listed = ", ".join(repr(n) for n in names)
+        raise InputError(str(path), "cases", f"no load case named {name!r} (it has {listed})")
+    return names[0] if name is None else name
+
+
+def _force_summary(forces) -> None:
+    """The largest tension and compression of each member over the sweep, per case; a
+    wishbone that is not a two-force member (it carries a pushrod, say) by its bushing
+    loads resolved along each leg, and said so."""
+    import numpy as np
+
+    bent = forces.meta.get("not_two_force", {})
+    stand_in = {}  # a bent arm's blank leg → its bushing's load along the leg
+    for _, legs, alongs in bent.values():
+        stand_in.update(zip(legs, alongs, strict=True))
+    names = [n for n in forces.columns if n.startswith(("force_", "torque_"))]
+    names = [stand_in.get(n, n) for n in names]
+    width = max([36, *(len(n) for n in names)])
+    print(f"  {'member':{width}s} {'case':18s} {'min':>12s} {'max':>12s}")
+    for case in dict.fromkeys(forces["load_case"]):
+        rows = forces["load_case"] == case
+        for name in names:
+            values = forces[name][rows].astype(float)
+            if np.isnan(values).all():
+                continue
+            unit = forces.units.get(name, "N")
+            print(
+                f"  {name:{width}s} {str(case)[:18]:18s} {np.nanmin(values):12.1f} "
+                f"{np.nanmax(values):12.1f} {unit}"
+            )
+    for arm, (points, legs, alongs) in bent.items():
+        print(
+            f"  {arm}: not a two-force member (it also carries {', '.join(points)}): its "
+            f"legs bend, {' and '.join(legs)} are blank; {' and '.join(alongs)} are its "
+            "bushings' loads resolved along each leg (+ as a leg's tension)"
+        )

@@ -1,0 +1,213 @@
+"""`pin-susp sensitivity`: exact d(metric)/d(hardpoint coordinate) of a corner or an
+axle, at design or along a sweep; the long-format CSV and the table of the largest
+entries per metric."""
+
+from __future__ import annotations
+
+from ... import __version__
+from ...errors import PinSuspError
+from ..options import axle_model, check_outputs, count, geometry_argument, is_axle
+from ..report import progress_bar, report_failures
+
+DESCRIPTION = (
+    "How much each hardpoint coordinate moves each metric and each derivative "
+    "column (camber gain, bump steer, ...): exact, by implicit differentiation of the "
+    "closure equations. Writes a long-format CSV (step_index, metric, hardpoint, axis, "
+    "value, unit) and prints the largest entries per metric."
+)
+
+
+def arguments(parser) -> None:
+    geometry_argument(parser)
+    parser.add_argument(
+        "--sweep", metavar="SWEEP", help="at every step of this sweep (default: the design state)"
+    )
+    parser.add_argument("-o", "--output", metavar="SENS.csv", help="long-format CSV")
+    parser.add_argument(
+        "--top",
+        type=count,
+        default=3,
+        metavar="N",
+        help="entries per metric in the printed table (default 3)",
+    )
+    parser.add_argument(
+        "--points",
+        default="designer",
+        metavar="GROUP|NAMES",
+        help="which hardpoints the printed table ranks: designer (default: chassis pickups "
+        "and link ends, not the spindle points), chassis, upright, all, or names separated "
+        "by commas (the CSV always has every hardpoint)",
+    )
+    parser.add_argument(
+        "--one-sided",
+        action="store_true",
+        help="an axle: move each side's point alone (hardpoints left_P, right_P); default "
+        "a symmetric move, the left P by (dx, dy, dz) and the right P by (dx, -dy, dz)",
+    )
+    parser.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
+
+
+def run(args) -> int:
+    from ...corner import Corner
+    from ...geometry import load_geometry
+    from ...sensitivity import hardpoint_sensitivities, select_points
+    from ...sweep import load_sweep
+
+    check_outputs(args, args.output)
+    if is_axle(args.geometry):
+        return _sensitivity_axle(args)
+    if args.one_sided:
+        raise PinSuspError("--one-sided: a corner has one side (it moves one side of an axle)")
+    corner = Corner(load_geometry(args.geometry))
+    points = select_points(corner, args.points)
+    sweep = None
+    if args.sweep is not None:
+        sweep = load_sweep(args.sweep)
+        corner.solver_for(sweep.targets, sweep.source)
+    progress = progress_bar(sweep.steps if sweep else 1, args.quiet)
+    states, results = hardpoint_sensitivities(corner, sweep, progress, with_results=True)
+    notes = []
+    if corner.geometry.drawn is not None:
+        notes.append("(with respect to the as-set hardpoints: shim and adjusters applied)")
+    groups = [("", list(states[0].values) if states else [])]
+    return _sensitivity_report(args, corner.geometry, sweep, states, results, points, groups, notes)
+
+
+def _sensitivity_axle(args) -> int:
+    """An axle's: each side's corner columns (_left, _right) and the axle's (track, roll
+    centre, roll rates), for a symmetric move of both sides' points or a one-sided one."""
+    from ...axle import CENTER, SIDE_EXTRAS, SIDES
+
+    side_points = {n for names in SIDE_EXTRAS.values() for n in names}
+    center_points = {n for names in CENTER.values() for n in names}
+    from ...sensitivity import (
+        AXLE_COLUMNS,
+        ONE_SIDED_MOVE,
+        SYMMETRIC_MOVE,
+        AxleSensitivity,
+        axle_held,
+        axle_sensitivities,
+        select_points,
+    )
+    from ...sweep import load_sweep
+
+    model = axle_model(args.geometry)
+    if model.axle is not None and model.axle.anti_roll_rigid:
+        raise PinSuspError(
+            f"{args.geometry}: sensitivity: not for an axle with a rigid anti-roll bar yet "
+            "(each wheel's height is held, which a rigid bar does not allow)"
+        )
+    bar = [
+        n
+        for n in (args.points or "").split(",")
+        if n.strip() in {*side_points, *center_points} or n.strip().startswith(SIDES)
+    ]
+    if bar:
+        raise PinSuspError(
+            f"--points: {bar[0].strip()} — the sensitivities of the anti-roll bar's and heave "
+            "link's points (and of side-prefixed names) are not computed yet: give the "
+            "corners' hardpoints (both sides move together; --one-sided for one side)"
+        )
+    sens = AxleSensitivity(model, args.one_sided)
+    points = select_points(sens.sides["left"].corner, args.points)
+    if args.one_sided:
+        points = [f"{side}_{p}" for side in SIDES for p in points]
+    sweep = None if args.sweep is None else load_sweep(args.sweep)
+    progress = progress_bar(sweep.steps if sweep else 1, args.quiet)
+    states, results = axle_sensitivities(sens, sweep, progress)
+    move = ONE_SIDED_MOVE if args.one_sided else SYMMETRIC_MOVE
+    notes = [f"exact; {axle_held(model)}; {move}"]
+    if any(g.drawn is not None for g in model.geometries.values()):
+        notes.append("(with respect to the as-set hardpoints: shims and adjusters applied)")
+    columns = list(states[0].values) if states else []
+    groups = [("the axle:", AXLE_COLUMNS)]
+    for side in ("left",) if model.axle.mirrored else SIDES:
+        names = [n for n in columns if n.endswith(f"_{side}") and n not in AXLE_COLUMNS]
+        groups.append((f"the {side} corner (columns suffixed _{side}):", names))
+    if model.axle.mirrored:
+        groups.append(("the right corner's columns mirror the left's (a mirrored axle)", ()))
+    head = (f"hardpoint: {move}", axle_held(model))
+    return _sensitivity_report(
+        args, model.axle, sweep, states, results, points, groups, notes, head
+    )
+
+
+def _sensitivity_report(
+    args, geometry, sweep, states, results, points, groups, notes=(), csv_notes=()
+) -> int:
+    """The CSV (``csv_notes`` in its head), the steps without sensitivities, and the
+    printed table: a title, ``notes``, then per group (heading, columns) the largest
+    entries among ``points``. The exit code."""
+    from ...sensitivity import POINT_GROUPS
+
+    if args.output is not None:
+        _sensitivity_csv(states, geometry.source, args.output, csv_notes)
+    status = 0 if results is None else report_failures(results, "have no sensitivities")
+    if args.quiet or not states:
+        return status
+    s = states[0]
+    where = "the design state" if sweep is None else f"step {s.step} of {sweep.source}"
+    print(f"{geometry.name}: hardpoint sensitivities at {where}")
+    for note in notes:
+        print(f"  {note}")
+    chosen = POINT_GROUPS.get(args.points, ", ".join(points))
+    print(f"  moving {chosen}; other points: --points chassis|upright|all|NAME,NAME")
+    for heading, names in groups:
+        if heading:
+            print(f"  {heading}")
+        _sensitivity_table(s, names, args.top, set(points))
+    if args.output is not None:
+        print(
+            f"wrote {args.output}: {len(states)} state(s) x {len(s.values)} metrics x "
+            f"{3 * len(s.hardpoints)} hardpoint coordinates (every hardpoint)"
+        )
+    return status
+
+
+def _sensitivity_table(s, names, top: int, points: set) -> None:
+    """The ``top`` largest entries of each column in ``names`` among ``points``; then the
+    columns these points do not move, and those undefined here."""
+    import numpy as np
+
+    from ...sensitivity import STEP, largest
+
+    unmoved, undefined = [], []
+    for name in names:
+        entries = largest(s, name, top, points)
+        unit = s.units[name].removesuffix("/mm")
+        if not np.isfinite(s.metrics[name]):
+            undefined.append(name)
+            continue
+        if not entries:
+            unmoved.append(name)
+            continue
+        step = STEP.get(unit, 1.0)
+        print(f"  {name} = {s.metrics[name]:.6g} {unit}")
+        for hardpoint, axis, value in entries:
+            move = step / value
+            print(
+                f"    {hardpoint + ' ' + axis:34} {value:+.4g} {unit}/mm"
+                f"   (to change it by +{step:g} {unit}, move {move:+.3g} mm)"
+            )
+    if unmoved:
+        print(f"  not moved by these points here: {', '.join(unmoved)}")
+    if undefined:
+        print(f"  undefined here (blank in the results): {', '.join(undefined)}")
+
+
+def _sensitivity_csv(states, source: str, path, notes=()) -> None:
+    from ...export import atomic_write, format_cell
+
+    with atomic_write(path) as f:
+        f.write(f"# pin_susp {__version__} hardpoint sensitivities of {source}\n")
+        f.write("# value = d(metric)/d(hardpoint coordinate), per mm of the coordinate\n")
+        f.writelines(f"# {note}\n" for note in notes)
+        f.write("step_index,metric,hardpoint,axis,value,unit\n")
+        for s in states:
+            for name, values in s.values.items():
+                for i, hardpoint in enumerate(s.hardpoints):
+                    for a, axis in enumerate("xyz"):
+                        f.write(
+                            f"{s.step},{name},{hardpoint},{axis},"
+                            f"{format_cell(values[i, a])},{s.units[name]}\n"
+                        )

@@ -1,0 +1,310 @@
+"""`pin-susp setup`: the setup sheet of a corner or an axle (static metrics with the
+camber shim and length adjusters applied, a row per listed value), exact sensitivities
+to the adjusters, and the inverse solve to target camber, toe and ride height."""
+
+from __future__ import annotations
+
+from ... import __version__
+from ...errors import PinSuspError
+from ..options import check_outputs, finite, geometry_argument, is_axle, numbers, positive
+from ..report import wrote
+
+DESCRIPTION = (
+    "Print the static metrics of GEOMETRY as set (camber shim and length "
+    "adjusters applied). List values to see one row each; ask for exact sensitivities; "
+    "or give target values to find the shim, trackrod and pushrod settings that hit them."
+)
+
+
+EPILOG = (
+    "Example: pin-susp setup examples/camber_shim.yaml --shim 15,20,25,30 "
+    "--sensitivities; pin-susp setup examples/camber_shim.yaml --camber -2.5 --toe 0.1 "
+    "-o set.yaml"
+)
+
+
+def arguments(parser) -> None:
+    geometry_argument(parser)
+    parser.add_argument(
+        "--shim",
+        type=numbers,
+        default=[],
+        metavar="MM,MM,...",
+        help="fitted shim stack thicknesses, one row each",
+    )
+    parser.add_argument(
+        "--trackrod",
+        type=numbers,
+        default=[],
+        metavar="MM,MM,...",
+        help="trackrod (or fixed toe link) length changes (+ longer), one row each; "
+        "negative values as written: --trackrod -1,0,1",
+    )
+    parser.add_argument(
+        "--pushrod",
+        type=numbers,
+        default=[],
+        metavar="MM,MM,...",
+        help="pushrod length changes (+ longer), one row each",
+    )
+    parser.add_argument(
+        "--sensitivities",
+        action="store_true",
+        help="exact d(camber, toe, ride height)/d(shim, trackrod, pushrod)",
+    )
+    parser.add_argument(
+        "--thread-pitch",
+        type=positive,
+        metavar="MM",
+        help="also give sensitivities per turn of an adjuster with this pitch "
+        "(length change per turn; a left/right-hand turnbuckle: twice the pitch)",
+    )
+    parser.add_argument("--camber", type=finite, metavar="DEG", help="target static camber (shim)")
+    parser.add_argument(
+        "--toe",
+        type=finite,
+        metavar="DEG",
+        help="target static roadwheel angle, + toe-in (trackrod)",
+    )
+    parser.add_argument(
+        "--ride-height-change",
+        type=finite,
+        metavar="MM",
+        help="target ride-height change, + car higher (pushrod)",
+    )
+    parser.add_argument(
+        "-o",
+        "--output",
+        metavar="SET.yaml",
+        help="with targets: write the geometry with the setup found",
+    )
+    parser.add_argument("--csv", metavar="OUT.csv", help="also write the sheet's rows as CSV")
+    parser.add_argument(
+        "--side",
+        choices=("left", "right"),
+        help="an axle with its own right points: listed values and targets set this side "
+        "alone (default: both sides; a mirrored axle has one setup for both)",
+    )
+
+
+SHEET_METRICS = (  # column, unit, short heading
+    ("camber", "deg", "camber"),
+    ("roadwheel_angle", "deg", "toe"),
+    ("caster", "deg", "caster"),
+    ("kpi", "deg", "KPI"),
+    ("scrub_radius", "mm", "scrub"),
+    ("mechanical_trail", "mm", "trail"),
+    ("half_track", "mm", "half track"),
+    ("ride_height_change", "mm", "ride height"),
+)
+
+
+SETUP_COLUMNS = ("shim_thickness", "trackrod_length_delta", "pushrod_length_delta")
+
+
+def run(args) -> int:
+    from ... import setup
+    from ...export import all_or_none
+    from ...geometry import load_geometry
+
+    check_outputs(args, args.output, args.csv)
+    targets = {
+        name: value
+        for name, value in (
+            ("camber", args.camber),
+            ("roadwheel_angle", args.toe),
+            ("ride_height_change", args.ride_height_change),
+        )
+        if value is not None
+    }
+    if args.output is not None and not targets:
+        raise PinSuspError("-o writes a solved setup: give --camber, --toe or --ride-height-change")
+    if is_axle(args.geometry):
+        return _setup_axle(args, targets)
+    if args.side is not None:
+        raise PinSuspError(f"--side: {args.geometry} is a corner (--side sets one side of an axle)")
+    geometry = load_geometry(args.geometry)
+    title = f"{geometry.name}: setup sheet ({geometry.source})"
+    link = _link(geometry)
+    if targets:
+        found = setup.solve_setup(geometry, targets)
+        print(title)
+        _sheet([found.before, found.after], ["before", "after"], _link(geometry))
+        _hit(targets, found.iterations)
+        with all_or_none():
+            if args.output is not None:
+                _write_setup(setup.geometry_data(found.geometry), geometry.name, args.output)
+            if args.csv is not None:
+                _sheet_csv([found.before, found.after], ["before", "after"], args.csv, link)
+        wrote(args.output, args.csv)
+        return 0
+    rows = setup.setup_sheet(geometry, args.shim, args.trackrod, args.pushrod)
+    labels = _sheet_labels(args, link)
+    print(title)
+    _sheet(rows, labels, link)
+    if args.sensitivities:
+        _sensitivities(rows[0], geometry, args.thread_pitch)
+    if args.csv is not None:
+        _sheet_csv(rows, labels, args.csv, link)
+    wrote(args.csv)
+    return 0
+
+
+def _setup_axle(args, targets: dict) -> int:
+    """An axle: each side's sheet as its corner's (its own shim and adjusters), the axle's
+    static columns of both sides together, or the inverse solve per side."""
+    import numpy as np
+
+    from ... import setup
+    from ...axle import SIDES, load_axle
+    from ...export import all_or_none
+
+    axle = load_axle(args.geometry)
+    chosen = setup.set_sides(axle, args.side)
+    link = _link(axle.left)
+    if targets:
+        found = setup.solve_axle_setup(axle, targets, args.side)
+        rows = {s: [found[s].before, found[s].after] for s in SIDES}
+        labels = ["before", "after"]
+    else:
+        rows = setup.axle_setup_sheet(axle, args.shim, args.trackrod, args.pushrod, args.side)
+        labels = _sheet_labels(args, link)
+    # the axle's columns per row: both sides as set in that row (a side not set: as set)
+    statics = [
+        setup.axle_static(axle, {s: rows[s][min(i, len(rows[s]) - 1)] for s in SIDES})
+        for i in range(len(labels))
+    ]
+    print(f"{axle.name}: setup sheet per side ({axle.source})")
+    for s in SIDES:
+        if s == "right" and axle.mirrored:
+            print(
+                "  right corner (the left mirrored: it takes the left's setup, the same shim "
+                "stack and length deltas):"
+            )
+        else:
+            setting = "" if s in chosen else f"; not set: --side {args.side}"
+            print(f"  {s} corner (axle_config.{s}_setup{setting}):")
+        _sheet(rows[s], labels[: len(rows[s])], link)
+        if targets and found[s].iterations:
+            _hit(targets, found[s].iterations)
+        if args.sensitivities and not targets:
+            _sensitivities(rows[s][0], axle.corner(s), args.thread_pitch)
+    print("  axle (both sides as set in each row):")
+    print(f"  {'':9}" + "".join(f"{head:>12}" for _, head in setup.AXLE_STATIC))
+    print(f"  {'':9}" + "".join(f"{'mm':>12}" for _ in setup.AXLE_STATIC))
+    for label, row in zip(labels, statics, strict=True):
+        cells = (round(row[name], 3) + 0.0 for name, _ in setup.AXLE_STATIC)
+        print(
+            f"  {label:9}"
+            + "".join(f"{v:>12.3f}" if np.isfinite(v) else f"{'-':>12}" for v in cells)
+        )
+    with all_or_none():
+        if args.output is not None:
+            data = setup.axle_data(axle, {s: found[s].geometry for s in chosen})
+            _write_setup(data, axle.name, args.output)
+        if args.csv is not None:
+            sides = [(s, i) for s in SIDES for i in range(len(rows[s]))]
+            _sheet_csv(
+                [rows[s][i] for s, i in sides],
+                [f"{s} {labels[i]}" for s, i in sides],
+                args.csv,
+                link,
+                [statics[i] for _, i in sides],
+            )
+    wrote(args.output, args.csv)
+    return 0
+
+
+def _sheet_labels(args, link: str) -> list[str]:
+    """The sheet's row labels: the as-set row, then one per listed value."""
+    return (
+        ["as set"]
+        + ["shim"] * len(args.shim)
+        + [link] * len(args.trackrod)
+        + ["pushrod"] * len(args.pushrod)
+    )
+
+
+def _hit(targets: dict, iterations: int) -> None:
+    print(
+        f"  hit {', '.join(f'{k} {v:g}' for k, v in targets.items())} "
+        f"in {iterations} Newton iterations"
+    )
+
+
+def _write_setup(data: dict, name: str, path) -> None:
+    """A geometry (corner or axle) file with the setup found."""
+    import yaml
+
+    from ...export import write_text
+
+    text = yaml.safe_dump(data, sort_keys=False, default_flow_style=None)
+    write_text(f"# {name}: setup solved by pin-susp setup\n" + text, path)
+
+
+def _link(geometry) -> str:
+    """The length adjuster that sets toe: the trackrod, a fixed toe link, or none."""
+    if not geometry.steering_points:
+        return "no link"
+    return "trackrod" if geometry.steering == "rack" else "toe link"
+
+
+def _sheet(rows, labels, link: str = "trackrod") -> None:
+    import numpy as np
+
+    print(
+        f"  {'':9}{'shim':>8}{link:>9}{'pushrod':>8}"
+        + "".join(f"{head:>12}" for _, _, head in SHEET_METRICS)
+    )
+    print(
+        f"  {'':9}{'mm':>8}{'Δ mm':>9}{'Δ mm':>8}"
+        + "".join(f"{unit:>12}" for _, unit, _ in SHEET_METRICS)
+    )
+    for label, row in zip(labels, rows, strict=True):
+        line = f"  {label:9}" + "".join(
+            f"{v + 0.0:>{w}.3f}" for v, w in zip(row.setup, (8, 9, 8), strict=True)
+        )
+        line += "".join(
+            f"{row.metrics[name] + 0.0:>12.4f}" if np.isfinite(row.metrics[name]) else f"{'-':>12}"
+            for name, _, _ in SHEET_METRICS
+        )
+        print(line)
+
+
+def _sensitivities(state, geometry, pitch) -> None:
+    drawn = geometry.drawn or geometry
+    have = (drawn.camber_shim is not None, bool(drawn.steering_points), drawn.has_pushrod)
+    link = _link(drawn)
+    columns = [("per mm shim", 0, 1.0), (f"per mm {link}", 1, 1.0), ("per mm pushrod", 2, 1.0)]
+    if pitch:
+        columns += [(f"per turn {link}", 1, pitch), ("per turn pushrod", 2, pitch)]
+    columns = [c for c in columns if have[c[1]]]
+    if not columns:
+        print("  exact sensitivities: this corner has no setup adjuster (shim, link or pushrod)")
+        return
+    print("  exact sensitivities at the static state:")
+    print(f"  {'':26}" + "".join(f"{c[0]:>19}" for c in columns))
+    for name, unit in (("camber", "deg"), ("roadwheel_angle", "deg"), ("ride_height_change", "mm")):
+        d = state.derivatives[name]
+        print(
+            f"  {name + ' (' + unit + ')':26}"
+            + "".join(f"{d[i] * k:>19.6g}" for _, i, k in columns)
+        )
+
+
+def _sheet_csv(rows, labels, path, link: str = "trackrod", extra=None) -> None:
+    """The sheet's rows; ``extra``: per row, more columns (name → value), e.g. an
+    axle's track and roll centre."""
+    from ...export import atomic_write, format_cell
+
+    setup_columns = [c.replace("trackrod", link.replace(" ", "_")) for c in SETUP_COLUMNS]
+    names = ["row", *setup_columns] + [name for name, _, _ in SHEET_METRICS]
+    extra = extra or [{}] * len(rows)
+    with atomic_write(path) as f:
+        f.write(f"# pin_susp {__version__} setup sheet; lengths mm, angles deg\n")
+        f.write(",".join(names + list(extra[0])) + "\n")
+        for label, row, more in zip(labels, rows, extra, strict=True):
+            cells = [label, *map(format_cell, row.setup)]
+            cells += [format_cell(row.metrics[name]) for name, _, _ in SHEET_METRICS]
+            cells += [format_cell(v) for v in more.values()]
+            f.write(",".join(cells) + "\n")

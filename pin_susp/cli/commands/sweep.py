@@ -1,0 +1,133 @@
+"""`pin-susp sweep`: every step of a sweep on a corner or an axle, one row each, to CSV
+or Parquet (and the standard report with --plot); a corner's sweep longer than
+STREAM_STEPS is written as it is solved, a chunk at a time (docs/sweep.md,
+docs/results.md)."""
+
+from __future__ import annotations
+
+import sys
+
+from ..options import axle_model, check_image, check_outputs, is_axle, run_arguments
+from ..report import Digest, axle_summary, progress_bar, report_failures, summary, warn_transmission
+
+DESCRIPTION = (
+    "Solve every step of SWEEP on GEOMETRY (a corner, or an axle: scope: axle) "
+    "and write the metrics (camber, toe, caster, KPI, scrub, trail, ...; an axle's per "
+    "side, and its roll, roll centre, bar twist, ...) and every point to CSV. "
+    "Exit code 1 if any step did not converge (its row is flagged)."
+)
+
+
+def arguments(parser) -> None:
+    run_arguments(
+        parser,
+        "results CSV",
+        "also draw the standard kinematics report (an axle's: camber, toe, steer, roll "
+        "centre, bar twist, ... against roll, heave or rack)",
+    )
+
+
+# A corner's sweep longer than this (steps) is streamed to its file, a chunk at a time.
+STREAM_STEPS = 10_000
+
+
+def run(args) -> int:
+    check_outputs(args, args.output, args.plot)  # before the numerics are imported
+    if args.plot is not None:
+        check_image(args.plot)
+    from ...corner import Corner
+    from ...geometry import load_geometry
+    from ...sweep import load_sweep
+
+    if is_axle(args.geometry):
+        return _sweep_axle(args)
+    corner = Corner(load_geometry(args.geometry))
+    sweep = load_sweep(args.sweep)
+    corner.solver_for(sweep.targets, sweep.source)  # target errors before any work
+    if sweep.steps > STREAM_STEPS and args.plot is None:
+        return _sweep_streamed(args, corner, sweep)
+    results = corner.run_sweep(sweep, progress=progress_bar(sweep.steps, args.quiet))
+    digest = Digest.of(results)
+    warn_transmission(digest)
+    plot = write_results(args, results)
+    if not args.quiet:
+        summary(digest, args.output)
+        if plot:
+            print(f"wrote {args.plot}")
+    return report_failures(digest)
+
+
+def _sweep_streamed(args, corner, sweep) -> int:
+    """A long sweep written as it is solved, a chunk of steps at a time: its memory does
+    not grow with its length (the same rows as run_sweep's, to the solver's tolerance).
+    A chunk is written by a second thread while the next one is solved (pyarrow's
+    formatting and numpy leave the GIL): two chunks alive at most."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from ...export import CsvStream, ParquetStream, is_parquet
+
+    parts = corner.run_sweep_chunks(sweep, progress=progress_bar(sweep.steps, args.quiet))
+    first = next(parts)
+    digest = Digest.of(first)
+    kind = ParquetStream if is_parquet(args.output) else CsvStream
+    with (
+        kind(args.output, first.units, first.meta, list(first.columns), sweep.steps) as out,
+        ThreadPoolExecutor(1) as writer,
+    ):
+        pending = writer.submit(out.write, first)
+        del first
+        for part in parts:
+            pending.result()
+            pending = writer.submit(out.write, part)
+            digest.add(part)
+            del part
+        pending.result()
+    warn_transmission(digest)
+    if not args.quiet:
+        summary(digest, args.output)
+    return report_failures(digest)
+
+
+def write_results(args, results) -> bool:
+    """The CSV (Parquet for an OUT ending .parquet) and, with --plot, the report: both or
+    neither; whether it was drawn."""
+    from ...export import all_or_none, csv_text, is_parquet, write_csv, write_text
+
+    plot = args.plot is not None and results["solver_converged"].any()
+    text = csv_text(results) if plot else None  # the report reads the CSV's text
+    with all_or_none():
+        if is_parquet(args.output):
+            from ...export import write_parquet
+
+            write_parquet(results, args.output)
+        elif text is None:
+            write_csv(results, args.output)
+        else:
+            write_text(text, args.output)
+        if plot:  # drawn from the CSV's text: the output may be a stream
+            from ...plots import ResultsFile, report_figure, save_figure
+
+            written = ResultsFile(args.output, raw=text.encode())
+            save_figure(report_figure([written]), args.plot)
+    if args.plot is not None and not plot:
+        print(f"pin-susp: no step converged: {args.plot} not drawn", file=sys.stderr)
+    return plot
+
+
+def _sweep_axle(args) -> int:
+    """An axle's sweep: both corners' columns (suffixed by side) and the axle's."""
+    from ...axle import axle_results, solve_axle_sweep
+    from ...sweep import load_sweep
+
+    model = axle_model(args.geometry)
+    sweep = load_sweep(args.sweep)
+    solutions = solve_axle_sweep(model, sweep, progress=progress_bar(sweep.steps, args.quiet))
+    results = axle_results(model, sweep, solutions)
+    digest = Digest.of(results)
+    warn_transmission(digest)
+    plot = write_results(args, results)
+    if not args.quiet:
+        axle_summary(results, digest, args.output)
+        if plot:
+            print(f"wrote {args.plot}")
+    return report_failures(digest)

@@ -1,0 +1,132 @@
+"""`pin-susp view`: the corner or axle in meshcat, live or as a self-contained HTML
+replay of its sweep, members coloured by force with --cases."""
+
+from __future__ import annotations
+
+import signal
+import threading
+from pathlib import Path
+
+from ...errors import PinSuspError
+from ..options import axle_model, check_outputs, geometry_argument, is_axle, positive
+from ..report import print_warnings, progress_bar, report_failures, warn_transmission
+from .loads import chosen_case, load_inputs, solve_forces
+
+DESCRIPTION = (
+    "Open GEOMETRY in a meshcat scene served locally (works offline) and print "
+    "its URL; with SWEEP, play the solved motion as an animation. --html writes the scene "
+    "and animation as one HTML file that opens in a browser with no server. An axle file "
+    "shows both corners, the anti-roll bar and the roll centre (hidden where it is blank). "
+    "With --cases (and SWEEP), the members are coloured by their force under one load "
+    "case at every frame: red tension, blue compression, grey zero, full colour at the "
+    "largest |force| over the sweep; one replay per case (--case)."
+)
+
+
+def arguments(parser) -> None:
+    geometry_argument(parser)
+    parser.add_argument("sweep", metavar="SWEEP", nargs="?", help="sweep YAML to animate")
+    parser.add_argument("--html", metavar="OUT.html", help="write a self-contained replay and exit")
+    parser.add_argument("--fps", type=positive, default=10.0, help="animation frames per second")
+    parser.add_argument(
+        "--cases", metavar="LOADS.yaml", help="load cases: colour the members by their force"
+    )
+    parser.add_argument(
+        "--case", metavar="NAME", help="the load case to colour by (default: the first)"
+    )
+
+
+def run(args) -> int:
+    import contextlib
+    import io
+    import time
+
+    from ...corner import Corner
+    from ...export import write_text
+    from ...geometry import load_geometry
+    from ...sweep import load_sweep
+    from ...viz import Scene, force_caption, force_key, roll_centres, signals_held
+
+    check_outputs(args, args.html)
+    if args.case is not None and args.cases is None:
+        raise PinSuspError(f"--case {args.case}: needs --cases LOADS.yaml, the cases it names")
+    if args.cases is not None and args.sweep is None:
+        raise PinSuspError(f"--cases {args.cases}: needs a SWEEP, whose steps the forces are of")
+    qs, results, markers, forces = None, None, None, None
+    if args.cases is not None:  # a corner, its sweep and its forces under every case
+        model, sweep, cases = load_inputs(args.geometry, args.sweep, args.cases)
+        case = chosen_case(args.cases, cases, args.case)
+        results, forces = solve_forces(model, sweep, cases, quiet=False)
+        warn_transmission(results)
+        axle = not isinstance(model, Corner)
+    else:
+        axle = is_axle(args.geometry)
+        model = axle_model(args.geometry) if axle else Corner(load_geometry(args.geometry))
+    if args.sweep is not None and forces is None:
+        sweep = load_sweep(args.sweep)
+        progress = progress_bar(sweep.steps, False)
+        if axle:  # both corners and the bar
+            from ...axle import axle_results, solve_axle_sweep
+
+            results = axle_results(model, sweep, solve_axle_sweep(model, sweep, progress=progress))
+        else:
+            model.solver_for(sweep.targets, sweep.source)
+            results = model.run_sweep(sweep, progress=progress)
+            warn_transmission(results)
+    if results is not None:
+        qs = [
+            q if ok else None
+            for q, ok in zip(results.meta["q"], results["solver_converged"], strict=True)
+        ]
+        if axle:  # the roll centre, from the results' columns
+            markers = {"roll_centre": roll_centres(results)}
+    quiet = io.StringIO()
+    with contextlib.redirect_stdout(quiet):  # meshcat announces its server on stdout
+        scene = Scene(model)
+    try:  # an interrupt before the scene is served is one as in every command: 130, 143
+        colours, caption = None, ""
+        if forces is not None:
+            colours, scale = scene.force_colours(forces, case)
+            others = f"the first of {len(cases)}: --case NAME for another" * (
+                args.case is None and len(cases) > 1
+            )
+            bent = bool(scene.not_two_force)
+            print(force_key(case, scale, others, bent))
+            caption = force_caption(case, scale, Path(args.cases).name, bent)
+        frames = (
+            scene.animate(qs, fps=args.fps, markers=markers, colours=colours)
+            if qs is not None
+            else 0
+        )
+        page = scene.html(caption) if args.html is not None else None
+    except BaseException:
+        with contextlib.suppress(KeyboardInterrupt):  # a second Ctrl+C while it stops
+            scene.close()
+        raise
+    if args.html is not None:
+        with signals_held():  # a signal while the server stops: raised once it has
+            scene.close()
+        write_text(page, args.html)  # whole or not at all
+        print(f"wrote {args.html}" + (f" ({frames} frames)" if frames else ""))
+        return 0 if results is None else report_failures(results, "are not in the replay")
+    try:
+        print(
+            f"meshcat: {scene.viewer.url()}"
+            + (f"  ({frames} frames: press play in Open Controls > Animations)" if frames else "")
+        )
+        if results is not None:
+            report_failures(results, "are not in the animation")
+        print_warnings(args)
+        # A process started in the background of a script inherits SIGINT ignored:
+        # we say "press Ctrl+C", so Ctrl+C must stop us.
+        if threading.current_thread() is threading.main_thread():
+            signal.signal(signal.SIGINT, signal.default_int_handler)
+        print("serving; press Ctrl+C to stop", flush=True)
+        while True:
+            time.sleep(0.5)
+    except KeyboardInterrupt:  # the way to stop a live scene: it was served, exit 0
+        print("stopped")
+        return 0
+    finally:
+        with contextlib.suppress(KeyboardInterrupt):  # a second Ctrl+C while it stops
+            scene.close()
