@@ -6,6 +6,10 @@ lets them propagate. Anything else is a bug in pin_susp.
 
 from __future__ import annotations
 
+# The command line's exit codes for how a run ended (0: success; 128 + N: signal N).
+EXIT_NOT_CONVERGED = 1  # it finished, but some steps did not converge (their rows flagged)
+EXIT_INPUT = 2  # a problem with the input: one line on stderr, nothing written
+
 
 class PinSuspError(Exception):
     """Base class: a problem the user can act on."""

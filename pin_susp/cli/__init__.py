@@ -24,9 +24,10 @@ from __future__ import annotations
 import argparse
 
 from .. import __version__
+from ..errors import EXIT_INPUT
 from .commands import COMMANDS, load
 from .options import Parser
-from .run import EXIT_INPUT, execute
+from .run import execute
 
 
 def main(argv: list[str] | None = None) -> int:

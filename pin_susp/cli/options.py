@@ -12,8 +12,7 @@ import re
 import stat
 from pathlib import Path
 
-from ..errors import PinSuspError
-from .run import EXIT_INPUT
+from ..errors import EXIT_INPUT, PinSuspError
 
 
 class Parser(argparse.ArgumentParser):

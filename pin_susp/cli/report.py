@@ -14,8 +14,7 @@ import math
 import sys
 import warnings
 
-from ..errors import PlausibilityWarning
-from .run import EXIT_NOT_CONVERGED
+from ..errors import EXIT_NOT_CONVERGED, PlausibilityWarning
 
 # Instant-centre columns: past this (mm) the arms are all but parallel and the
 # centre is better described as "at infinity" than by a number.

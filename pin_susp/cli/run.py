@@ -17,10 +17,7 @@ import threading
 import warnings
 from pathlib import Path
 
-from ..errors import PinSuspError, PlausibilityWarning
-
-EXIT_NOT_CONVERGED = 1
-EXIT_INPUT = 2
+from ..errors import EXIT_INPUT, PinSuspError, PlausibilityWarning
 
 
 def execute(args) -> int:

@@ -8,9 +8,9 @@ import signal
 import sys
 from pathlib import Path
 
-from ...errors import PinSuspError
+from ...errors import EXIT_NOT_CONVERGED, PinSuspError
 from ..report import progress_bar
-from ..run import EXIT_NOT_CONVERGED, Terminated
+from ..run import Terminated
 
 DESCRIPTION = (
     "Run the variants of STUDY (a design of experiments, manufacturing "
