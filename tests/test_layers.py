@@ -359,3 +359,29 @@ if __name__ == "__main__":
         else:
             print(f"{key}: {value}")
     sys.exit(0)
+
+
+def test_the_readme_module_table_lists_every_module():
+    """Every module of the package in README's "How it works" table: by its own name
+    (`axle.py`), or — for a subpackage's members — by the subpackage's row
+    (`constraints/`, `mechanisms/`, `cli/commands/`), which names what is in it."""
+    readme = PACKAGE.parent / "README.md"
+    table = readme.read_text().split("## How it works", 1)[1].split("\n\n", 2)[1]
+    listed = {
+        cell.strip("` ")
+        for line in table.splitlines()
+        if line.startswith("| `")
+        for cell in line.split("|")[1].split(",")
+    }
+    missing = []
+    for path in sorted(PACKAGE.rglob("*.py")):
+        relative = path.relative_to(PACKAGE)
+        if relative.name == "__main__.py" or relative == Path("__init__.py"):
+            continue  # `python -m` shims, and the package itself (the README's subject)
+        folders = ["/".join(relative.parts[:i]) + "/" for i in range(1, len(relative.parts))]
+        if str(relative) in listed or (len(relative.parts) == 1 and relative.name in listed):
+            continue
+        if any(folder in listed for folder in folders):
+            continue
+        missing.append(str(relative))
+    assert not missing, f"modules missing from README's module table: {missing}"
