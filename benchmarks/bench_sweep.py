@@ -235,7 +235,7 @@ def long_sweep(rounds: int, steps: int, baseline_steps: int) -> dict:
 
     import pin_susp.corner
     from pin_susp import march as marching
-    from pin_susp.export import csv_text, write_parquet
+    from pin_susp.io.tables import csv_text, write_parquet
 
     corner = pin_susp.Corner(EXAMPLES / "double_wishbone.yaml")
     sweep = issue_sweep(steps)

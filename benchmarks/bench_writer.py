@@ -6,17 +6,17 @@ On the example corner's bump + steer sweep (examples/double_wishbone.yaml, wheel
 z −40…120 mm and rack −40…40 mm; 2 001 steps, 86 columns by default) it times, in
 alternation, several rounds (the machine drifts: figures are p10 / median / p90):
 
-- ``repr``: export.write_csv in the repr style (numpy's str of each float);
-- ``fast``: export.write_csv in the compiled style (pyarrow's cast to string);
-- ``fast_text``: export.csv_text in the compiled style (a str, what the CLI holds);
-- ``parquet``: export.write_parquet;
-- ``stream_N``: export.CsvStream, chunks of N rows (--chunks: 101 and 1 001);
-- ``parquet_stream_N``: export.ParquetStream, chunks of N rows;
+- ``repr``: tables.write_csv in the repr style (numpy's str of each float);
+- ``fast``: tables.write_csv in the compiled style (pyarrow's cast to string);
+- ``fast_text``: tables.csv_text in the compiled style (a str, what the CLI holds);
+- ``parquet``: tables.write_parquet;
+- ``stream_N``: tables.CsvStream, chunks of N rows (--chunks: 101 and 1 001);
+- ``parquet_stream_N``: tables.ParquetStream, chunks of N rows;
 
 each as µs per row and as a ratio to ``repr`` in the same round (target: the CSV
 ≤ 8 µs per row). Then the import of pyarrow and pyarrow.compute (what the compiled
 style costs a process that has not imported them; fresh interpreters) and where that
-cost is paid back: rows of this table, and cells, against export.FAST_CELLS.
+cost is paid back: rows of this table, and cells, against tables.FAST_CELLS.
 """
 
 from __future__ import annotations
@@ -34,8 +34,8 @@ from pathlib import Path
 import numpy as np
 
 import pin_susp
-from pin_susp import export
 from pin_susp.corner import Results
+from pin_susp.io import tables
 from pin_susp.sweep import Sweep, Target
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
@@ -69,11 +69,11 @@ def writers(results: Results, folder: Path, sizes: list[int]) -> dict:
 
     def styled(cells, function):
         def run():
-            export.FAST_CELLS, kept = cells, export.FAST_CELLS
+            tables.FAST_CELLS, kept = cells, tables.FAST_CELLS
             try:
                 function()
             finally:
-                export.FAST_CELLS = kept
+                tables.FAST_CELLS = kept
 
         return run
 
@@ -88,16 +88,16 @@ def writers(results: Results, folder: Path, sizes: list[int]) -> dict:
         return run
 
     out = {
-        "repr": styled(NEVER, lambda: export.write_csv(results, folder / "repr.csv")),
-        "fast": styled(0, lambda: export.write_csv(results, folder / "fast.csv")),
-        "fast_text": styled(0, lambda: export.csv_text(results)),
-        "parquet": lambda: export.write_parquet(results, folder / "r.parquet"),
+        "repr": styled(NEVER, lambda: tables.write_csv(results, folder / "repr.csv")),
+        "fast": styled(0, lambda: tables.write_csv(results, folder / "fast.csv")),
+        "fast_text": styled(0, lambda: tables.csv_text(results)),
+        "parquet": lambda: tables.write_parquet(results, folder / "r.parquet"),
     }
     for size in sizes:
-        out[f"stream_{size}"] = styled(0, stream(export.CsvStream, folder / f"{size}.csv", size))
+        out[f"stream_{size}"] = styled(0, stream(tables.CsvStream, folder / f"{size}.csv", size))
     for size in sizes:
         path = folder / f"{size}.parquet"
-        out[f"parquet_stream_{size}"] = stream(export.ParquetStream, path, size)
+        out[f"parquet_stream_{size}"] = stream(tables.ParquetStream, path, size)
     return out
 
 
@@ -178,7 +178,7 @@ def main() -> None:
     )
     print(
         f"paid back from {even_rows:.0f} rows of this table = {even_rows * columns:.0f} cells"
-        f" (export.FAST_CELLS = {export.FAST_CELLS})"
+        f" (tables.FAST_CELLS = {tables.FAST_CELLS})"
     )
     figures["import_s"] = imports
     figures["break_even"] = {"rows": even_rows, "cells": even_rows * columns}

@@ -923,7 +923,7 @@ def _drive_rows(model: AxleModel) -> list:
 
 class AxleResults(Results):
     """Columns of a solved axle sweep (docs/axle.md, "Columns"), in output units; written
-    as a corner's are (export.csv_text): ``results["camber_left"]``,
+    as a corner's are (io.tables.csv_text): ``results["camber_left"]``,
     ``results.to_pandas()``, ``results.to_csv(path)``, ``results.plot(path)``."""
 
 

@@ -413,13 +413,13 @@ class Results:
         >>> frame = results.to_pandas()
         >>> frame[["wheel_travel", "camber"]], frame.attrs["units"]["camber"]  # 'deg'
         """
-        from .export import results_frame
+        from .io.tables import results_frame
 
         return results_frame(self)
 
     def to_csv(self, path) -> None:
         """The CSV that ``pin-susp sweep -o`` writes (docs/results.md), whole or not at all."""
-        from .export import write_csv
+        from .io.tables import write_csv
 
         write_csv(self, path)
 
@@ -440,7 +440,7 @@ class Results:
         check_image_path(path)  # before any work
         if len(self) == 0 or not np.any(self.columns["solver_converged"]):
             raise PinSuspError(f"{path}: no step converged: nothing to plot")
-        from .export import csv_text
+        from .io.tables import csv_text
         from .plots import ResultsFile, report_figure, save_figure
 
         name = _file_name(self.meta.get("sweep", ("",))[0]) or "results"

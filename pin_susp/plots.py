@@ -62,8 +62,8 @@ import numpy as np  # noqa: E402
 from matplotlib.transforms import Bbox  # noqa: E402
 
 from .errors import InputError, PinSuspError  # noqa: E402
-from .export import FULL, atomic_write  # noqa: E402
 from .geometry import unit, wheel_down  # noqa: E402
+from .io.atomic import FULL, atomic_write  # noqa: E402
 from .metrics import (  # noqa: E402
     HUB_Z,
     METRIC_BY_NAME,

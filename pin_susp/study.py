@@ -829,7 +829,7 @@ def _row(job: Job, vid: int, deltas, v: Variant) -> dict:
 def _steps_table(results, vid: int):
     import pyarrow as pa
 
-    from .export import arrow_columns
+    from .io.tables import arrow_columns
 
     arrays = {"variant_id": pa.array(np.full(len(results), vid, dtype=np.int64))}
     arrays |= arrow_columns(results)
@@ -840,7 +840,7 @@ def _steps_table(results, vid: int):
 def _variants_table(rows: list[dict]):
     import pyarrow as pa
 
-    from .export import arrow_column
+    from .io.tables import arrow_column
 
     names = list(rows[0])
     return pa.table({k: arrow_column(np.array([r[k] for r in rows])) for k in names})
@@ -1021,7 +1021,7 @@ def _run(study, outdir, client, steps, resume, progress, dashboard, warn=None) -
         outcome.best = outdir / "best.yaml"
         curves = curves_of(study, best)
     outcome.lines = summary_lines(study, variants, outcome.linear, curves)
-    from .export import all_or_none
+    from .io.atomic import all_or_none
 
     with all_or_none():  # best.yaml, study.png, variants.parquet: together, or none of them
         if outcome.best is not None:
@@ -1191,7 +1191,7 @@ INFORMATION = ("pin_susp", "study")  # manifest entries that do not decide samen
 
 def _prepare(study: Study, outdir: Path, steps: bool, resume: bool) -> Path:
     """Check OUTDIR again and write its manifest; the parts' folder."""
-    from .export import write_text
+    from .io.atomic import write_text
 
     mine = _check_outdir(study, outdir, steps, resume)
     manifest = outdir / MANIFEST
@@ -1208,7 +1208,7 @@ def _prepare(study: Study, outdir: Path, steps: bool, resume: bool) -> Path:
 def _check_outdir(study: Study, outdir: Path, steps: bool, resume: bool) -> dict:
     """OUTDIR must be new or empty, or hold this study's unfinished run (``resume``);
     nothing is written. The manifest that the run will write."""
-    from .export import check_folder
+    from .io.atomic import check_folder
 
     mine = _fingerprint(study, steps)
     check_folder(outdir)  # a name too long for the file system: one line, not a traceback
@@ -1251,7 +1251,7 @@ def _check_outdir(study: Study, outdir: Path, steps: bool, resume: bool) -> dict
     elif resume:
         raise PinSuspError(f"{outdir}: no unfinished run of this study to resume")
     else:
-        from .export import existing_ancestor
+        from .io.atomic import existing_ancestor
 
         folder = existing_ancestor(outdir.absolute())
         if not folder.is_dir():
@@ -1318,10 +1318,10 @@ def _first_line(exc: BaseException) -> str:
 
 
 def _write_parquet(table, path: Path) -> None:
-    """A table as Parquet, whole or not at all (export.atomic_write)."""
+    """A table as Parquet, whole or not at all (io.atomic.atomic_write)."""
     import pyarrow.parquet as pq
 
-    from .export import atomic_write
+    from .io.atomic import atomic_write
 
     with atomic_write(path, binary=True) as f:
         pq.write_table(table, f)
@@ -1382,7 +1382,7 @@ def read_steps(outdir: str | Path):
 
 def write_geometry(study: Study, deltas, path: str | Path, comment: str) -> None:
     """The study's geometry file with the deltas applied (best.yaml), whole or not at all."""
-    from .export import write_text
+    from .io.atomic import write_text
 
     data = variant_data(study.geometry_data, study.variables, deltas, study.axle)
     lines = "".join(f"# {line}\n" for line in comment.splitlines())

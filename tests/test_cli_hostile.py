@@ -302,7 +302,7 @@ def _room_for(monkeypatch, parts: int):
     import errno
 
     from pin_susp import study as studies
-    from pin_susp.export import atomic_write
+    from pin_susp.io.atomic import atomic_write
 
     real, written = studies._write_parquet, []
 
@@ -431,7 +431,8 @@ def test_a_damaged_part_file_is_named_and_its_batch_solved_again_on_resume(
 # animation being recorded, the page being made, the HTML being written.
 _AT = """
 import importlib.abc, signal, sys
-from pin_susp import cli, export, viz
+from pin_susp import cli, viz
+from pin_susp.io import atomic
 number = getattr(signal, sys.argv[2])
 
 def fire():
@@ -455,13 +456,13 @@ moment = sys.argv[1]
 if moment == "import":
     sys.meta_path.insert(0, Finder())
 elif moment == "write":
-    real = export.write_text
+    real = atomic.write_text
     def write_text(text, path):
-        with export.atomic_write(path) as f:
+        with atomic.atomic_write(path) as f:
             f.write(text[: len(text) // 2])
             fire()
             f.write(text[len(text) // 2 :])
-    export.write_text = write_text
+    atomic.write_text = write_text
 else:
     before(viz.Scene, moment)
 sys.exit(cli.main(sys.argv[3:]))

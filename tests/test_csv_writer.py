@@ -12,8 +12,8 @@ import pyarrow.parquet as pq
 import pytest
 from conftest import EXAMPLES
 
-from pin_susp import export
 from pin_susp.corner import Results
+from pin_susp.io import atomic, tables
 from pin_susp.sweep import load_sweep
 
 EDGE = [
@@ -72,7 +72,7 @@ def edge_results(rows: int = 60, seed: int = 0) -> Results:
 @pytest.fixture(params=["repr", "fast"])
 def style(request, monkeypatch):
     """Each text style in turn: FAST_CELLS moved so that any table has it."""
-    monkeypatch.setattr(export, "FAST_CELLS", 10**18 if request.param == "repr" else 0)
+    monkeypatch.setattr(tables, "FAST_CELLS", 10**18 if request.param == "repr" else 0)
     return request.param
 
 
@@ -117,13 +117,13 @@ def check_cells(results: Results, path) -> None:
 
 def test_every_cell_reads_back_as_written(tmp_path, style):
     results = edge_results()
-    export.write_csv(results, tmp_path / "r.csv")
+    tables.write_csv(results, tmp_path / "r.csv")
     check_cells(results, tmp_path / "r.csv")
 
 
 def test_pandas_reads_back_the_same_float64s(tmp_path, style):
     results = edge_results(200, seed=1)
-    export.write_csv(results, tmp_path / "r.csv")
+    tables.write_csv(results, tmp_path / "r.csv")
     frame = pd.read_csv(tmp_path / "r.csv", comment="#")
     for name, values in results.columns.items():
         values = np.asarray(values)
@@ -143,10 +143,10 @@ def test_the_layout_of_a_small_table(tmp_path, style):
         "load_case": np.array(["a,b", "c"], dtype=object),
     }
     units = {"step_index": "", "solver_converged": "", "x": "mm", "y": "deg", "load_case": ""}
-    export.write_csv(Results(columns, units, META), tmp_path / "r.csv")
+    tables.write_csv(Results(columns, units, META), tmp_path / "r.csv")
     x0 = "1e-05" if style == "repr" else "0.00001"  # the one cell the two styles differ in
     assert (tmp_path / "r.csv").read_bytes().decode() == (
-        f"# pin_susp {export.__version__}\n"
+        f"# pin_susp {tables.__version__}\n"
         "# geometry: g.yaml sha256=ab12\n"
         "# sweep: s.yaml\n"
         '# units: {"step_index": "", "solver_converged": "", "x": "mm", "y": "deg", '
@@ -160,7 +160,7 @@ def test_the_layout_of_a_small_table(tmp_path, style):
 def test_the_fast_style_writes_whole_numbers_and_exponents_as_floats(tmp_path, style):
     values = np.array([100.0, -0.0, 0.0, 1e15, 1e22, 123456789.0, 2.5, 1e-7, 1e-05])
     columns = {"step_index": np.arange(len(values)), "v": values}
-    export.write_csv(Results(columns, {"step_index": "", "v": ""}, META), tmp_path / "r.csv")
+    tables.write_csv(Results(columns, {"step_index": "", "v": ""}, META), tmp_path / "r.csv")
     _, _, rows = parsed(tmp_path / "r.csv")
     cells = [r[1] for r in rows]
     assert same_bits([float(c) for c in cells], values)
@@ -175,7 +175,7 @@ def test_a_table_of_fixed_values_only(tmp_path, style, rows):
     """Every column the same all along (each formatted once in the fast style)."""
     columns = {"a": np.full(rows, 2.0), "b": np.full(rows, np.nan), "c": np.full(rows, -0.0)}
     results = Results(columns, dict.fromkeys(columns, ""), META)
-    export.write_csv(results, tmp_path / "r.csv")
+    tables.write_csv(results, tmp_path / "r.csv")
     check_cells(results, tmp_path / "r.csv")
     assert (tmp_path / "r.csv").read_text().endswith("a,b,c\n" + "2.0,,-0.0\n" * rows)
 
@@ -191,8 +191,8 @@ def test_the_example_sweep_parses_the_same_on_both_sides_of_the_threshold(
     rows, columns = len(sweep_results), len(sweep_results.columns)
     texts = {}
     for cells, name in ((rows * columns + 1, "below"), (rows * columns, "at")):
-        monkeypatch.setattr(export, "FAST_CELLS", cells)
-        export.write_csv(sweep_results, tmp_path / f"{name}.csv")
+        monkeypatch.setattr(tables, "FAST_CELLS", cells)
+        tables.write_csv(sweep_results, tmp_path / f"{name}.csv")
         texts[name] = (tmp_path / f"{name}.csv").read_text()
         check_cells(sweep_results, tmp_path / f"{name}.csv")
     assert texts["below"] != texts["at"]  # two styles...
@@ -209,14 +209,14 @@ def test_the_example_sweep_parses_the_same_on_both_sides_of_the_threshold(
 
 
 def test_the_threshold_counts_cells():
-    assert export.fast_style(1, export.FAST_CELLS)
-    assert not export.fast_style(1, export.FAST_CELLS - 1)
-    assert export.fast_style(2001, 86) and not export.fast_style(41, 86)
+    assert tables.fast_style(1, tables.FAST_CELLS)
+    assert not tables.fast_style(1, tables.FAST_CELLS - 1)
+    assert tables.fast_style(2001, 86) and not tables.fast_style(41, 86)
 
 
 def test_csv_text_is_the_files_text(tmp_path, style, sweep_results):
-    export.write_csv(sweep_results, tmp_path / "r.csv")
-    assert export.csv_text(sweep_results).encode() == (tmp_path / "r.csv").read_bytes()
+    tables.write_csv(sweep_results, tmp_path / "r.csv")
+    assert tables.csv_text(sweep_results).encode() == (tmp_path / "r.csv").read_bytes()
 
 
 def chunks(results: Results, sizes) -> list[Results]:
@@ -231,11 +231,11 @@ def chunks(results: Results, sizes) -> list[Results]:
 
 @pytest.mark.parametrize("sizes", [[60], [1] * 60, [7] * 8 + [4], [0, 13, 0, 40, 7]])
 def test_a_stream_writes_the_bytes_of_the_whole_table(tmp_path, style, monkeypatch, sizes):
-    monkeypatch.setattr(export, "_BLOCK_ROWS", 9)  # chunks cut across the fast style's blocks
+    monkeypatch.setattr(tables, "_BLOCK_ROWS", 9)  # chunks cut across the fast style's blocks
     results = edge_results()
-    export.write_csv(results, tmp_path / "whole.csv")
+    tables.write_csv(results, tmp_path / "whole.csv")
     names = list(results.columns)
-    with export.CsvStream(tmp_path / "s.csv", results.units, META, names, len(results)) as out:
+    with tables.CsvStream(tmp_path / "s.csv", results.units, META, names, len(results)) as out:
         for part in chunks(results, sizes):
             out.write(part)
     assert (tmp_path / "s.csv").read_bytes() == (tmp_path / "whole.csv").read_bytes()
@@ -243,11 +243,11 @@ def test_a_stream_writes_the_bytes_of_the_whole_table(tmp_path, style, monkeypat
 
 
 def test_the_stream_takes_its_style_from_the_total_rows(tmp_path, monkeypatch):
-    monkeypatch.setattr(export, "FAST_CELLS", 60 * 13)  # edge_results: 13 columns
+    monkeypatch.setattr(tables, "FAST_CELLS", 60 * 13)  # edge_results: 13 columns
     results = edge_results()
     names = list(results.columns)
     for total, cell in ((60, "0.00001"), (59, "1e-05")):
-        with export.CsvStream(tmp_path / "s.csv", results.units, META, names, total) as out:
+        with tables.CsvStream(tmp_path / "s.csv", results.units, META, names, total) as out:
             for part in chunks(results, [10] * 6):  # every chunk below the threshold
                 out.write(part)
         _, _, rows = parsed(tmp_path / "s.csv")
@@ -256,11 +256,11 @@ def test_the_stream_takes_its_style_from_the_total_rows(tmp_path, monkeypatch):
 
 @pytest.mark.parametrize("sizes", [[60], [1] * 60, [3, 4, 0, 20, 33], [14, 14, 32]])
 def test_a_parquet_stream_writes_the_bytes_of_the_whole_table(tmp_path, monkeypatch, sizes):
-    monkeypatch.setattr(export, "ROW_GROUP", 7)
+    monkeypatch.setattr(tables, "ROW_GROUP", 7)
     results = edge_results()
-    export.write_parquet(results, tmp_path / "whole.parquet")
+    tables.write_parquet(results, tmp_path / "whole.parquet")
     names = list(results.columns)
-    with export.ParquetStream(tmp_path / "s.parquet", results.units, META, names) as out:
+    with tables.ParquetStream(tmp_path / "s.parquet", results.units, META, names) as out:
         for part in chunks(results, sizes):
             out.write(part)
     assert (tmp_path / "s.parquet").read_bytes() == (tmp_path / "whole.parquet").read_bytes()
@@ -281,20 +281,20 @@ def test_write_parquet_is_pyarrows_own_table_written_whole(tmp_path, sweep_resul
     below a row group's rows."""
     import pyarrow as pa
 
-    export.write_parquet(sweep_results, tmp_path / "r.parquet")
-    columns = {k: export.arrow_column(v) for k, v in sweep_results.columns.items()}
-    meta = export.parquet_metadata(sweep_results.units, sweep_results.meta)
+    tables.write_parquet(sweep_results, tmp_path / "r.parquet")
+    columns = {k: tables.arrow_column(v) for k, v in sweep_results.columns.items()}
+    meta = tables.parquet_metadata(sweep_results.units, sweep_results.meta)
     pq.write_table(pa.table(columns).replace_schema_metadata(meta), tmp_path / "own.parquet")
     assert (tmp_path / "r.parquet").read_bytes() == (tmp_path / "own.parquet").read_bytes()
     assert (
-        pq.read_schema(tmp_path / "r.parquet").metadata[b"pin_susp"] == export.__version__.encode()
+        pq.read_schema(tmp_path / "r.parquet").metadata[b"pin_susp"] == tables.__version__.encode()
     )
 
 
-@pytest.mark.parametrize("stream", [export.CsvStream, export.ParquetStream])
+@pytest.mark.parametrize("stream", [tables.CsvStream, tables.ParquetStream])
 @pytest.mark.parametrize("failure", [RuntimeError, KeyboardInterrupt])
 def test_a_failure_inside_a_stream_leaves_no_file(tmp_path, style, monkeypatch, stream, failure):
-    monkeypatch.setattr(export, "ROW_GROUP", 7)  # the Parquet writer is open when it fails
+    monkeypatch.setattr(tables, "ROW_GROUP", 7)  # the Parquet writer is open when it fails
     results = edge_results()
     names = list(results.columns)
     (tmp_path / "old.out").write_text("before")
@@ -312,14 +312,14 @@ def test_streams_inside_all_or_none_appear_together_or_not_at_all(tmp_path, styl
     results = edge_results()
     names = list(results.columns)
     with pytest.raises(RuntimeError):
-        with export.all_or_none():
-            for stream, name in ((export.CsvStream, "r.csv"), (export.ParquetStream, "r.pq")):
+        with atomic.all_or_none():
+            for stream, name in ((tables.CsvStream, "r.csv"), (tables.ParquetStream, "r.pq")):
                 with stream(tmp_path / name, results.units, META, names, len(results)) as out:
                     out.write(results)
             raise RuntimeError("after both were complete")
     assert list(tmp_path.iterdir()) == []
-    with export.all_or_none():
-        with export.CsvStream(tmp_path / "r.csv", results.units, META, names, 60) as out:
+    with atomic.all_or_none():
+        with tables.CsvStream(tmp_path / "r.csv", results.units, META, names, 60) as out:
             out.write(results)
         assert list(tmp_path.iterdir()) != [] and not (tmp_path / "r.csv").exists()
     assert [p.name for p in tmp_path.iterdir()] == ["r.csv"]
@@ -330,14 +330,14 @@ def test_a_chunk_with_other_columns_is_refused_and_leaves_no_file(tmp_path):
     names = list(results.columns)
     other = Results({k: v for k, v in results.columns.items() if k != "edge"}, {}, META)
     with pytest.raises(ValueError, match="edge"):
-        with export.CsvStream(tmp_path / "r.csv", results.units, META, names, 60) as out:
+        with tables.CsvStream(tmp_path / "r.csv", results.units, META, names, 60) as out:
             out.write(other)
     assert list(tmp_path.iterdir()) == []
 
 
 def test_a_parquet_stream_of_many_small_chunks_still_writes_the_same_bytes(tmp_path, monkeypatch):
     """Pages of a row group fill at the same rows however the chunks cut them."""
-    monkeypatch.setattr(export, "ROW_GROUP", 150_000)
+    monkeypatch.setattr(tables, "ROW_GROUP", 150_000)
     rng = np.random.default_rng(2)
     n = 200_000  # a first group of more than a page (1 MB) per column, then the rest
     columns = {
@@ -346,8 +346,8 @@ def test_a_parquet_stream_of_many_small_chunks_still_writes_the_same_bytes(tmp_p
         "y": np.where(rng.random(n) < 0.1, np.nan, rng.normal(size=n)),
     }
     results = Results(columns, dict.fromkeys(columns, "mm"), META)
-    export.write_parquet(results, tmp_path / "whole.parquet")
-    with export.ParquetStream(tmp_path / "s.parquet", results.units, META, list(columns)) as out:
+    tables.write_parquet(results, tmp_path / "whole.parquet")
+    with tables.ParquetStream(tmp_path / "s.parquet", results.units, META, list(columns)) as out:
         for part in chunks(results, [101] * (n // 101) + [n % 101]):
             out.write(part)
     assert (tmp_path / "s.parquet").read_bytes() == (tmp_path / "whole.parquet").read_bytes()

@@ -383,5 +383,7 @@ def test_the_readme_module_table_lists_every_module():
             continue
         if any(folder in listed for folder in folders):
             continue
+        if relative.name == "__init__.py" and any(n.startswith(folders[-1]) for n in listed):
+            continue  # a subpackage whose modules have their own rows
         missing.append(str(relative))
     assert not missing, f"modules missing from README's module table: {missing}"

@@ -397,9 +397,9 @@ def test_urdf_with_an_unwritable_sidecar_writes_neither(tmp_path, capsys):
 
 
 def test_sigterm_during_a_write_leaves_no_temporary_file(tmp_path, capsys, monkeypatch):
-    from pin_susp import export
+    from pin_susp.io import tables
 
-    real = export._column_cells
+    real = tables._column_cells
     calls = []
 
     def slow(values):
@@ -408,7 +408,7 @@ def test_sigterm_during_a_write_leaves_no_temporary_file(tmp_path, capsys, monke
             signal.raise_signal(signal.SIGTERM)
         return real(values)
 
-    monkeypatch.setattr(export, "_column_cells", slow)
+    monkeypatch.setattr(tables, "_column_cells", slow)
     code = main(["sweep", GEOMETRY, BUMP_STEER, "-o", str(tmp_path / "r.csv"), "-q"])
     assert code == 128 + signal.SIGTERM
     assert files(tmp_path) == set()

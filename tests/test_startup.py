@@ -93,7 +93,7 @@ def test_a_plain_sweep_to_csv_imports_nothing_heavy(inputs):
     assert code == 0, proc.stderr
     assert imported(modules, HEAVY) == []
     # what it does need, it has
-    assert {"numpy", "pinocchio", "yaml", "pin_susp.solver", "pin_susp.export"} <= modules
+    assert {"numpy", "pinocchio", "yaml", "pin_susp.solver", "pin_susp.io.tables"} <= modules
     # the CSV is the sweep's: 41 rows, each camber the very float the API computes
     lines = (inputs / "out.csv").read_text().splitlines()
     rows = list(csv.DictReader(line for line in lines if not line.startswith("#")))

@@ -106,7 +106,7 @@ def axle_model(path):
 
 def check_image(path) -> None:
     """An image output: a writable path with an extension matplotlib can write."""
-    from ..export import check_output
+    from ..io.atomic import check_output
     from ..plots import check_image_path
 
     check_output(path, "image")
@@ -115,7 +115,7 @@ def check_image(path) -> None:
 
 def check_outputs(args, *paths) -> None:
     """Before any work: every output writable, each its own file, none of them an input."""
-    from ..export import check_output
+    from ..io.atomic import check_output
 
     inputs = [getattr(args, name, None) for name in ("geometry", "sweep", "mjcf", "cases")]
     inputs += list(getattr(args, "results", None) or ())

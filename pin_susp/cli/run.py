@@ -67,7 +67,7 @@ def unwritten(args) -> str:
     pipe) is out, and a streamed sweep may have sent some of its rows."""
     output = getattr(args, "output", None)
     if isinstance(output, str) and output:
-        from ..export import is_stream
+        from ..io.atomic import is_stream
 
         if is_stream(Path(output)):
             return f"{output} is a stream: what was already sent to it is incomplete"

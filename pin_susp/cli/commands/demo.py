@@ -35,8 +35,9 @@ def run(args) -> int:
     import yaml
 
     from ...corner import Corner
-    from ...export import all_or_none, check_folder, csv_text, write_text
     from ...geometry import load_geometry
+    from ...io.atomic import all_or_none, check_folder, write_text
+    from ...io.tables import csv_text
     from ...sweep import load_sweep
 
     if str(args.output).strip() == "":
@@ -90,7 +91,7 @@ def _demo_pictures(corner, results, files, csv: str) -> None:
     import contextlib
     import io
 
-    from ...export import write_text
+    from ...io.atomic import write_text
     from ...plots import ResultsFile, drawing_figure, report_figure, save_figure
     from ...viz import CornerScene
 

@@ -22,8 +22,8 @@ def arguments(parser) -> None:
 
 def run(args) -> int:
     from ...corner import Corner
-    from ...export import write_text
     from ...geometry import load_geometry
+    from ...io.atomic import write_text
     from ...mjcf import tree_to_mjcf
 
     check_outputs(args, args.output)

@@ -196,7 +196,8 @@ def _sensitivity_table(s, names, top: int, points: set) -> None:
 
 
 def _sensitivity_csv(states, source: str, path, notes=()) -> None:
-    from ...export import atomic_write, format_cell
+    from ...io.atomic import atomic_write
+    from ...io.tables import format_cell
 
     with atomic_write(path) as f:
         f.write(f"# pin_susp {__version__} hardpoint sensitivities of {source}\n")

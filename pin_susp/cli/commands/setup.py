@@ -104,8 +104,8 @@ SETUP_COLUMNS = ("shim_thickness", "trackrod_length_delta", "pushrod_length_delt
 
 def run(args) -> int:
     from ... import setup
-    from ...export import all_or_none
     from ...geometry import load_geometry
+    from ...io.atomic import all_or_none
 
     check_outputs(args, args.output, args.csv)
     targets = {
@@ -157,7 +157,7 @@ def _setup_axle(args, targets: dict) -> int:
 
     from ... import setup
     from ...axle import SIDES, load_axle
-    from ...export import all_or_none
+    from ...io.atomic import all_or_none
 
     axle = load_axle(args.geometry)
     chosen = setup.set_sides(axle, args.side)
@@ -236,7 +236,7 @@ def _write_setup(data: dict, name: str, path) -> None:
     """A geometry (corner or axle) file with the setup found."""
     import yaml
 
-    from ...export import write_text
+    from ...io.atomic import write_text
 
     text = yaml.safe_dump(data, sort_keys=False, default_flow_style=None)
     write_text(f"# {name}: setup solved by pin-susp setup\n" + text, path)
@@ -295,7 +295,8 @@ def _sensitivities(state, geometry, pitch) -> None:
 def _sheet_csv(rows, labels, path, link: str = "trackrod", extra=None) -> None:
     """The sheet's rows; ``extra``: per row, more columns (name → value), e.g. an
     axle's track and roll centre."""
-    from ...export import atomic_write, format_cell
+    from ...io.atomic import atomic_write
+    from ...io.tables import format_cell
 
     setup_columns = [c.replace("trackrod", link.replace(" ", "_")) for c in SETUP_COLUMNS]
     names = ["row", *setup_columns] + [name for name, _, _ in SHEET_METRICS]

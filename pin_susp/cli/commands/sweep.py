@@ -64,7 +64,7 @@ def _sweep_streamed(args, corner, sweep) -> int:
     formatting and numpy leave the GIL): two chunks alive at most."""
     from concurrent.futures import ThreadPoolExecutor
 
-    from ...export import CsvStream, ParquetStream, is_parquet
+    from ...io.tables import CsvStream, ParquetStream, is_parquet
 
     parts = corner.run_sweep_chunks(sweep, progress=progress_bar(sweep.steps, args.quiet))
     first = next(parts)
@@ -91,13 +91,14 @@ def _sweep_streamed(args, corner, sweep) -> int:
 def write_results(args, results) -> bool:
     """The CSV (Parquet for an OUT ending .parquet) and, with --plot, the report: both or
     neither; whether it was drawn."""
-    from ...export import all_or_none, csv_text, is_parquet, write_csv, write_text
+    from ...io.atomic import all_or_none, write_text
+    from ...io.tables import csv_text, is_parquet, write_csv
 
     plot = args.plot is not None and results["solver_converged"].any()
     text = csv_text(results) if plot else None  # the report reads the CSV's text
     with all_or_none():
         if is_parquet(args.output):
-            from ...export import write_parquet
+            from ...io.tables import write_parquet
 
             write_parquet(results, args.output)
         elif text is None:

@@ -31,8 +31,8 @@ def arguments(parser) -> None:
 
 def run(args) -> int:
     from ...corner import Corner
-    from ...export import all_or_none, is_stream, write_text
     from ...geometry import load_geometry
+    from ...io.atomic import all_or_none, is_stream, write_text
 
     if args.at is not None and args.output is None:
         raise PinSuspError("--at writes a sidecar beside the URDF: give -o OUT.urdf too")

@@ -42,8 +42,8 @@ def run(args) -> int:
     import time
 
     from ...corner import Corner
-    from ...export import write_text
     from ...geometry import load_geometry
+    from ...io.atomic import write_text
     from ...sweep import load_sweep
     from ...viz import Scene, force_caption, force_key, roll_centres, signals_held
 
