@@ -33,7 +33,7 @@ from .march import march
 from .mechanisms import axis_foot, xml_name
 from .solver import NewtonSolver
 from .sweep import Target, check_held
-from .urdf import Body, Closure, Joint, Tree, Visual
+from .tree import Body, Closure, Joint, Tree, Visual
 from .yamlio import Reader, load_yaml
 
 SIDES = ("left", "right")

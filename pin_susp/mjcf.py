@@ -27,11 +27,10 @@ import numpy as np
 
 from .errors import PinSuspError
 from .geometry import unit
-from .urdf import (
+from .tree import (
     PLACEHOLDER_INERTIA,
     PLACEHOLDER_MASS,
     Tree,
-    _fmt,
     cylinder_inertia,
     design_rates,
     inertials,
@@ -39,6 +38,7 @@ from .urdf import (
     joint_steps,
     spring_sense,
 )
+from .urdf import number_text
 
 ROD_RADIUS = 0.005  # m: a closure's rod body, drawn and weighed (at the tree's density)
 GRAVITY = (0.0, 0.0, -9.81)  # m/s², ISO 8855: +Z up
@@ -66,7 +66,11 @@ def tree_to_mjcf(tree: Tree, comment: str = "") -> str:
     ET.SubElement(
         root,
         "option",
-        {"gravity": _fmt(GRAVITY), "timestep": _fmt([TIMESTEP]), "integrator": "implicitfast"},
+        {
+            "gravity": number_text(GRAVITY),
+            "timestep": number_text([TIMESTEP]),
+            "integrator": "implicitfast",
+        },
     )
     default = ET.SubElement(root, "default")
     ET.SubElement(default, "equality", {"solref": CLOSURE_SOLREF, "solimp": CLOSURE_SOLIMP})
@@ -84,7 +88,9 @@ def tree_to_mjcf(tree: Tree, comment: str = "") -> str:
             origin[body.name] = np.zeros(3)
     for s in steps:
         el = ET.SubElement(
-            element[s.parent], "body", {"name": s.child, "pos": _fmt(s.origin - origin[s.parent])}
+            element[s.parent],
+            "body",
+            {"name": s.child, "pos": number_text(s.origin - origin[s.parent])},
         )
         reach = limits[s.name][0]
         ET.SubElement(
@@ -94,9 +100,9 @@ def tree_to_mjcf(tree: Tree, comment: str = "") -> str:
                 "name": s.name,
                 "type": "slide" if s.kind == "prismatic" else "hinge",
                 "pos": "0 0 0",
-                "axis": _fmt(s.axis),
+                "axis": number_text(s.axis),
                 "limited": "true",
-                "range": _fmt([-reach, reach]),
+                "range": number_text([-reach, reach]),
             },
         )
         _inertial(el, *masses[s.child], s.origin)
@@ -107,19 +113,23 @@ def tree_to_mjcf(tree: Tree, comment: str = "") -> str:
         ET.SubElement(
             element[body],
             "site",
-            {"name": name, "pos": _fmt(position - origin[body]), "size": "0.006"},
+            {"name": name, "pos": number_text(position - origin[body]), "size": "0.006"},
         )
     for v in tree.visuals:
-        rgba = _fmt(tree.materials[v.material])
+        rgba = number_text(tree.materials[v.material])
         attrs = {"contype": "0", "conaffinity": "0", "group": "1", "rgba": rgba}
         o = origin[v.body]
         if v.shape == "ball":
-            attrs |= {"type": "sphere", "size": _fmt([v.radius]), "pos": _fmt(v.start - o)}
+            attrs |= {
+                "type": "sphere",
+                "size": number_text([v.radius]),
+                "pos": number_text(v.start - o),
+            }
         else:
             attrs |= {
                 "type": "cylinder" if v.material == "tyre" else "capsule",
-                "size": _fmt([v.radius]),
-                "fromto": _fmt(np.r_[v.start - o, v.end - o]),
+                "size": number_text([v.radius]),
+                "fromto": number_text(np.r_[v.start - o, v.end - o]),
             }
         ET.SubElement(element[v.body], "geom", attrs)
 
@@ -135,7 +145,7 @@ def tree_to_mjcf(tree: Tree, comment: str = "") -> str:
                     "name": c.name,
                     "body1": body_a,
                     "body2": body_b,
-                    "anchor": _fmt(a - origin[body_a]),
+                    "anchor": number_text(a - origin[body_a]),
                 },
             )
             continue
@@ -149,11 +159,16 @@ def tree_to_mjcf(tree: Tree, comment: str = "") -> str:
         for k, axis in ((1, u1), (2, u2)):
             name = f"{c.name}_rod" if k == 2 else f"{c.name}_rod_link"
             pos = a - origin[parent] if k == 1 else np.zeros(3)
-            el = ET.SubElement(element[parent], "body", {"name": name, "pos": _fmt(pos)})
+            el = ET.SubElement(element[parent], "body", {"name": name, "pos": number_text(pos)})
             ET.SubElement(
                 el,
                 "joint",
-                {"name": f"{c.name}_rod_{k}", "type": "hinge", "pos": "0 0 0", "axis": _fmt(axis)},
+                {
+                    "name": f"{c.name}_rod_{k}",
+                    "type": "hinge",
+                    "pos": "0 0 0",
+                    "axis": number_text(axis),
+                },
             )
             if k == 1:
                 _inertial(el, PLACEHOLDER_MASS, a, _placeholder(), a)
@@ -168,8 +183,8 @@ def tree_to_mjcf(tree: Tree, comment: str = "") -> str:
             "geom",
             {
                 "type": "capsule",
-                "size": _fmt([ROD_RADIUS]),
-                "fromto": _fmt(np.r_[0, 0, 0, b - a]),
+                "size": number_text([ROD_RADIUS]),
+                "fromto": number_text(np.r_[0, 0, 0, b - a]),
                 "contype": "0",
                 "conaffinity": "0",
                 "group": "1",
@@ -179,7 +194,7 @@ def tree_to_mjcf(tree: Tree, comment: str = "") -> str:
         ET.SubElement(
             equality,
             "connect",
-            {"name": c.name, "body1": parent, "body2": body_b, "anchor": _fmt(b - a)},
+            {"name": c.name, "body1": parent, "body2": body_b, "anchor": number_text(b - a)},
         )
     _spring(root, element, tree, steps, rates)
     if any(s.name == "rack_slide" for s in steps):
@@ -191,9 +206,9 @@ def tree_to_mjcf(tree: Tree, comment: str = "") -> str:
             {
                 "name": "steering",
                 "joint": "rack_slide",
-                "kp": _fmt([STEERING_KP]),
-                "kv": _fmt([STEERING_KV]),
-                "ctrlrange": _fmt([-reach, reach]),
+                "kp": number_text([STEERING_KP]),
+                "kv": number_text([STEERING_KV]),
+                "ctrlrange": number_text([-reach, reach]),
             },
         )
 
@@ -212,9 +227,9 @@ def _inertial(body, mass: float, center, inertia: np.ndarray, body_origin) -> No
         body,
         "inertial",
         {
-            "pos": _fmt(np.asarray(center) - body_origin),
-            "mass": _fmt([mass]),
-            "fullinertia": _fmt(inertia[[0, 1, 2, 0, 0, 1], [0, 1, 2, 1, 2, 2]]),
+            "pos": number_text(np.asarray(center) - body_origin),
+            "mass": number_text([mass]),
+            "fullinertia": number_text(inertia[[0, 1, 2, 0, 0, 1], [0, 1, 2, 1, 2, 2]]),
         },
     )
 
@@ -240,11 +255,11 @@ def _spring(root, element: dict, tree: Tree, steps: list, rates) -> None:
                 "spatial",
                 {
                     "name": "spring" if spring.side is None else f"{spring.side}_spring",
-                    "stiffness": _fmt([rate]),
-                    "springlength": _fmt([length + spring.preload / rate]),
-                    "damping": _fmt([spring.damping]),
+                    "stiffness": number_text([rate]),
+                    "springlength": number_text([length + spring.preload / rate]),
+                    "damping": number_text([spring.damping]),
                     "width": "0.012",
-                    "rgba": _fmt(tree.materials.get("strut", (0.8, 0.15, 0.15, 1.0))),
+                    "rgba": number_text(tree.materials.get("strut", (0.8, 0.15, 0.15, 1.0))),
                 },
             )
             ET.SubElement(el, "site", {"site": top})
@@ -253,11 +268,11 @@ def _spring(root, element: dict, tree: Tree, steps: list, rates) -> None:
         sense = spring_sense(tree, steps, rates, spring)
         for joint in root.iter("joint"):
             if joint.get("name") == spring.ends[0]:
-                joint.set("stiffness", _fmt([rate]))
-                joint.set("springref", _fmt([-sense * spring.preload / rate]))
-                joint.set("damping", _fmt([spring.damping]))
+                joint.set("stiffness", number_text([rate]))
+                joint.set("springref", number_text([-sense * spring.preload / rate]))
+                joint.set("damping", number_text([spring.damping]))
                 armature = rate * (ARMATURE_STEPS * TIMESTEP) ** 2 + 0.5 * spring.damping * TIMESTEP
-                joint.set("armature", _fmt([armature]))
+                joint.set("armature", number_text([armature]))
 
 
 # what identifies the MJCF of a corner: its named elements, by kind, in this order

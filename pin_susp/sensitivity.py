@@ -44,7 +44,8 @@ from .geometry import contact_patch, unit, wheel_points
 from .jet import Dual
 from .metrics import METRIC_BY_NAME, METRICS, PointSet, derivative_columns
 from .sweep import Target
-from .urdf import Body, Joint, Tree, tree_to_urdf
+from .tree import Body, Joint, Tree
+from .urdf import tree_to_urdf
 
 V = "__v_"  # marks virtual joints and links
 AXES = "xyz"

@@ -28,7 +28,8 @@ from .errors import InputError
 from .geometry import Geometry, unit
 from .mechanisms.double_wishbone import upright_mounts
 from .solver import NewtonSolver
-from .urdf import Body, Joint, Tree, tree_to_urdf
+from .tree import Body, Joint, Tree
+from .urdf import tree_to_urdf
 
 KEY = "config.camber_shim.setup_thickness"
 

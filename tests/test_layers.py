@@ -40,11 +40,8 @@ CIRCLES = {
     frozenset({"axle", "corner", "loads", "plots", "setup", "viz"}),
 }
 
-# Today's private names taken across modules: (importer, source module, name).
-PRIVATE = {
-    # the model files' number text: left for the rename of urdf.py (issue 25, point 4)
-    ("mjcf", "urdf", "_fmt"),
-}
+# Today's private names taken across modules: (importer, source module, name) — none.
+PRIVATE: set[tuple[str, str, str]] = set()
 
 
 @dataclass(frozen=True)

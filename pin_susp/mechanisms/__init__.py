@@ -18,7 +18,7 @@ Each module has:
 - ``prepare(p, o, r)``: check the points (one clear error each), then ``settle``;
 - ``settle(p)``: hardpoints that others place (the MacPherson clamp on its
   strut line); runs on jet.Duals too;
-- ``tree(g)``: bodies, joints, points, closures, visuals (a urdf.Tree), and
+- ``tree(g)``: bodies, joints, points, closures, visuals (a tree.Tree), and
   what robotics tools read beside them (``robot(g)`` below);
 - ``kingpin(ps)``: (lower, upper) points of the steering axis, or None;
 - ``instant_planes(ps)``: two planes (normal, point) whose line is the instant
@@ -41,7 +41,7 @@ from types import ModuleType
 
 import numpy as np
 
-from ..urdf import DAMPER, DENSITY, Joint, Spring, Visual
+from ..tree import DAMPER, DENSITY, Joint, Spring, Visual
 from ..vectors import unit
 
 # Hardpoint names that more than one mechanism has (docs/geometry.md)

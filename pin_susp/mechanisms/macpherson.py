@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..urdf import Body, Closure, Joint, Tree
+from ..tree import Body, Closure, Joint, Tree
 from ..vectors import unit
 from . import (
     AXLE_POINTS,

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..urdf import Body, Tree
+from ..tree import Body, Tree
 from . import (
     AXLE_POINTS,
     COILOVER_POINTS,
