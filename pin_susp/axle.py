@@ -925,8 +925,9 @@ def solve_axle_sweep(model: AxleModel, sweep, source: str | None = None, progres
         ok = np.abs(np.linalg.det(across)) > 0.0
         inverse = np.full_like(across, np.nan)
         inverse[ok] = np.linalg.inv(across[ok])
-        for i, inv in zip(kept, inverse, strict=True):
-            found[i] = found[i][0] @ inv
+        per_target = np.array([found[i][0] for i in kept])
+        for i, tangent in zip(kept, per_target @ inverse, strict=True):
+            found[i] = tangent
     for solution, tangent in zip(solutions, found, strict=True):
         solution.drive_tangent = tangent
     return solutions
@@ -1074,8 +1075,10 @@ def _motion(model: AxleModel, qs: list, solutions: list | None = None) -> dict:
     motion = FrameMotion(model.kin, model.frame_names, model.points, model.design_positions)
     pos, rates = motion(qs, tangent_at, rhs.shape[1], many)
     out = {}
+    # each side's drivers' rates, point by point: (m, k, n, 3), each point's contiguous
+    own = {side: np.ascontiguousarray(np.moveaxis(rates[columns[side]], 2, 0)) for side in SIDES}
     for j, name in enumerate(model.frame_names):
-        out[name] = {side: Dual(pos[:, j], rates[columns[side], :, j]) for side in SIDES}
+        out[name] = {side: Dual(pos[:, j], own[side][j]) for side in SIDES}
     for side, g in model.geometries.items():
         p = {k: out[f"{side}_{k}"] for k in ("wheel_center", "axle_inboard", "axle_outboard")}
         out[f"{side}_contact_patch_center"] = {
