@@ -21,6 +21,9 @@ where there is no rack, against the fixed-toe-link double wishbone) it prints:
   rack, a U-bar) against its corner (examples/pushrod_rocker.yaml), per step,
   measured in alternation: bump + steer on both wheels and a roll sweep (roll
   and heave targets), solve alone and solve with every column (target <= 2.5x);
+- the axle's roll sweep of 2 001 steps with every column against its corner's long
+  sweep (bump + steer, 2 001 steps) with every column, per step, in alternation
+  (target <= 1.3x; ``--axle-long`` runs this figure alone);
 - the member forces under examples/loads.yaml's 3 load cases on the pushrod-rocker
   corner's 101-step sweep, as a share of the sweep's own time (target <= 30 %).
 
@@ -210,6 +213,7 @@ def run(repeat: int, quick: bool) -> dict:
     pairs = [(201, 2001)] if quick else [(2001, 20001), (20001, 100001)]
     report["cli"] = [cli_marginal(pair, 2 if quick else 5) for pair in pairs]
     report["axle"] = axle_vs_corner(max(3, repeat // 2))
+    report["axle_long"] = axle_long(max(3, repeat // 8), 201 if quick else 2001)
     report["loads"] = loads_overhead(max(3, repeat // 4))
     return report
 
@@ -397,12 +401,7 @@ def axle_sweeps(steps: int) -> dict[str, Sweep]:
 def axle_vs_corner(rounds: int, steps: int = 101) -> dict:
     """Per-step time of the example axle over its corner's, in alternation (so that the
     machine's drift cancels): solve alone, and solve with every column."""
-    # the axle's corner as the axle has it: no spring rate (whose rate columns an axle
-    # does not write yet), so that both write the same kind of columns
-    drawn = yaml.safe_load((EXAMPLES / "pushrod_rocker.yaml").read_text())
-    drawn["spring"] = {"type": drawn["spring"]["type"]}
-    drawn["config"]["wheel"].pop("tyre", None)
-    corner = pin_susp.Corner(drawn)
+    corner = axle_corner()
     model = AxleModel(load_axle(EXAMPLES / "axle_front.yaml"))
     reference = bump_steer(steps)
     jobs = {
@@ -420,6 +419,52 @@ def axle_vs_corner(rounds: int, steps: int = 101) -> dict:
         if name.startswith("axle"):
             out["ratio"][name] = t / us[f"corner {name.rsplit(' ', 1)[1]}"]
     return out
+
+
+def axle_corner(drawn_from: str = "pushrod_rocker.yaml"):
+    """The axle's corner as the axle has it: no spring rate (whose rate columns an axle
+    does not write yet), so that both write the same kind of columns."""
+    drawn = yaml.safe_load((EXAMPLES / drawn_from).read_text())
+    drawn["spring"] = {"type": drawn["spring"]["type"]}
+    drawn["config"]["wheel"].pop("tyre", None)
+    return pin_susp.Corner(drawn)
+
+
+def axle_long(rounds: int, steps: int = 2001) -> dict:
+    """The example axle's roll sweep (examples/roll.yaml's −3…3° at design heave, the
+    rack held) of ``steps`` steps with every column, against its corner's long sweep
+    (bump + steer) of as many steps with every column: per step, in alternation in one
+    process (target <= 1.3x, issue 25)."""
+    corner = axle_corner()
+    model = AxleModel(load_axle(EXAMPLES / "axle_front.yaml"))
+    roll = yaml.safe_load((EXAMPLES / "roll.yaml").read_text()) | {"steps": steps}
+    sweep = load_sweep(roll)
+    reference = bump_steer(steps)
+    last = {}
+
+    def axle_whole():
+        last["axle"] = axle_results(model, sweep, solve_axle_sweep(model, sweep))
+
+    def corner_whole():
+        last["corner"] = corner.run_sweep(reference)
+
+    jobs = {
+        "corner solve": lambda: corner.solve_steps(reference),
+        "corner solve + every column": corner_whole,
+        "axle roll solve": lambda: solve_axle_sweep(model, sweep),
+        "axle roll solve + every column": axle_whole,
+    }
+    us = alternating(jobs, rounds, steps)
+    results = last["axle"]
+    return {
+        "steps": steps,
+        "us_per_step": us,
+        "ratio": us["axle roll solve + every column"] / us["corner solve + every column"],
+        "ratio_solve": us["axle roll solve"] / us["corner solve"],
+        "columns": {"axle": len(results.columns), "corner": len(last["corner"].columns)},
+        "converged": bool(results["solver_converged"].all()),
+        "max_residual_mm": float(np.max(results["solver_max_residual"])),
+    }
 
 
 def interleaved(pairs: dict[str, str], rounds: int) -> dict[str, float]:
@@ -540,6 +585,21 @@ def show_axle(axle: dict) -> None:
         print(f"  {name:26s} {us[name]:8.1f} us = {ratio:.2f}x")
 
 
+def show_axle_long(long: dict) -> None:
+    us = long["us_per_step"]
+    print(
+        f"\naxle_front.yaml roll sweep of {long['steps']} steps ({long['columns']['axle']} "
+        f"columns) against its corner's bump + steer of {long['steps']} steps "
+        f"({long['columns']['corner']} columns), per step, measured in alternation:"
+    )
+    for name, t in us.items():
+        print(f"  {name:32s} {t:8.1f} us")
+    print(
+        f"  axle / corner: solve + every column {long['ratio']:.2f}x (target <= 1.3x), "
+        f"solve alone {long['ratio_solve']:.2f}x; max residual {long['max_residual_mm']:.1e} mm"
+    )
+
+
 def show_loads(loads: dict) -> None:
     us = loads["us_per_step"]
     print(
@@ -554,11 +614,20 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=40, help="repetitions per measurement")
     parser.add_argument("--quick", action="store_true", help="few repetitions, small sizes")
     parser.add_argument("--json", metavar="OUT.json", help="also write the figures as JSON")
+    parser.add_argument(
+        "--axle-long",
+        action="store_true",
+        help="only the axle's long roll sweep against its corner's (2 001 steps each)",
+    )
     args = parser.parse_args()
+    if args.axle_long:
+        show_axle_long(axle_long(max(3, args.repeat // 8), 201 if args.quick else 2001))
+        return
     report = run(3 if args.quick else args.repeat, args.quick)
     show(report)
     show_long(report["long"], report["cli"])
     show_axle(report["axle"])
+    show_axle_long(report["axle_long"])
     show_loads(report["loads"])
     if args.json:
         Path(args.json).write_text(json.dumps(report, indent=2, default=float))

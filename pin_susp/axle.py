@@ -16,6 +16,7 @@ import numpy as np
 import pinocchio as pin
 
 from . import __version__
+from .bulk import MIN_STEPS, Frames, rows_of, solve_all, tree_of
 from .constraints import (
     WORLD,
     ContactPatchPoint,
@@ -882,20 +883,41 @@ def solve_axle_sweep(model: AxleModel, sweep, source: str | None = None, progres
         model.model.joints[model.model.getJointId("rack_slide")].idx_v if len(drive) > 2 else None
     )
 
-    def per_driver(tangent: np.ndarray) -> tuple | None:
+    def per_driver(tangent: np.ndarray) -> tuple | list | None:
         """The drivers' rows times the tangent at the solution, J_drive·T (each wheel
         centre's z and the rack; the inverse is taken for all steps at once below). A
-        rigid bar has fewer freedoms than drivers: its per-side rates stay blank."""
-        if tangent.shape[1] != len(drive):
-            return None
+        rigid bar has fewer freedoms than drivers: its per-side rates stay blank. Every
+        step's tangent at once (the sweep solved at once): J_drive·T left to below."""
+        if tangent.shape[-1] != len(drive):
+            return None if tangent.ndim == 2 else [None] * len(tangent)
+        if tangent.ndim == 3:
+            return [(t, None) for t in tangent]
         rows = [pin.getFrameJacobian(model.model, data, f, WORLD)[2] @ tangent for f in frames]
         if rack is not None:
             rows.append(tangent[rack])
         return tangent, np.array(rows)
 
     solutions = march(
-        solver, values, model.q_design, previous, progress, tangents=found, keep=per_driver
+        solver,
+        values,
+        model.q_design,
+        previous,
+        progress,
+        tangents=found,
+        keep=per_driver,
+        bulk=True,
     )
+    at_once = [i for i, f in enumerate(found) if f is not None and f[1] is None]
+    if at_once:  # J_drive·T of every step solved at once, on the model's tree
+        Q = np.array([solutions[i].q for i in at_once])
+        _, J = Frames(tree_of(model.kin), frames).evaluate(Q)
+        T = np.array([found[i][0] for i in at_once])
+        rows = [np.einsum("nv,nvk->nk", Jf[:, 2], T) for Jf in J]
+        if rack is not None:
+            rows.append(T[:, rack])
+        across = np.stack(rows, axis=1)
+        for i, t, a in zip(at_once, T, across, strict=True):
+            found[i] = (t, a)
     # dq per driver from dq per target, T·(J_drive·T)⁻¹, every step's in one call
     kept = [i for i, f in enumerate(found) if f is not None]
     if kept:
@@ -903,8 +925,9 @@ def solve_axle_sweep(model: AxleModel, sweep, source: str | None = None, progres
         ok = np.abs(np.linalg.det(across)) > 0.0
         inverse = np.full_like(across, np.nan)
         inverse[ok] = np.linalg.inv(across[ok])
-        for i, inv in zip(kept, inverse, strict=True):
-            found[i] = found[i][0] @ inv
+        per_target = np.array([found[i][0] for i in kept])
+        for i, tangent in zip(kept, per_target @ inverse, strict=True):
+            found[i] = tangent
     for solution, tangent in zip(solutions, found, strict=True):
         solution.drive_tangent = tangent
     return solutions
@@ -1033,11 +1056,29 @@ def _motion(model: AxleModel, qs: list, solutions: list | None = None) -> dict:
         solver.evaluate(q)
         return solver.tangent(rhs)
 
+    def at_once(Q: np.ndarray, steps: list, placed: tuple) -> np.ndarray | None:
+        """dq per driver at every solved step at once: the sweep's where it has them
+        all, else solved here on the model's tree (bulk.Rows)."""
+        known = [None if solutions is None else solutions[i].drive_tangent for i in steps]
+        if all(t is not None and t.shape[1] == rhs.shape[1] for t in known):
+            return np.array(known)
+        batched = rows_of(solver)
+        if not batched.supported or batched.nrows != model.model.nv:
+            return None
+        zero = np.zeros((len(Q), len(drive)))
+        _, J = batched.evaluate(Q, zero, placed=placed)
+        return solve_all(J, rhs)
+
+    # a long sweep's steps evaluated at once (as its solve, march.solve_sweep); a short
+    # one's one Pinocchio call after another (the numbers it always had, to the last bit)
+    many = at_once if len(qs) >= MIN_STEPS else None
     motion = FrameMotion(model.kin, model.frame_names, model.points, model.design_positions)
-    pos, rates = motion(qs, tangent_at, rhs.shape[1])
+    pos, rates = motion(qs, tangent_at, rhs.shape[1], many)
     out = {}
+    # each side's drivers' rates, point by point: (m, k, n, 3), each point's contiguous
+    own = {side: np.ascontiguousarray(np.moveaxis(rates[columns[side]], 2, 0)) for side in SIDES}
     for j, name in enumerate(model.frame_names):
-        out[name] = {side: Dual(pos[:, j], rates[columns[side], :, j]) for side in SIDES}
+        out[name] = {side: Dual(pos[:, j], own[side][j]) for side in SIDES}
     for side, g in model.geometries.items():
         p = {k: out[f"{side}_{k}"] for k in ("wheel_center", "axle_inboard", "axle_outboard")}
         out[f"{side}_contact_patch_center"] = {

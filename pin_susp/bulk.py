@@ -263,13 +263,21 @@ class Frames:
         """Each frame's position (n, 3) from the joints' placements (Tree.placements)."""
         return [o[j] + _apply(R[j], x) for j, x in zip(self.joint, self.offset, strict=True)]
 
-    def rotations(self, R: np.ndarray) -> list[np.ndarray]:
-        """Each frame's world rotation (n, 3, 3) from the joints' (Tree.placements)."""
-        return [_times(R[j], t) for j, t in zip(self.joint, self.turn, strict=True)]
+    def rotations(self, R: np.ndarray, only=None) -> list:
+        """Each frame's world rotation (n, 3, 3) from the joints' (Tree.placements);
+        ``only``: the indices of the frames wanted (the others None)."""
+        return [
+            _times(R[j], t) if only is None or f in only else None
+            for f, (j, t) in enumerate(zip(self.joint, self.turn, strict=True))
+        ]
 
-    def angular_jacobians(self, a: np.ndarray) -> list[np.ndarray]:
-        """Each frame's angular Jacobian rows (n, 3, nv): its joint's (Tree.axes: a)."""
-        return [self.tree.angular_jacobian(j, a) for j in self.joint]
+    def angular_jacobians(self, a: np.ndarray, only=None) -> list:
+        """Each frame's angular Jacobian rows (n, 3, nv): its joint's (Tree.axes: a);
+        ``only``: the indices of the frames wanted (the others None)."""
+        return [
+            self.tree.angular_jacobian(j, a) if only is None or f in only else None
+            for f, j in enumerate(self.joint)
+        ]
 
     def motion(self, P: list, o: np.ndarray, state) -> tuple[list, list]:
         """Each frame's velocity and classical acceleration (n, 3) in a Tree.motion state."""
@@ -299,6 +307,8 @@ class Rows:
         self.nrows = i
         self.first_target = i - ntargets
         self.angular = any(row.angular for row in rows)
+        # the frames whose rotations and angular Jacobians the angular rows read
+        self.turning = {f for row, k, _ in self.items if row.angular for f in k}
         self.frames = Frames(tree, frames)
 
     def _at(self, q, P, Jp, R) -> ManyFrames:
@@ -306,9 +316,9 @@ class Rows:
         reads them); R: the joints' world rotations (Tree.placements)."""
         rotations = angular = None
         if self.angular:
-            rotations = self.frames.rotations(R)
+            rotations = self.frames.rotations(R, self.turning)
             if Jp is not None:
-                angular = self.frames.angular_jacobians(self.tree.axes(R))
+                angular = self.frames.angular_jacobians(self.tree.axes(R), self.turning)
         return ManyFrames(P, Jp, rotations, angular, q, self.tree.nv)
 
     def evaluate(self, q: np.ndarray, values: np.ndarray, jacobian: bool = True, placed=None):

@@ -303,3 +303,96 @@ def test_a_sweep_with_no_converged_step_gives_empty_cells():
     assert not results["solver_converged"][0]
     assert np.isnan(results["camber"][0]) and np.isnan(results["wheel_center_x"][0])
     assert np.isnan(results["deriv_camber_wrt_hub_z"][0])
+
+
+# ---------------------------------------------------------------- an axle's long sweep
+
+
+def axle_sweeps(steps: int = 401) -> dict:
+    """The example axle's roll (−3…3° at 10 mm of heave, the rack held) and both wheels'
+    bump with the rack moving (its Ackermann defined): point, roll and heave rows."""
+    from pin_susp.sweep import load_sweep
+
+    rack = {"point": "trackrod_inboard", "side": "left", "direction": {"axis": "y"}}
+    wheel = lambda side, a, b: {  # noqa: E731
+        "point": "wheel_center", "side": side, "direction": {"axis": "z"}, "start": a, "stop": b
+    }  # fmt: skip
+    return {
+        "roll": load_sweep(
+            {
+                "steps": steps,
+                "targets": [
+                    {"quantity": "roll", "start": -3, "stop": 3},
+                    {"quantity": "heave", "start": 10, "stop": 10},
+                    rack | {"start": 0, "stop": 0},
+                ],
+            }
+        ),
+        "bump+steer": load_sweep(
+            {
+                "steps": steps,
+                "targets": [
+                    wheel("left", -30, 40),
+                    wheel("right", 20, -25),
+                    rack | {"start": -10, "stop": 10},
+                ],
+            }
+        ),
+    }
+
+
+def axle_step_by_step(monkeypatch):
+    """Make the axle march every step and evaluate its columns one Pinocchio call after
+    another (the reference)."""
+    import pin_susp.axle
+
+    march = marching.march
+    monkeypatch.setattr(pin_susp.axle, "march", lambda *a, **k: march(*a, **{**k, "bulk": False}))
+    monkeypatch.setattr(pin_susp.axle, "MIN_STEPS", 10**9)
+
+
+@pytest.mark.parametrize("kind", ["roll", "bump+steer"])
+def test_an_axle_long_sweep_solved_at_once_equals_the_step_by_step_march(kind, monkeypatch):
+    """Every column of a 401-step axle sweep — each side's metrics and exact derivatives,
+    the roll derivatives, the bar's, the points — solved and evaluated at once equals the
+    same sweep marched and evaluated step by step (to 1e-9), every step converged and on
+    every loop's design assembly (the scalar branch check, step by step), and the sweep
+    took the at-once path: the march saw only the coarse steps."""
+    from pin_susp.axle import AxleModel, axle_results, solve_axle_sweep
+
+    model = AxleModel(EXAMPLES / "axle_front.yaml")
+    sweep = axle_sweeps()[kind]
+    seen = []
+    march = marching.march
+
+    def counting(solver_, values, *args, **kwargs):
+        seen.append(len(values))
+        if kwargs.get("bulk"):
+            counting.solver = solver_
+        return march(solver_, values, *args, **kwargs)
+
+    monkeypatch.setattr(marching, "march", counting)
+    monkeypatch.setattr(pin_susp.axle, "march", counting)
+    solutions = solve_axle_sweep(model, sweep)
+    assert seen[0] == 401 and len(seen) == 2 and seen[1] <= 2 * bulk.COARSE_STEPS
+    assert all(s.converged for s in solutions)
+    guard = counting.solver.branches
+    for s in solutions:
+        model.kin.update(s.q)
+        assert guard.left(model.kin) is None
+    ours = axle_results(model, sweep, solutions)
+    monkeypatch.setattr(marching, "march", march)
+    axle_step_by_step(monkeypatch)
+    reference = axle_results(model, sweep, solve_axle_sweep(model, sweep))
+    assert ours.columns.keys() == reference.columns.keys()
+    for key, expected in reference.columns.items():
+        if key in ("solver_iterations", "solver_max_residual"):
+            continue
+        got, expected = np.asarray(ours.columns[key]), np.asarray(expected)
+        if expected.dtype.kind != "f":
+            np.testing.assert_array_equal(got, expected, err_msg=key)
+            continue
+        np.testing.assert_array_equal(np.isnan(got), np.isnan(expected), err_msg=key)
+        scale = 1.0 + np.nanmax(np.abs(expected), initial=0.0)
+        np.testing.assert_allclose(got, expected, rtol=1e-9, atol=1e-9 * scale, err_msg=key)
+    assert np.max(ours["solver_max_residual"]) <= 1e-9  # mm
