@@ -1,7 +1,7 @@
 """A corner ready to solve: its linkage with the setup applied, sweeps and results.
 
 ``Corner(geometry)`` applies the camber shim and the length adjusters first
-(``setup.apply_setup``): the as-set state is the design state of every sweep.
+(``as_set.apply_setup``): the as-set state is the design state of every sweep.
 The model itself — URDF, Pinocchio model, points, closures — is the
 :class:`~pin_susp.linkage.Linkage`.
 """
@@ -59,9 +59,9 @@ class Corner(Linkage):
         if not isinstance(geometry, Geometry):
             geometry = load_geometry(geometry)
         if apply_setup and geometry.needs_setup:  # shims and adjusters: the as-set
-            from . import setup  # state is the design state
+            from . import as_set  # state is the design state
 
-            geometry = setup.apply_setup(geometry)
+            geometry = as_set.apply_setup(geometry)
         super().__init__(geometry, visuals)
         if warn:
             self._warn_implausible()
@@ -340,7 +340,7 @@ class Results:
             columns[name], units[name] = values, column_unit
         qs = [s.q if s.converged else None for s in solutions]
         if corner.geometry.rated_spring:
-            from .loads import RATE_COLUMNS, rate_columns  # a rated spring's columns
+            from .rates import RATE_COLUMNS, rate_columns  # a rated spring's columns
 
             if only is None or RATE_COLUMNS & set(only):
                 for name, (values, column_unit) in rate_columns(corner, qs).items():

@@ -179,7 +179,7 @@ PUBLIC = {
     "Pose": "metrics",
     "hardpoint_sensitivities": "sensitivity",
     "SetupModel": "setup",
-    "apply_setup": "setup",
+    "apply_setup": "as_set",
     "setup_sheet": "setup",
     "solve_setup": "setup",
     "Sweep": "sweep",
