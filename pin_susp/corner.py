@@ -434,20 +434,9 @@ class Results:
 
         >>> corner.run_sweep("examples/bump_steer.yaml").plot("report.png")
         """
-        from .errors import PinSuspError
-        from .plots import check_image_path
+        from .plots import plot_results  # drawn from the table alone: plots.py knows no model
 
-        check_image_path(path)  # before any work
-        if len(self) == 0 or not np.any(self.columns["solver_converged"]):
-            raise PinSuspError(f"{path}: no step converged: nothing to plot")
-        from .export import csv_text
-        from .plots import ResultsFile, report_figure, save_figure
-
-        name = _file_name(self.meta.get("sweep", ("",))[0]) or "results"
-        written = ResultsFile(name, raw=csv_text(self).encode())
-        if label is not None:
-            written.label = label
-        save_figure(report_figure([written]), path)
+        plot_results(self, path, label)
 
 
 def _file_name(source) -> str:

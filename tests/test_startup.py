@@ -40,6 +40,7 @@ HEAVY = (
     "pin_susp.validate",
     "pin_susp.pointwise",
     "pin_susp.plots",
+    "pin_susp.drawing",
     "pin_susp.viz",
     "pin_susp.axle",
     # a double wishbone's corner loads no other mechanism
