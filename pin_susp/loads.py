@@ -33,6 +33,9 @@ import numpy as np
 
 from .constraints import BallClosure, BarTwist, DistanceClosure, JointTarget, RockerTurn
 from .errors import PinSuspError, PlausibilityWarning
+from .rates import RATE_COLUMNS as RATE_COLUMNS  # the spring's rates (rates.py, below
+from .rates import SpringRates as SpringRates  # the corner), by their old address too
+from .rates import rate_columns as rate_columns
 from .solver import NewtonSolver
 from .sweep import Sweep
 from .yamlio import Reader, load_yaml
