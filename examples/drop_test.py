@@ -10,7 +10,7 @@ spring tendon (the geometry's rate and preload) and its damper, until the corner
 
 pin_susp's static solve of the same load: the wheel travel at which the spring force
 that holds the load (`loads.Statics`, the rack held) is the force the spring has there
-(preload + rate × compression, `loads.SpringRates`).
+(preload + rate × compression, `rates.SpringRates`).
 
     python examples/drop_test.py [GEOMETRY.yaml] [--load N]
 """
@@ -23,8 +23,9 @@ import numpy as np
 from scipy.optimize import brentq
 
 import pin_susp
-from pin_susp.loads import LoadCase, SpringRates, Statics
+from pin_susp.loads import LoadCase, Statics
 from pin_susp.mjcf import tree_to_mjcf
+from pin_susp.rates import SpringRates
 
 HERE = Path(__file__).resolve().parent
 SETTLED = 1e-7  # m/s and rad/s: every joint's speed below this is at rest

@@ -52,7 +52,7 @@ _EXPORTS = {
     "Pose": "metrics",
     "hardpoint_sensitivities": "sensitivity",
     "SetupModel": "setup",
-    "apply_setup": "setup",
+    "apply_setup": "as_set",
     "setup_sheet": "setup",
     "solve_setup": "setup",
     "Sweep": "sweep",
@@ -61,6 +61,7 @@ _EXPORTS = {
 }
 
 if TYPE_CHECKING:  # for type checkers and IDEs; at run time __getattr__ below
+    from .as_set import apply_setup
     from .axle import Axle, AxleModel, AxleResults, load_axle
     from .corner import Corner, Results
     from .errors import InputError, PinSuspError
@@ -68,7 +69,7 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time __getattr__ below
     from .loads import LoadCase, load_cases, member_forces
     from .metrics import METRICS, Pose
     from .sensitivity import hardpoint_sensitivities
-    from .setup import SetupModel, apply_setup, setup_sheet, solve_setup
+    from .setup import SetupModel, setup_sheet, solve_setup
     from .sweep import Sweep, Target, load_sweep
 
 

@@ -266,7 +266,7 @@ class AxleModel:
         self.axle = elements
         self.name = name
         # shims and length adjusters first, per side: the as-set corners (as Corner does)
-        from .setup import apply_setup
+        from .as_set import apply_setup
 
         left, right = apply_setup(left), apply_setup(right)
         self.geometries = dict(zip(SIDES, (left, right), strict=True))
@@ -979,9 +979,9 @@ def axle_results(model: AxleModel, sweep, solutions: list) -> AxleResults:
 
 def _side_rates(model: AxleModel, plain: dict, qs: list) -> dict:
     """Each side's spring force and wheel and ride rates where its rate is given (the
-    corner's, loads.SpringRates, along its own hub z with the rack held: its corner
+    corner's, rates.SpringRates, along its own hub z with the rack held: its corner
     posed at the side's wheel-centre height and the rack's travel at each step)."""
-    from .loads import rate_columns
+    from .rates import rate_columns
 
     out = {}
     rack = model.model.existJointName("rack_slide")

@@ -1,7 +1,7 @@
 """A corner ready to solve: its linkage with the setup applied, sweeps and results.
 
 ``Corner(geometry)`` applies the camber shim and the length adjusters first
-(``setup.apply_setup``): the as-set state is the design state of every sweep.
+(``as_set.apply_setup``): the as-set state is the design state of every sweep.
 The model itself — URDF, Pinocchio model, points, closures — is the
 :class:`~pin_susp.linkage.Linkage`.
 """
@@ -59,9 +59,9 @@ class Corner(Linkage):
         if not isinstance(geometry, Geometry):
             geometry = load_geometry(geometry)
         if apply_setup and geometry.needs_setup:  # shims and adjusters: the as-set
-            from . import setup  # state is the design state
+            from . import as_set  # state is the design state
 
-            geometry = setup.apply_setup(geometry)
+            geometry = as_set.apply_setup(geometry)
         super().__init__(geometry, visuals)
         if warn:
             self._warn_implausible()
@@ -340,7 +340,7 @@ class Results:
             columns[name], units[name] = values, column_unit
         qs = [s.q if s.converged else None for s in solutions]
         if corner.geometry.rated_spring:
-            from .loads import RATE_COLUMNS, rate_columns  # a rated spring's columns
+            from .rates import RATE_COLUMNS, rate_columns  # a rated spring's columns
 
             if only is None or RATE_COLUMNS & set(only):
                 for name, (values, column_unit) in rate_columns(corner, qs).items():
@@ -434,20 +434,9 @@ class Results:
 
         >>> corner.run_sweep("examples/bump_steer.yaml").plot("report.png")
         """
-        from .errors import PinSuspError
-        from .plots import check_image_path
+        from .plots import plot_results  # drawn from the table alone: plots.py knows no model
 
-        check_image_path(path)  # before any work
-        if len(self) == 0 or not np.any(self.columns["solver_converged"]):
-            raise PinSuspError(f"{path}: no step converged: nothing to plot")
-        from .io.tables import csv_text
-        from .plots import ResultsFile, report_figure, save_figure
-
-        name = _file_name(self.meta.get("sweep", ("",))[0]) or "results"
-        written = ResultsFile(name, raw=csv_text(self).encode())
-        if label is not None:
-            written.label = label
-        save_figure(report_figure([written]), path)
+        plot_results(self, path, label)
 
 
 def _file_name(source) -> str:

@@ -113,7 +113,7 @@ class Geometry:
     camber_shim: CamberShim | None = None
     trackrod_length_delta: float = 0.0  # m, config.setup
     pushrod_length_delta: float = 0.0  # m, config.setup
-    # Set on an as-set geometry (setup.apply_setup): the geometry as drawn, and
+    # Set on an as-set geometry (as_set.apply_setup): the geometry as drawn, and
     # the wheel's move relative to the chassis it caused (m, + = car higher).
     drawn: Geometry | None = None
     ride_height_change: float = 0.0

@@ -1,11 +1,12 @@
 """Setup options: camber shim, trackrod and pushrod adjusters, and their inverse.
 
-Forward (``apply_setup``): the shim assembly (``shim.py``) first, then the
-length adjusters on the main mechanism, holding the static load path — the
-rocker at its design angle where there is a pushrod-rocker (the spring keeps
-its static length), otherwise the wheel-centre height — and the rack at its
-design position. The result, the as-set geometry, is the design state of
-every later sweep; ``ride_height_change`` is −ΔCP_z from the drawn design.
+Forward (``apply_setup``, in ``as_set.py`` below the corner, here by name too): the
+shim assembly (``shim.py``) first, then the length adjusters on the main mechanism,
+holding the static load path — the rocker at its design angle where there is a
+pushrod-rocker (the spring keeps its static length), otherwise the wheel-centre
+height — and the rack at its design position. The result, the as-set geometry, is
+the design state of every later sweep; ``ride_height_change`` is −ΔCP_z from the
+drawn design.
 
 Exact sensitivities (``SetupModel``): a camber shim of Δt adds a rigid offset
 −Δt·n₀ (in the upright's design frame) between the lower and upper ball
@@ -25,108 +26,20 @@ from dataclasses import dataclass, replace
 import numpy as np
 import pinocchio as pin
 
+from .as_set import PARAMETER_KEYS, as_geometry, static_holds
+from .as_set import apply_setup as apply_setup  # the as-set geometry, by its old address
 from .constraints import (
-    MEASURES,
     DistanceClosure,
     JointTarget,
-    LoopBranch,
-    PointTarget,
-    pick_branch,
 )
 from .errors import InputError
-from .geometry import MM, Geometry, load_geometry
+from .geometry import MM, Geometry
 from .jet import Dual
 from .linkage import Linkage
 from .metrics import METRIC_BY_NAME, STANDARD, PointSet
 from .solver import NewtonSolver
 
 PARAMETERS = ("shim_thickness", "trackrod_length", "pushrod_length")
-PARAMETER_KEYS = {
-    "shim_thickness": "config.camber_shim.setup_thickness",
-    "trackrod_length": "config.setup.trackrod_length_delta",
-    "pushrod_length": "config.setup.pushrod_length_delta",
-}
-Z = np.array([0.0, 0.0, 1.0])
-
-
-def apply_setup(g) -> Geometry:
-    """The as-set geometry: shim, then adjusters. Unchanged (the same object) when
-    the setup equals the design. ``g``: a path, a dict or a Geometry."""
-    g = _geometry(g)
-    if not g.needs_setup:
-        return g
-    hardpoints = dict(g.hardpoints)
-    shim = g.camber_shim
-    if shim is not None and shim.setup_thickness != shim.design_thickness:
-        from .shim import ShimAssembly  # a fitted shim only: a plain sweep needs none
-
-        hardpoints.update(ShimAssembly(g).shimmed_hardpoints())
-        _check_branches(g, hardpoints, PARAMETER_KEYS["shim_thickness"])
-    as_set = replace(g, hardpoints=hardpoints, drawn=g)
-    if g.trackrod_length_delta != 0.0 or g.pushrod_length_delta != 0.0:
-        hardpoints.update(_adjusted_hardpoints(as_set))
-        as_set = replace(as_set, hardpoints=hardpoints)
-    cp_drawn = g.design_points()["contact_patch_center"][2]
-    cp_set = as_set.design_points()["contact_patch_center"][2]
-    return replace(as_set, ride_height_change=-(cp_set - cp_drawn))
-
-
-def _check_branches(drawn: Geometry, hardpoints: dict[str, np.ndarray], key: str) -> None:
-    """The set-up corner must be the drawn mechanism: every loop on its drawn branch."""
-    for loop in drawn.mechanism.tree(drawn).closures:
-        if not loop.branch:
-            continue
-        measure = MEASURES[loop.branch_kind]
-        points, before = pick_branch(loop.branch_candidates, measure, lambda n: drawn.hardpoints[n])
-        after = measure(*(hardpoints[n] for n in points))
-        if abs(before) >= LoopBranch.DEGENERATE and before * after <= 0.0:
-            raise InputError(
-                drawn.source,
-                key,
-                f"the corner assembles this way only with the {loop.name} loop flipped over "
-                "(another assembly branch): beyond the linkage's reach",
-            )
-
-
-def _adjusted_hardpoints(g: Geometry) -> dict[str, np.ndarray]:
-    """Apply the trackrod/pushrod length changes with the static load path held."""
-    corner = Linkage(g)
-    delta = {
-        "trackrod": g.trackrod_length_delta,
-        "toe_link": g.trackrod_length_delta,
-        "pushrod": g.pushrod_length_delta,
-    }
-    closures = [
-        DistanceClosure(c.name, c.a, c.b, c.length + delta.get(c.name, 0.0))
-        if isinstance(c, DistanceClosure)
-        else c
-        for c in corner.closures
-    ]
-    solver = NewtonSolver(corner.kin, closures, _holds(corner, corner.q_design), corner.branches)
-    solution = solver.newton(corner.q_design)
-    if not solution.converged:
-        key = "trackrod_length_delta" if g.pushrod_length_delta == 0.0 else "pushrod_length_delta"
-        raise InputError(
-            g.source,
-            f"config.setup.{key}",
-            f"the corner does not assemble with these lengths ({solution.why}): "
-            "beyond the linkage's reach",
-        )
-    positions = corner.positions(solution.q)
-    return {name: positions[name] for name in g.hardpoints}
-
-
-def _holds(corner, q_static: np.ndarray) -> list:
-    """The static load path: rack at design; rocker at design, else wheel-centre height."""
-    holds = []
-    if corner.geometry.steering == "rack":
-        holds.append(JointTarget(corner.model, "rack_slide"))
-    if corner.geometry.has_pushrod:
-        holds.append(JointTarget(corner.model, "rocker_pivot"))
-    else:
-        wc = corner.positions(q_static)["wheel_center"][2]
-        holds.append(PointTarget(corner.points["wheel_center"], Z, wc))
-    return holds
 
 
 def setup_values(g: Geometry) -> np.ndarray:
@@ -169,7 +82,7 @@ class SetupModel:
     """The drawn corner with the setup p as parameters: static state and dq/dp."""
 
     def __init__(self, g):
-        g = _geometry(g)
+        g = as_geometry(g)
         self.drawn = g.drawn or g
         self.corner = Linkage(self.drawn)
         c = self.corner
@@ -239,7 +152,7 @@ class SetupModel:
             elif x.name == "pushrod":
                 x = DistanceClosure(x.name, x.a, x.b, length1 + p[2])
             closures.append(x)
-        s2 = NewtonSolver(kin, closures, _holds(c, q1), c.branches)
+        s2 = NewtonSolver(kin, closures, static_holds(c, q1), c.branches)
         key = PARAMETER_KEYS["pushrod_length" if p[2] else "trackrod_length"]
         q2 = self._solve(s2, q1, key, "the corner does not assemble with these lengths")
         s2.evaluate(q2)
@@ -308,11 +221,6 @@ TARGET_PARAMETER = {"camber": 0, "roadwheel_angle": 1, "ride_height_change": 2}
 TARGET_ALIASES = {"toe": "roadwheel_angle", "ride_height": "ride_height_change"}
 
 
-def _geometry(g) -> Geometry:
-    """A Geometry from a path, a dict or a Geometry (as Corner accepts)."""
-    return g if isinstance(g, Geometry) else load_geometry(g)
-
-
 def _targets(targets: dict[str, float]) -> dict[str, float]:
     """Target names as the CLI says them (``toe``, ``ride-height-change``) or as columns."""
     out = {}
@@ -363,7 +271,7 @@ def solve_setup(g, targets: dict[str, float], max_iterations: int = 25) -> Inver
     to their wanted static values; each moves its own adjuster (shim,
     trackrod, pushrod). Newton with exact sensitivities.
     """
-    g = _geometry(g)
+    g = as_geometry(g)
     targets = _targets(targets)
     drawn = g.drawn or g
     for name in targets:
@@ -464,7 +372,7 @@ def setup_sheet(
     fitted stack thicknesses; ``trackrod`` and ``pushrod`` list length deltas.
     Each row changes that one value from the file's setup.
     """
-    g = _geometry(g)
+    g = as_geometry(g)
     drawn = g.drawn or g
     if shim and drawn.camber_shim is None:
         raise InputError(drawn.source, "config.camber_shim", "--shim needs a camber shim")

@@ -241,8 +241,8 @@ def test_tree_velocities_and_accelerations_match_pinocchio(name):
 def test_spring_length_and_its_rates_at_once_equal_each_pose_alone(geometry):
     """The spring's length (a torsion bar's wind-up), motion ratio and its rate — the
     second-order closure solve — for every step at once, against Pinocchio's
-    forwardKinematics(q, v, a) one pose at a time (loads.SpringRates.derivatives)."""
-    from pin_susp.loads import SpringRates
+    forwardKinematics(q, v, a) one pose at a time (rates.SpringRates.derivatives)."""
+    from pin_susp.rates import SpringRates
 
     corner = pin_susp.Corner(geometry, warn=False)
     solutions = corner.solve_steps(long_sweep(corner, steps=61))

@@ -33,12 +33,8 @@ from pathlib import Path
 PACKAGE = Path(__file__).resolve().parents[1] / "pin_susp"
 ROOT = "pin_susp"
 
-# Today's import circles, by the modules in each (names below pin_susp).
-CIRCLES = {
-    # the corner builds its loads, setup and plots; they build corners and axles (and
-    # the plots and the 3D view draw axles, which draw through them)
-    frozenset({"axle", "corner", "loads", "plots", "setup", "viz"}),
-}
+# Today's import circles, by the modules in each (names below pin_susp): none.
+CIRCLES: set[frozenset[str]] = set()
 
 # Today's private names taken across modules: (importer, source module, name) — none.
 PRIVATE: set[tuple[str, str, str]] = set()
@@ -255,6 +251,43 @@ def test_import_circles_are_the_declared_ones():
             "tests/test_layers.py:\n" + _listing(gone)
         )
     assert not message, "\n".join(message) + "\ntoday's circles:\n" + _listing(found)
+
+
+def reach(edges: dict[str, set[str]], start: str) -> set[str]:
+    """Every module that ``start`` imports, directly or through others (itself left out)."""
+    seen, todo = set(), [start]
+    while todo:
+        for w in edges.get(todo.pop(), ()):
+            if w not in seen:
+                seen.add(w)
+                todo.append(w)
+    return seen - {start}
+
+
+# The model's modules and what stands above them: a model module reaches none of these,
+# at any depth (function-level imports included). The corner and the axle are built on
+# the as-set geometry (as_set.py) and write the rated spring's columns (rates.py); the
+# setup's analyses, the loads, the drawings and the 3D view build on them.
+MODEL = ("linkage", "as_set", "rates", "corner", "axle")
+ABOVE_MODEL = ("setup", "loads", "sensitivity", "drawing", "viz", "validate", "study", "cli")
+# The report drawn from a results table (``Results.plot``) knows no model.
+MODEL_FREE = {"plots": ("linkage", "corner", "axle", "constraints", "solver")}
+
+
+def test_the_model_reaches_no_analysis_and_the_report_no_model():
+    edges = graph(imports())
+    wrong = []
+    for low in MODEL:
+        above = {_short(m) for m in reach(edges, f"{ROOT}.{low}")}
+        hit = sorted(m for m in above if m.split(".")[0] in ABOVE_MODEL)
+        if hit:
+            wrong.append(f"{low} reaches {', '.join(hit)}")
+    for free, model in MODEL_FREE.items():
+        below = {_short(m) for m in reach(edges, f"{ROOT}.{free}")}
+        hit = sorted(m for m in below if m.split(".")[0] in model)
+        if hit:
+            wrong.append(f"{free} reaches {', '.join(hit)}")
+    assert not wrong, "\n".join(wrong)
 
 
 def test_private_names_taken_across_modules_are_the_declared_ones():

@@ -221,8 +221,8 @@ def test_five_steps_do_not_jump_the_toggle_that_many_steps_cannot_pass(tmp_path,
 
 
 def test_setup_refuses_an_as_set_corner_on_another_branch():
+    from pin_susp.as_set import check_branches
     from pin_susp.errors import InputError
-    from pin_susp.setup import _check_branches
 
     g = pin_susp.load_geometry(EXAMPLES / "double_wishbone.yaml")
     points = dict(g.hardpoints)
@@ -236,8 +236,8 @@ def test_setup_refuses_an_as_set_corner_on_another_branch():
     d = points["trackrod_outboard"]
     points["trackrod_outboard"] = d - 2 * ((d - a) @ n) * n
     with pytest.raises(InputError, match="trackrod loop flipped over"):
-        _check_branches(g, points, "config.setup.trackrod_length_delta")
-    _check_branches(g, g.hardpoints, "config.setup.trackrod_length_delta")  # design: fine
+        check_branches(g, points, "config.setup.trackrod_length_delta")
+    check_branches(g, g.hardpoints, "config.setup.trackrod_length_delta")  # design: fine
 
 
 # -- 3. targets along a vector -------------------------------------------------------

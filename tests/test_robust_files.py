@@ -276,7 +276,7 @@ def test_image_endings_are_matplotlibs_and_case_insensitive(tmp_path):
     for ext in ("png", "PNG", "Pdf", "svg", "jpeg"):
         check_image_path(f"out.{ext}")
     assert "png" in FigureCanvasBase.get_supported_filetypes()
-    drawing = pin_susp.plots.drawing_figure(pin_susp.Corner(EXAMPLES / "double_wishbone.yaml"))
+    drawing = pin_susp.drawing.drawing_figure(pin_susp.Corner(EXAMPLES / "double_wishbone.yaml"))
     save_figure(drawing, tmp_path / "d.PNG")
     assert (tmp_path / "d.PNG").read_bytes()[:4] == b"\x89PNG"
 

@@ -40,6 +40,7 @@ HEAVY = (
     "pin_susp.validate",
     "pin_susp.pointwise",
     "pin_susp.plots",
+    "pin_susp.drawing",
     "pin_susp.viz",
     "pin_susp.axle",
     # a double wishbone's corner loads no other mechanism
@@ -179,7 +180,7 @@ PUBLIC = {
     "Pose": "metrics",
     "hardpoint_sensitivities": "sensitivity",
     "SetupModel": "setup",
-    "apply_setup": "setup",
+    "apply_setup": "as_set",
     "setup_sheet": "setup",
     "solve_setup": "setup",
     "Sweep": "sweep",

@@ -24,8 +24,8 @@ import pin_susp
 from pin_susp.axle import AxleModel, load_axle
 from pin_susp.cli import main
 from pin_susp.errors import PinSuspError
-from pin_susp.loads import RATE_COLUMNS
 from pin_susp.mjcf import tree_to_mjcf
+from pin_susp.rates import RATE_COLUMNS
 from pin_susp.urdf import read_closures
 from pin_susp.validate import (
     CornerScope,

@@ -14,7 +14,8 @@ from conftest import EXAMPLES, example, mirrored, sweep_csv
 
 import pin_susp
 from pin_susp.cli import main
-from pin_susp.plots import ResultsFile, drawing_figure, panels, report_figure
+from pin_susp.drawing import drawing_figure
+from pin_susp.plots import ResultsFile, panels, report_figure
 
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 

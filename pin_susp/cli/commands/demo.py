@@ -91,8 +91,9 @@ def _demo_pictures(corner, results, files, csv: str) -> None:
     import contextlib
     import io
 
+    from ...drawing import drawing_figure
     from ...io.atomic import write_text
-    from ...plots import ResultsFile, drawing_figure, report_figure, save_figure
+    from ...plots import ResultsFile, report_figure, save_figure
     from ...viz import CornerScene
 
     written = ResultsFile(files["results"], raw=csv.encode())

@@ -66,8 +66,9 @@ def _step(args) -> tuple[str, str | None]:
 
 def run(args) -> int:
     from ...corner import Corner
+    from ...drawing import axle_drawing_figure, axle_pose, drawing_figure
     from ...geometry import load_geometry
-    from ...plots import ResultsFile, axle_drawing_figure, axle_pose, drawing_figure, save_figure
+    from ...plots import ResultsFile, save_figure
 
     check_outputs(args, args.output)
     check_image(args.output)
