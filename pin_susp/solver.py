@@ -245,6 +245,7 @@ class _Batch:
         self.angular = any(row.angular for row in rows)
         self.fixed = [model.frames[f].parentJoint == 0 for f in self.frames]
         self.zero6 = np.zeros((6, model.nv))
+        self.one_freedom = model.nv == 1
         self.at = StepFrames(self.fixed)
 
     def fill(self, kin: Kinematics, q: np.ndarray, r: np.ndarray, J: np.ndarray | None) -> None:
@@ -260,6 +261,8 @@ class _Batch:
                 self.zero6 if fixed else pin.getFrameJacobian(model, data, f, WORLD)
                 for f, fixed in zip(self.frames, self.fixed, strict=True)
             ]
+            if self.one_freedom:  # Pinocchio gives a 6-vector when nv = 1: one column
+                J6 = [j.reshape(6, 1) for j in J6]
             at.J6 = J6
             at.Jp = [j[:3] for j in J6]
         for row, k, i in self.rows:

@@ -184,3 +184,21 @@ def test_a_target_rows_batched_value_is_its_column():
 
 def test_the_closures_module_is_gone():
     assert not Path(pin_susp.__file__).with_name("closures.py").exists()
+
+
+def test_a_contact_patch_target_on_a_one_freedom_corner():
+    """A trailing arm (nv = 1: Pinocchio's frame Jacobians come as 6-vectors) held by a
+    target on its contact patch along a tilted direction — a derived point's fast form
+    on a one-column Jacobian (found by the fuzzer: it raised). Every step meets its
+    target, recomputed from the results' own contact-patch columns."""
+    corner = pin_susp.Corner(EXAMPLES / "semi_trailing_arm.yaml")
+    assert corner.model.nv == 1
+    d = np.array([0.23, 0.0, 1.0]) / np.hypot(0.23, 1.0)
+    values = np.linspace(-20.0, 20.0, 15)
+    sweep = {"steps": 15, "targets": [{"point": "contact_patch_center",
+             "direction": {"vector": [0.23, 0.0, 1.0]}, "start": -20.0, "stop": 20.0}]}  # fmt: skip
+    results = corner.run_sweep(sweep)
+    assert results["solver_converged"].all()
+    cp = np.column_stack([results[f"contact_patch_center_{a}"] for a in "xyz"])  # mm
+    design = corner.geometry.design_points()["contact_patch_center"] * 1e3
+    np.testing.assert_allclose((cp - design) @ d, values, rtol=0, atol=1e-9)
