@@ -21,7 +21,8 @@ class Assembly:
     ``name``: its name in the file; ``anti_roll_rigid``: whether an anti-roll bar locks
     the corners together (then each wheel's own height is no driver); ``streams``:
     whether a long sweep can be solved and written a chunk at a time
-    (``run_sweep_chunks``).
+    (``run_sweep_chunks``); ``poses_at_steps``: whether ``pin-susp urdf --at`` can
+    write the joint values of one of its sweep's steps.
     """
 
     labels: tuple[str, ...]
@@ -30,6 +31,7 @@ class Assembly:
     name: str
     anti_roll_rigid: bool = False
     streams: bool = False
+    poses_at_steps: bool = False
 
     @staticmethod
     def suffix(label: str) -> str:

@@ -44,6 +44,7 @@ class Corner(Linkage, Assembly):
 
     labels = ("",)
     streams = True  # run_sweep_chunks
+    poses_at_steps = True  # urdf --at SWEEP:STEP
 
     @property
     def corners(self) -> dict[str, Geometry]:

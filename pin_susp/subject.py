@@ -19,6 +19,18 @@ def is_axle_file(path) -> bool:
     return data.get("scope") == "axle"
 
 
+def subject_class(path) -> type[Assembly]:
+    """The class a geometry file's subject is (Corner or AxleModel), before it is built:
+    what it can do (``poses_at_steps``, ...) said before any work."""
+    if is_axle_file(path):
+        from .axle import AxleModel
+
+        return AxleModel
+    from .corner import Corner
+
+    return Corner
+
+
 def load_subject(path) -> Assembly:
     """The subject of a geometry file, set up: a Corner (its shim and adjusters applied)
     or an AxleModel (both corners as set, the axle's shared elements)."""

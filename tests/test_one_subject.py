@@ -13,7 +13,7 @@ fails; one removed must leave the list too. The ways of asking:
 - the geometry file's ``scope`` compared (``data.get("scope") == "axle"``), or any
   value compared to ``"axle"`` or ``"corner"``;
 - an axle's elements tested for (``model.axle is None``, ``axle is not None``);
-- a call of ``is_axle`` (or its definition);
+- a call of ``is_axle`` or ``is_axle_file`` (or a definition of ``is_axle``);
 - the number of a subject's corners compared (``len(subject.labels) > 1``): a twin
   still chosen by kind, only spelt through the labels.
 
@@ -39,16 +39,13 @@ KIND_WORDS = {"axle", "corner"}
 # Today's places, by file (below pin_susp/): a ratchet that only goes down.
 KIND_TESTS = {
     "as_set.py": 1,  # isinstance(g, Geometry): a path or a Geometry
-    "cli/commands/draw.py": 1,
-    "cli/commands/loads.py": 2,
-    "cli/commands/mjcf.py": 1,
-    "cli/commands/sensitivity.py": 2,
-    "cli/commands/setup.py": 1,
-    "cli/commands/sweep.py": 1,
-    "cli/commands/urdf.py": 1,
-    "cli/commands/validate.py": 1,
-    "cli/commands/view.py": 2,
-    "cli/options.py": 2,
+    "cli/commands/draw.py": 1,  # the axle's front view, a twin
+    "cli/commands/loads.py": 1,  # an axle's load cases: a block per side
+    "cli/commands/sensitivity.py": 1,  # the axle's sensitivities, a twin
+    "cli/commands/setup.py": 1,  # the axle's setup sheet, a twin
+    "cli/commands/sweep.py": 1,  # the axle's printed summary, a twin
+    "cli/commands/validate.py": 1,  # the roll centre's tolerance, said
+    "cli/commands/view.py": 1,  # an axle's replay warns no transmission
     "drawing.py": 1,
     "geometry.py": 2,  # the corner file's reader: its own scope key (an axle's file refused)
     "loads.py": 3,
@@ -119,8 +116,8 @@ def kind_tests_in(tree: ast.AST) -> list[tuple[int, str]]:
                 a = node.args[1]
                 if isinstance(a, ast.Constant) and a.value in ONE_KIND_ATTRIBUTES:
                     found.append((node.lineno, f"{name}(…, {a.value!r})"))
-            elif name == "is_axle":
-                found.append((node.lineno, "is_axle(…)"))
+            elif name in ("is_axle", "is_axle_file"):
+                found.append((node.lineno, f"{name}(…)"))
         elif isinstance(node, ast.Compare):
             sides = [node.left, *node.comparators]
             ops = node.ops
@@ -193,7 +190,7 @@ h = data["scope"] != "corner"
 i = kind == "axle"
 j = model.axle is not None
 k = axle is None
-l = is_axle(path)
+l = is_axle_file(path)
 m = len(subject.labels) > 1
 # none of these
 n = isinstance(m, dict)
