@@ -12,6 +12,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from .assembly import Assembly
 from .constraints import PointTarget
 from .errors import InputError
 from .geometry import Geometry, load_geometry, summary_repr, warn_outside
@@ -24,7 +25,7 @@ from .sweep import Sweep, Target, check_held, load_sweep
 CHUNK = 10_000  # steps solved and written at a time by a streamed sweep
 
 
-class Corner(Linkage):
+class Corner(Linkage, Assembly):
     """One suspension corner: geometry (as set), URDF, Pinocchio model, sweeps.
 
     >>> corner = Corner("examples/double_wishbone.yaml")  # a path, a dict or a Geometry
@@ -37,8 +38,25 @@ class Corner(Linkage):
     >>> results.to_pandas()  # a DataFrame, a row per step; results.plot("report.png")
 
     ``corner.geometry`` is the as-set Geometry, in m (``geometry.hardpoints_mm`` in
-    mm); ``corner.design_positions`` every point at design, in m.
+    mm); ``corner.design_positions`` every point at design, in m. As an Assembly
+    (assembly.py) it is one corner, labelled ``""``: its columns and points unsuffixed.
     """
+
+    labels = ("",)
+    streams = True  # run_sweep_chunks
+    poses_at_steps = True  # urdf --at SWEEP:STEP
+
+    @property
+    def corners(self) -> dict[str, Geometry]:
+        return {"": self.geometry}
+
+    @property
+    def source(self) -> str:
+        return self.geometry.source
+
+    @property
+    def name(self) -> str:
+        return self.geometry.name
 
     def __repr__(self) -> str:
         def parts():
@@ -143,9 +161,17 @@ class Corner(Linkage):
         ``progress(i, n)``: called after each step."""
         if not isinstance(sweep, Sweep):
             sweep = load_sweep(sweep)
+        return self.solve_sweep(sweep, progress)[1]
+
+    def solve_sweep(self, sweep: Sweep, progress=None) -> tuple[list[Solution], Results]:
+        """Every step solved: the solutions and their results (run_sweep's)."""
         tangents = []
         solutions = self.solve_steps(sweep, progress, tangents=tangents)
-        return Results.from_solutions(self, solutions, sweep, tangents or None)
+        return solutions, Results.from_solutions(self, solutions, sweep, tangents or None)
+
+    def check_sweep(self, sweep: Sweep) -> None:
+        """The sweep's target errors, before any work (solver_for's)."""
+        self.solver_for(sweep.targets, sweep.source)
 
     def run_sweep_chunks(self, sweep: Sweep | str | dict, rows: int = CHUNK, progress=None):
         """The sweep's Results ``rows`` steps at a time (each chunk's ``step_index``

@@ -498,7 +498,7 @@ def _posed_visuals(model, q) -> list:
 def _roll_centre_construction(ax, model, q, sides) -> tuple[bool, list[np.ndarray]]:
     """Each side's FVIC construction and the crossing of the contact-patch lines, the
     roll centre; whether it was drawn, and the points (mm) the view should keep."""
-    from .axle import roll_centre
+    from .vectors import roll_centre
 
     # with the rates (solved here): a mechanism's FVIC may come from its twist
     motion = model.motion([q])

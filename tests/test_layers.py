@@ -455,7 +455,7 @@ LAYERS = (
     ("metrics", ("metrics",)),  # the metric functions of points, their registry
     ("solve", ("solver", "bulk", "march", "urdf", "linkage", "shim", "as_set")),
     ("columns", ("rates",)),  # a rated spring's columns, from the solve's rates
-    ("subjects", ("corner", "axle")),
+    ("subjects", ("assembly", "corner", "axle", "subject")),
     ("analyses", ("setup", "loads", "sensitivity", "pointwise")),
     (
         "outputs",

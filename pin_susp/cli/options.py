@@ -1,7 +1,7 @@
 """The arguments the commands share and their checks: the parser (usage errors on one
-line), numbers, finite and positive values, counts, the GEOMETRY argument (and whether
-it is an axle's), a run's GEOMETRY SWEEP -o OUT arguments, and the output paths checked
-before any work (writable, each its own file, none of them an input)."""
+line), numbers, finite and positive values, counts, the GEOMETRY argument, a run's
+GEOMETRY SWEEP -o OUT arguments, and the output paths checked before any work
+(writable, each its own file, none of them an input)."""
 
 from __future__ import annotations
 
@@ -88,20 +88,6 @@ def run_arguments(parser, output: str, plot: str, cases: bool = False) -> None:
     )
     parser.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
     parser.add_argument("--plot", metavar="OUT.png", help=plot)
-
-
-def is_axle(path) -> bool:
-    """Whether a geometry file is an axle's (scope: axle)."""
-    from ..yamlio import load_yaml
-
-    data, _, _ = load_yaml(path)
-    return data.get("scope") == "axle"
-
-
-def axle_model(path):
-    from ..axle import AxleModel, load_axle
-
-    return AxleModel(load_axle(path))
 
 
 def check_image(path) -> None:

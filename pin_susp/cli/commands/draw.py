@@ -13,7 +13,7 @@ import re
 import sys
 
 from ...errors import PinSuspError
-from ..options import axle_model, check_image, check_outputs, geometry_argument, is_axle
+from ..options import check_image, check_outputs, geometry_argument
 
 DESCRIPTION = (
     "Draw GEOMETRY at its design (as-set) state in front and side view, with "
@@ -69,6 +69,7 @@ def run(args) -> int:
     from ...drawing import axle_drawing_figure, axle_pose, drawing_figure
     from ...geometry import load_geometry
     from ...plots import ResultsFile, save_figure
+    from ...subject import is_axle_file, load_subject
 
     check_outputs(args, args.output)
     check_image(args.output)
@@ -77,8 +78,8 @@ def run(args) -> int:
         path, _, step = at.rpartition(":")
         if not path or not re.fullmatch(r"[0-9]{1,9}", step):
             raise PinSuspError(f"{option} {at}: expected RESULTS.csv:STEP, e.g. axle.csv:15")
-    if is_axle(args.geometry):
-        model = axle_model(args.geometry)
+    if is_axle_file(args.geometry):
+        model = load_subject(args.geometry)
         q, caption = None, "design state"
         if at is not None:
             q, caption = axle_pose(model, ResultsFile(path), int(step))

@@ -5,7 +5,7 @@ compression of each member printed. Its inputs and solve are shared with `view
 
 from __future__ import annotations
 
-from ..options import axle_model, check_image, check_outputs, is_axle, run_arguments
+from ..options import check_image, check_outputs, run_arguments
 from ..report import progress_bar, report_failures
 from .sweep import write_results
 
@@ -58,44 +58,23 @@ def run(args) -> int:
 def load_inputs(geometry, sweep, cases):
     """A corner or an axle, its sweep and load cases, every input error said before any
     work."""
-    from ...corner import Corner
-    from ...geometry import load_geometry
     from ...loads import Statics, load_cases
+    from ...subject import load_subject
     from ...sweep import load_sweep
 
-    if is_axle(geometry):
-        from ...axle import axle_rows
-
-        model = axle_model(geometry)
-        sweep = load_sweep(sweep)
-        cases = load_cases(cases, axle=True)
-        axle_rows(model, sweep.targets, sweep.source)  # target errors before any work
-        Statics(model)  # no load path, or a bar without its stiffness
-        return model, sweep, cases
-    corner = Corner(load_geometry(geometry))
+    subject = load_subject(geometry)
     sweep = load_sweep(sweep)
-    cases = load_cases(cases)
-    corner.solver_for(sweep.targets, sweep.source)  # target errors before any work
-    Statics(corner)  # a corner without a load path
-    return corner, sweep, cases
+    cases = load_cases(cases, axle=len(subject.labels) > 1)  # an axle's: a block per side
+    subject.check_sweep(sweep)  # target errors before any work
+    Statics(subject)  # no load path, or an anti-roll bar without its stiffness
+    return subject, sweep, cases
 
 
 def solve_forces(corner, sweep, cases, quiet: bool):
     """The sweep's results and, at every step and load case, the forces."""
-    from ...corner import Corner, Results
     from ...loads import member_forces
 
-    if not isinstance(corner, Corner):  # an axle
-        from ...axle import axle_results, solve_axle_sweep
-
-        solutions = solve_axle_sweep(corner, sweep, progress=progress_bar(sweep.steps, quiet))
-        results = axle_results(corner, sweep, solutions)
-        return results, member_forces(corner, sweep, cases, solutions, results)
-    tangents = []
-    solutions = corner.solve_steps(
-        sweep, progress=progress_bar(sweep.steps, quiet), tangents=tangents
-    )
-    results = Results.from_solutions(corner, solutions, sweep, tangents or None)
+    solutions, results = corner.solve_sweep(sweep, progress=progress_bar(sweep.steps, quiet))
     return results, member_forces(corner, sweep, cases, solutions, results)
 
 

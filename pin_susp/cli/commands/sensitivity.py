@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from ... import __version__
 from ...errors import PinSuspError
-from ..options import axle_model, check_outputs, count, geometry_argument, is_axle
+from ..options import check_outputs, count, geometry_argument
 from ..report import progress_bar, report_failures
 
 DESCRIPTION = (
@@ -51,10 +51,11 @@ def run(args) -> int:
     from ...corner import Corner
     from ...geometry import load_geometry
     from ...sensitivity import hardpoint_sensitivities, select_points
+    from ...subject import is_axle_file
     from ...sweep import load_sweep
 
     check_outputs(args, args.output)
-    if is_axle(args.geometry):
+    if is_axle_file(args.geometry):
         return _sensitivity_axle(args)
     if args.one_sided:
         raise PinSuspError("--one-sided: a corner has one side (it moves one side of an axle)")
@@ -89,10 +90,11 @@ def _sensitivity_axle(args) -> int:
         axle_sensitivities,
         select_points,
     )
+    from ...subject import load_subject
     from ...sweep import load_sweep
 
-    model = axle_model(args.geometry)
-    if model.axle is not None and model.axle.anti_roll_rigid:
+    model = load_subject(args.geometry)
+    if model.anti_roll_rigid:
         raise PinSuspError(
             f"{args.geometry}: sensitivity: not for an axle with a rigid anti-roll bar yet "
             "(each wheel's height is held, which a rigid bar does not allow)"

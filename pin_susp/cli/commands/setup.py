@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from ... import __version__
 from ...errors import PinSuspError
-from ..options import check_outputs, finite, geometry_argument, is_axle, numbers, positive
+from ..options import check_outputs, finite, geometry_argument, numbers, positive
 from ..report import wrote
 
 DESCRIPTION = (
@@ -106,6 +106,7 @@ def run(args) -> int:
     from ... import setup
     from ...geometry import load_geometry
     from ...io.atomic import all_or_none
+    from ...subject import is_axle_file
 
     check_outputs(args, args.output, args.csv)
     targets = {
@@ -119,7 +120,7 @@ def run(args) -> int:
     }
     if args.output is not None and not targets:
         raise PinSuspError("-o writes a solved setup: give --camber, --toe or --ride-height-change")
-    if is_axle(args.geometry):
+    if is_axle_file(args.geometry):
         return _setup_axle(args, targets)
     if args.side is not None:
         raise PinSuspError(f"--side: {args.geometry} is a corner (--side sets one side of an axle)")

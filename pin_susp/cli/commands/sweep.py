@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import sys
 
-from ..options import axle_model, check_image, check_outputs, is_axle, run_arguments
+from ..options import check_image, check_outputs, run_arguments
 from ..report import Digest, axle_summary, progress_bar, report_failures, summary, warn_transmission
 
 DESCRIPTION = (
@@ -35,23 +35,23 @@ def run(args) -> int:
     check_outputs(args, args.output, args.plot)  # before the numerics are imported
     if args.plot is not None:
         check_image(args.plot)
-    from ...corner import Corner
-    from ...geometry import load_geometry
+    from ...subject import load_subject
     from ...sweep import load_sweep
 
-    if is_axle(args.geometry):
-        return _sweep_axle(args)
-    corner = Corner(load_geometry(args.geometry))
+    subject = load_subject(args.geometry)  # a corner, or an axle: its columns per side
     sweep = load_sweep(args.sweep)
-    corner.solver_for(sweep.targets, sweep.source)  # target errors before any work
-    if sweep.steps > STREAM_STEPS and args.plot is None:
-        return _sweep_streamed(args, corner, sweep)
-    results = corner.run_sweep(sweep, progress=progress_bar(sweep.steps, args.quiet))
+    subject.check_sweep(sweep)  # target errors before any work
+    if subject.streams and sweep.steps > STREAM_STEPS and args.plot is None:
+        return _sweep_streamed(args, subject, sweep)
+    results = subject.run_sweep(sweep, progress=progress_bar(sweep.steps, args.quiet))
     digest = Digest.of(results)
     warn_transmission(digest)
     plot = write_results(args, results)
     if not args.quiet:
-        summary(digest, args.output)
+        if len(subject.labels) > 1:  # an axle's summary: its own columns, each side's main
+            axle_summary(results, digest, args.output)
+        else:
+            summary(digest, args.output)
         if plot:
             print(f"wrote {args.plot}")
     return report_failures(digest)
@@ -113,22 +113,3 @@ def write_results(args, results) -> bool:
     if args.plot is not None and not plot:
         print(f"pin-susp: no step converged: {args.plot} not drawn", file=sys.stderr)
     return plot
-
-
-def _sweep_axle(args) -> int:
-    """An axle's sweep: both corners' columns (suffixed by side) and the axle's."""
-    from ...axle import axle_results, solve_axle_sweep
-    from ...sweep import load_sweep
-
-    model = axle_model(args.geometry)
-    sweep = load_sweep(args.sweep)
-    solutions = solve_axle_sweep(model, sweep, progress=progress_bar(sweep.steps, args.quiet))
-    results = axle_results(model, sweep, solutions)
-    digest = Digest.of(results)
-    warn_transmission(digest)
-    plot = write_results(args, results)
-    if not args.quiet:
-        axle_summary(results, digest, args.output)
-        if plot:
-            print(f"wrote {args.plot}")
-    return report_failures(digest)

@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 
 from ...errors import PinSuspError
-from ..options import axle_model, check_outputs, geometry_argument, is_axle
+from ..options import check_outputs, geometry_argument
 
 DESCRIPTION = (
     "Write the URDF of GEOMETRY: the kinematic tree in metres, every "
@@ -30,9 +30,8 @@ def arguments(parser) -> None:
 
 
 def run(args) -> int:
-    from ...corner import Corner
-    from ...geometry import load_geometry
     from ...io.atomic import all_or_none, is_stream, write_text
+    from ...subject import load_subject, subject_class
 
     if args.at is not None and args.output is None:
         raise PinSuspError("--at writes a sidecar beside the URDF: give -o OUT.urdf too")
@@ -43,12 +42,9 @@ def run(args) -> int:
             raise PinSuspError(f"--at writes a sidecar beside the URDF: {args.output} is a stream")
         sidecar = Path(args.output).with_suffix(".pose.yaml")
         check_outputs(args, args.output, sidecar)
-    if is_axle(args.geometry):
-        if args.at is not None:
-            raise PinSuspError("--at: not for an axle yet (a corner's URDF at a step only)")
-        corner = axle_model(args.geometry)  # the URDF of both corners on one chassis
-    else:
-        corner = Corner(load_geometry(args.geometry))
+    if args.at is not None and not subject_class(args.geometry).poses_at_steps:
+        raise PinSuspError("--at: not for an axle yet (a corner's URDF at a step only)")
+    corner = load_subject(args.geometry)  # an axle's: both corners on one chassis
     pose = _pose_at(corner, args.at) if args.at is not None else None
     if args.output is None:
         sys.stdout.write(corner.urdf)

@@ -5,7 +5,7 @@ engine's verdict."""
 from __future__ import annotations
 
 from ...errors import PinSuspError
-from ..options import axle_model, geometry_argument, is_axle, positive
+from ..options import geometry_argument, positive
 from ..report import report_failures, step_list
 
 DESCRIPTION = (
@@ -49,18 +49,15 @@ def arguments(parser) -> None:
 
 
 def run(args) -> int:
-    from ...corner import Corner
-    from ...geometry import load_geometry
+    from ...subject import load_subject
     from ...sweep import load_sweep
     from ...validate import validate
     from ...yamlio import read_input
 
-    axle = is_axle(args.geometry)
-    corner = axle_model(args.geometry) if axle else Corner(load_geometry(args.geometry))
+    corner = load_subject(args.geometry)
     sweep = load_sweep(args.sweep)
-    if not axle:  # an axle's target errors come from its solve, before any work
-        corner.solver_for(sweep.targets, sweep.source)
-    name = corner.axle.name if axle else corner.geometry.name
+    corner.check_sweep(sweep)  # target errors before any work
+    name = corner.name
     engines = {
         "mujoco": ("pointwise", "mujoco"),
         "drake": ("pointwise", "drake"),
@@ -126,7 +123,9 @@ def run(args) -> int:
             print(f"  {r.engine}: {r.warnings} warnings (first: {r.first_warning})")
         if r.agrees:
             centres = "instant centres also within 1e-9 of their size" + (
-                "; the roll centre of its size times max(1, |RC|/track)" if axle else ""
+                "; the roll centre of its size times max(1, |RC|/track)"
+                if len(corner.labels) > 1  # an axle's roll centre
+                else ""
             )
             print(f"  {r.engine}: agrees within {args.tolerance:g} mm/deg ({centres})")
         elif r.disagree:

@@ -8,7 +8,7 @@ import threading
 from pathlib import Path
 
 from ...errors import PinSuspError
-from ..options import axle_model, check_outputs, geometry_argument, is_axle, positive
+from ..options import check_outputs, geometry_argument, positive
 from ..report import print_warnings, progress_bar, report_failures, warn_transmission
 from .loads import chosen_case, load_inputs, solve_forces
 
@@ -41,9 +41,8 @@ def run(args) -> int:
     import io
     import time
 
-    from ...corner import Corner
-    from ...geometry import load_geometry
     from ...io.atomic import write_text
+    from ...subject import load_subject
     from ...sweep import load_sweep
     from ...viz import Scene, force_caption, force_key, roll_centres, signals_held
 
@@ -58,32 +57,26 @@ def run(args) -> int:
         case = chosen_case(args.cases, cases, args.case)
         results, forces = solve_forces(model, sweep, cases, quiet=False)
         warn_transmission(results)
-        axle = not isinstance(model, Corner)
     else:
-        axle = is_axle(args.geometry)
-        model = axle_model(args.geometry) if axle else Corner(load_geometry(args.geometry))
+        model = load_subject(args.geometry)  # an axle's: both corners and the bar
     if args.sweep is not None and forces is None:
         sweep = load_sweep(args.sweep)
         progress = progress_bar(sweep.steps, False)
-        if axle:  # both corners and the bar
-            from ...axle import axle_results, solve_axle_sweep
-
-            results = axle_results(model, sweep, solve_axle_sweep(model, sweep, progress=progress))
-        else:
-            model.solver_for(sweep.targets, sweep.source)
-            results = model.run_sweep(sweep, progress=progress)
+        model.check_sweep(sweep)  # target errors before any work
+        results = model.run_sweep(sweep, progress=progress)
+        if len(model.labels) == 1:  # a corner's (an axle's replay has not warned so far)
             warn_transmission(results)
     if results is not None:
         qs = [
             q if ok else None
             for q, ok in zip(results.meta["q"], results["solver_converged"], strict=True)
         ]
-        if axle:  # the roll centre, from the results' columns
-            markers = {"roll_centre": roll_centres(results)}
     quiet = io.StringIO()
     with contextlib.redirect_stdout(quiet):  # meshcat announces its server on stdout
         scene = Scene(model)
     try:  # an interrupt before the scene is served is one as in every command: 130, 143
+        if results is not None:  # the scene's markers (an axle's roll centre) at each step
+            markers = {name: roll_centres(results) for name in scene.design_markers}
         colours, caption = None, ""
         if forces is not None:
             colours, scale = scene.force_colours(forces, case)

@@ -1,0 +1,52 @@
+"""What every subject answers alike, a corner or an axle (README, How it works).
+
+A subject is labelled corners and the elements they share (an axle's rack, anti-roll
+bar, heave link). ``labels`` names its corners — a corner's one, ``""``; an axle's,
+``"left"`` and ``"right"`` — and ``corners`` maps each label to its as-set Geometry.
+A column of one corner takes its label as a suffix (``camber_left``), a point as a
+prefix (``left_wheel_center``); a corner's empty label adds neither. Code that takes
+a subject asks these, never which kind it holds (tests/test_one_subject.py counts the
+places that still do).
+"""
+
+from __future__ import annotations
+
+
+class Assembly:
+    """The surface :class:`~pin_susp.corner.Corner` and
+    :class:`~pin_susp.axle.AxleModel` share.
+
+    ``labels``: the corners' labels, in the order their columns are written;
+    ``corners``: label → the as-set Geometry; ``source``: the file it was read from;
+    ``name``: its name in the file; ``anti_roll_rigid``: whether an anti-roll bar locks
+    the corners together (then each wheel's own height is no driver); ``streams``:
+    whether a long sweep can be solved and written a chunk at a time
+    (``run_sweep_chunks``); ``poses_at_steps``: whether ``pin-susp urdf --at`` can
+    write the joint values of one of its sweep's steps.
+    """
+
+    labels: tuple[str, ...]
+    corners: dict
+    source: str
+    name: str
+    anti_roll_rigid: bool = False
+    streams: bool = False
+    poses_at_steps: bool = False
+
+    @staticmethod
+    def suffix(label: str) -> str:
+        """A column's suffix for a corner's label: ``"_left"``; none for ``""``."""
+        return f"_{label}" if label else ""
+
+    @staticmethod
+    def prefix(label: str) -> str:
+        """A point's prefix for a corner's label: ``"left_"``; none for ``""``."""
+        return f"{label}_" if label else ""
+
+    def check_sweep(self, sweep) -> None:
+        """A sweep's target errors (an InputError naming its file), before any work."""
+        raise NotImplementedError
+
+    def solve_sweep(self, sweep, progress=None) -> tuple[list, object]:
+        """Every step of a Sweep solved: the solutions and the results (run_sweep's)."""
+        raise NotImplementedError
