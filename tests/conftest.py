@@ -1,6 +1,9 @@
 import copy
+import json
 import os
 import stat
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -51,6 +54,32 @@ def sweep_csv(tmp_path: Path, geometry: str, sweep: str, name: str = "results.cs
         main(["sweep", str(EXAMPLES / geometry), str(EXAMPLES / sweep), "-o", str(out), "-q"]) == 0
     )
     return out
+
+
+# Runs pin_susp.cli.main(argv) as the console script would, then writes the names of
+# every imported module (a command's own output stays on stdout).
+RUN_CLI = """
+import json, sys
+from pin_susp.cli import main
+code = main(sys.argv[2:])
+with open(sys.argv[1], "w") as f:
+    json.dump({"exit": code, "modules": sorted(sys.modules)}, f)
+"""
+
+
+def run_cli(tmp_path, *argv: str) -> tuple[int, set[str], subprocess.CompletedProcess]:
+    """One command in a new process, in tmp_path: its exit code and imported modules."""
+    report = tmp_path / "modules.json"
+    proc = subprocess.run(
+        [sys.executable, "-c", RUN_CLI, str(report), *argv],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert report.exists(), proc.stderr
+    data = json.loads(report.read_text())
+    return data["exit"], set(data["modules"]), proc
 
 
 @pytest.fixture(scope="session")

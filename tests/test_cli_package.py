@@ -7,13 +7,10 @@ YAML), draw's step of results named `--from-results`, its old `--at` still worki
 
 import importlib
 import inspect
-import json
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
-from conftest import EXAMPLES
+from conftest import EXAMPLES, run_cli
 
 import pin_susp
 from pin_susp.cli import _parser, main
@@ -50,28 +47,12 @@ REQUIRED = {
     "study": ("s.yaml", "-o", "out"),
 }
 
-# main(argv) in a new process; the names of the command modules it imported
-RUN = """
-import json, sys
-from pin_susp.cli import main
-code = main(sys.argv[2:])
-with open(sys.argv[1], "w") as f:
-    json.dump([code, sorted(m for m in sys.modules if m.startswith("pin_susp.cli."))], f)
-"""
-
 
 def cli_modules(tmp_path, *argv: str) -> tuple[int, list[str], str]:
-    report = tmp_path / "modules.json"
-    proc = subprocess.run(
-        [sys.executable, "-c", RUN, str(report), *argv],
-        cwd=tmp_path,
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
-    assert report.exists(), proc.stderr
-    code, modules = json.loads(report.read_text())
-    return code, [m for m in modules if m.startswith("pin_susp.cli.commands.")], proc.stdout
+    """main(argv) in a new process: its exit code, the command modules it imported and
+    its standard output."""
+    code, modules, proc = run_cli(tmp_path, *argv)
+    return code, sorted(m for m in modules if m.startswith("pin_susp.cli.commands.")), proc.stdout
 
 
 def test_help_lists_every_command_and_imports_none_a_sweep_its_own(tmp_path):

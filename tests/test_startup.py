@@ -17,7 +17,7 @@ import sys
 
 import pytest
 import yaml
-from conftest import EXAMPLES
+from conftest import EXAMPLES, run_cli
 
 import pin_susp
 
@@ -48,31 +48,6 @@ HEAVY = (
     "pin_susp.mechanisms.multilink",
     "pin_susp.mechanisms.trailing_arm",
 )
-
-# Runs pin_susp.cli.main(argv) as the console script would, then writes the names of
-# every imported module (a command's own output stays on stdout).
-RUN = """
-import json, sys
-from pin_susp.cli import main
-code = main(sys.argv[2:])
-with open(sys.argv[1], "w") as f:
-    json.dump({"exit": code, "modules": sorted(sys.modules)}, f)
-"""
-
-
-def run_cli(tmp_path, *argv: str) -> tuple[int, set[str], subprocess.CompletedProcess]:
-    """One command in a new process, in tmp_path: its exit code and imported modules."""
-    report = tmp_path / "modules.json"
-    proc = subprocess.run(
-        [sys.executable, "-c", RUN, str(report), *argv],
-        cwd=tmp_path,
-        capture_output=True,
-        text=True,
-        timeout=300,
-    )
-    assert report.exists(), proc.stderr
-    data = json.loads(report.read_text())
-    return data["exit"], set(data["modules"]), proc
 
 
 def imported(modules: set[str], names) -> list[str]:
