@@ -423,27 +423,13 @@ def _mutate_geometry(draw, data) -> str:
         "degenerate_named degenerate_named"
     ).split()
     kind = draw(st.sampled_from(kinds))
-    if kind == "drop_key":
-        choices = paths(data, lambda n: True)
-        path = draw(st.sampled_from(sorted(choices, key=repr)))
-        del get(data, path[:-1])[path[-1]]
-        return f"drop {'.'.join(map(str, path))}"
     if kind == "drop_hardpoint" and _hardpoint_names(data):
         name = draw(st.sampled_from(_hardpoint_names(data)))
         del data["hardpoints"][name]
         return f"drop hardpoints.{name}"
-    if kind == "unknown_key":
-        maps = [()] + paths(data, lambda n: isinstance(n, dict))
-        path = draw(st.sampled_from(sorted(maps, key=repr)))
-        key = draw(st.sampled_from(UNKNOWN_KEYS))
-        get(data, path)[key] = draw(st.one_of(small(100), wild()))
-        return f"unknown key {key!r} in {'.'.join(map(str, path)) or 'top'}"
-    if kind == "retype":
-        leaves = [p for p in paths(data, _is_leaf) if p[0] != "hardpoints"] or [("name",)]
-        path = draw(st.sampled_from(sorted(leaves, key=repr)))
-        value = draw(st.one_of(wild(), small(100)))
-        put(data, path, value)
-        return f"{'.'.join(map(str, path))} = {value!r}"
+    generic = _mutate_keys(draw, data, kind, UNKNOWN_KEYS)
+    if generic is not None:
+        return generic
     if kind == "wild_coordinate" and _coordinate_paths(data):
         path = draw(st.sampled_from(_coordinate_paths(data)))
         value = draw(wild())
@@ -2242,6 +2228,29 @@ def _mirrored(points: dict) -> dict:
     return out
 
 
+def _mutate_keys(draw, data: dict, kind: str, unknown_keys: tuple) -> str | None:
+    """The moves every input file takes alike — a key dropped, an unknown key added
+    (from ``unknown_keys``), a leaf outside the hardpoints given another type — or None
+    when ``kind`` is none of them. (A corner's and an axle's mutations both use it.)"""
+    if kind == "drop_key":
+        path = draw(st.sampled_from(sorted(paths(data, lambda n: True), key=repr)))
+        del get(data, path[:-1])[path[-1]]
+        return f"drop {'.'.join(map(str, path))}"
+    if kind == "unknown_key":
+        maps = [()] + paths(data, lambda n: isinstance(n, dict))
+        path = draw(st.sampled_from(sorted(maps, key=repr)))
+        key = draw(st.sampled_from(unknown_keys))
+        get(data, path)[key] = draw(st.one_of(small(100), wild()))
+        return f"unknown key {key!r} in {'.'.join(map(str, path)) or 'top'}"
+    if kind == "retype":
+        leaves = [p for p in paths(data, _is_leaf) if p[0] != "hardpoints"] or [("name",)]
+        path = draw(st.sampled_from(sorted(leaves, key=repr)))
+        value = draw(st.one_of(wild(), small(100)))
+        put(data, path, value)
+        return f"{'.'.join(map(str, path))} = {value!r}"
+    return None
+
+
 @st.composite
 def _mutate_axle(draw, data) -> str:
     kinds = (
@@ -2251,22 +2260,9 @@ def _mutate_axle(draw, data) -> str:
     kind = draw(st.sampled_from(kinds))
     ac = data.get("axle_config") if isinstance(data.get("axle_config"), dict) else None
     hp = data.get("hardpoints") if isinstance(data.get("hardpoints"), dict) else {}
-    if kind == "drop_key":
-        path = draw(st.sampled_from(sorted(paths(data, lambda n: True), key=repr)))
-        del get(data, path[:-1])[path[-1]]
-        return f"drop {'.'.join(map(str, path))}"
-    if kind == "unknown_key":
-        maps = [()] + paths(data, lambda n: isinstance(n, dict))
-        path = draw(st.sampled_from(sorted(maps, key=repr)))
-        key = draw(st.sampled_from(UNKNOWN_KEYS + ("config", "side", "droplink")))
-        get(data, path)[key] = draw(st.one_of(small(100), wild()))
-        return f"unknown key {key!r} in {'.'.join(map(str, path)) or 'top'}"
-    if kind == "retype":
-        leaves = [p for p in paths(data, _is_leaf) if p[0] != "hardpoints"] or [("name",)]
-        path = draw(st.sampled_from(sorted(leaves, key=repr)))
-        value = draw(st.one_of(wild(), small(100)))
-        put(data, path, value)
-        return f"{'.'.join(map(str, path))} = {value!r}"
+    generic = _mutate_keys(draw, data, kind, UNKNOWN_KEYS + ("config", "side", "droplink"))
+    if generic is not None:
+        return generic
     if kind == "wild_coordinate" and _axle_coordinate_paths(data):
         path = draw(st.sampled_from(_axle_coordinate_paths(data)))
         value = draw(st.one_of(wild(), small(600)))
