@@ -210,21 +210,26 @@ def test_every_input_kind_is_read_once_from_a_fifo(tmp_path, command):
         assert not writer.is_alive()
 
 
+def three_variants(geometry: str, sweep: str, **more) -> dict:
+    """A 3-variant DOE of the example corner's trackrod end height (±2 mm)."""
+    return {
+        "version": 1,
+        "geometry": geometry,
+        "sweep": sweep,
+        "variables": [{"point": "trackrod_outboard", "axis": "z", "range": [-2, 2]}],
+        "kind": "doe",
+        "doe": {"method": "full_factorial", "levels": 3},
+        "summary": ["roadwheel_angle"],
+        **more,
+    }
+
+
 def test_a_study_reads_its_geometry_and_sweep_once_from_fifos(tmp_path):
     """A study's geometry and sweep through named pipes: the study is checked, solved and
     written as from the files."""
     _fifo(tmp_path / "g.yaml", (EXAMPLES / "double_wishbone.yaml").read_bytes())
     _fifo(tmp_path / "s.yaml", (EXAMPLES / "bump_rack_held.yaml").read_bytes())
-    study = {
-        "version": 1,
-        "geometry": "g.yaml",
-        "sweep": "s.yaml",
-        "variables": [{"point": "trackrod_outboard", "axis": "z", "range": [-2, 2]}],
-        "kind": "doe",
-        "doe": {"method": "full_factorial", "levels": 3},
-        "summary": ["roadwheel_angle"],
-    }
-    write_yaml(tmp_path / "study.yaml", study)
+    write_yaml(tmp_path / "study.yaml", three_variants("g.yaml", "s.yaml"))
     proc = cli(
         "study", "study.yaml", "-o", "out", "--scheduler", "none", "-q", cwd=tmp_path, timeout=60
     )
@@ -245,16 +250,7 @@ def small_study(tmp_path):
     """A 3-variant study of the example corner (its files copied beside it)."""
     for name in ("double_wishbone.yaml", "bump_rack_held.yaml"):
         (tmp_path / name).write_bytes((EXAMPLES / name).read_bytes())
-    study = {
-        "version": 1,
-        "geometry": "double_wishbone.yaml",
-        "sweep": "bump_rack_held.yaml",
-        "variables": [{"point": "trackrod_outboard", "axis": "z", "range": [-2, 2]}],
-        "kind": "doe",
-        "doe": {"method": "full_factorial", "levels": 3},
-        "summary": ["roadwheel_angle"],
-        "batch_size": 1,
-    }
+    study = three_variants("double_wishbone.yaml", "bump_rack_held.yaml", batch_size=1)
     return write_yaml(tmp_path / "study.yaml", study)
 
 
