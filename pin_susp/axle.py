@@ -30,7 +30,7 @@ from .axle_file import (  # noqa: F401 (the axle file's names, as they were)
     load_axle,
     mirror_corner,
 )
-from .bulk import MIN_STEPS, Frames, rows_of, solve_all, tree_of
+from .bulk import MIN_STEPS, Frames, tree_of
 from .compose import compose_tree, prefixed  # noqa: F401 (prefixed: as it was)
 from .constraints import (
     WORLD,
@@ -44,7 +44,7 @@ from .elements import elements_of, rack
 from .elements.anti_roll_bar import AntiRollBar
 from .errors import InputError
 from .geometry import Geometry, summary_repr, unit
-from .linkage import RACK_HELD, Composed, FrameMotion, Linkage, closure_row
+from .linkage import RACK_HELD, Composed, Linkage
 from .march import march
 from .mechanisms import xml_name
 from .solver import NewtonSolver
@@ -81,6 +81,7 @@ class AxleModel(Composed, Assembly):
     """
 
     labels = SIDES
+    motion_at_once_from = MIN_STEPS  # linkage.Composed.label_motion
 
     def __init__(self, left, right: Geometry | None = None, name: str = "axle"):
         elements = None
@@ -104,6 +105,7 @@ class AxleModel(Composed, Assembly):
         self._compose(self.geometries, self.elements, xml_name(name, "axle"), comment)
         self.point_names = self.corner_points
         self.frame_names = [n for n in self.output_points if "contact_patch_center" not in n]
+        self._drivers()
         self.kin.update(self.q_design)
         if elements is not None:
             self._check_determined(elements.source)
@@ -198,7 +200,8 @@ class AxleModel(Composed, Assembly):
         """Every point (prefixed) at each configuration (None: NaN), as a jet.Dual per
         side: its rates along that side's hub z and the rack (or its toe link);
         ``solutions``: the sweep's, whose exact tangents spare a solve per step."""
-        return _motion(self, qs, solutions)
+        tangents = None if solutions is None else [s.drive_tangent for s in solutions]
+        return self.label_motion(qs, tangents)
 
     def side_positions(self, q: np.ndarray, side: str) -> dict[str, np.ndarray]:
         """One corner's points at q, by their corner names."""
@@ -487,72 +490,6 @@ def axle_metric_columns(model: AxleModel, points: dict) -> dict:
     out = {f"{name}_{side}": c for side, cols in sides.items() for name, c in cols.items()}
     plain = {k: v["left"].val for k, v in points.items()}
     return out | _axle_metrics(model, plain, sides) | _roll_rates(model, points, sides)
-
-
-def _motion(model: AxleModel, qs: list, solutions: list | None = None) -> dict:
-    """Every point (prefixed) at every step, as a Dual per side: that side's rates along
-    its wheel-centre z (the other wheel centre and the rack held) and the rack. A
-    step that did not converge is NaN."""
-    from .geometry import contact_patch
-    from .jet import Dual
-
-    drive = _drive_rows(model)
-    rack = len(drive) == 3
-    solver = NewtonSolver(model.kin, model.closures, drive, model.branches)
-    # each side's columns: its hub z, then the rack, or its fixed toe link's length (the
-    # steer of a toe-link corner: a column of 1 on that closure's row, as Linkage's)
-    rhs, columns = solver.unit_rhs, {}
-    for c, (side, g) in enumerate(model.geometries.items()):
-        columns[side] = [c, 2] if rack else [c]
-        if g.steering == "none" and g.steering_points:
-            row = closure_row(model.closures, f"{side}_toe_link")
-            toe = np.zeros((solver.nrows, 1))
-            toe[row] = 1.0
-            columns[side].append(rhs.shape[1])
-            rhs = np.hstack([rhs, toe])
-
-    def tangent_at(i: int, q: np.ndarray) -> np.ndarray:
-        known = None if solutions is None else solutions[i].drive_tangent
-        if known is not None and known.shape[1] == rhs.shape[1]:
-            model.kin.update(q)
-            return known
-        solver.evaluate(q)
-        return solver.tangent(rhs)
-
-    def at_once(Q: np.ndarray, steps: list, placed: tuple) -> np.ndarray | None:
-        """dq per driver at every solved step at once: the sweep's where it has them
-        all, else solved here on the model's tree (bulk.Rows)."""
-        known = [None if solutions is None else solutions[i].drive_tangent for i in steps]
-        if all(t is not None and t.shape[1] == rhs.shape[1] for t in known):
-            return np.array(known)
-        batched = rows_of(solver)
-        if not batched.supported or batched.nrows != model.model.nv:
-            return None
-        zero = np.zeros((len(Q), len(drive)))
-        _, J = batched.evaluate(Q, zero, placed=placed)
-        return solve_all(J, rhs)
-
-    # a long sweep's steps evaluated at once (as its solve, march.solve_sweep); a short
-    # one's one Pinocchio call after another (the numbers it always had, to the last bit)
-    many = at_once if len(qs) >= MIN_STEPS else None
-    motion = FrameMotion(model.kin, model.frame_names, model.points, model.design_positions)
-    pos, rates = motion(qs, tangent_at, rhs.shape[1], many)
-    out = {}
-    # each side's drivers' rates, point by point: (m, k, n, 3), each point's contiguous
-    own = {side: np.ascontiguousarray(np.moveaxis(rates[columns[side]], 2, 0)) for side in SIDES}
-    for j, name in enumerate(model.frame_names):
-        out[name] = {side: Dual(pos[:, j], own[side][j]) for side in SIDES}
-    for side, g in model.geometries.items():
-        p = {k: out[f"{side}_{k}"] for k in ("wheel_center", "axle_inboard", "axle_outboard")}
-        out[f"{side}_contact_patch_center"] = {
-            s: contact_patch(
-                p["wheel_center"][s],
-                unit(p["axle_outboard"][s] - p["axle_inboard"][s]),
-                g.wheel.radius,
-            )
-            for s in SIDES
-        }
-    return out
 
 
 def _roll_rates(model: AxleModel, points: dict, sides: dict) -> dict:

@@ -431,7 +431,7 @@ LONG = {
     "loads.py": 740,  # load-case files, the statics' plan, member forces, summaries
     "plots.py": 850,  # reading results files, the kinematics, axle and force reports
     "validate.py": 1032,  # the point-based, MuJoCo and Drake engines and the comparison
-    "axle.py": 730,  # the axle's model, its sweep and its columns
+    "axle.py": 629,  # the axle's model, its sweep and its columns
     "study.py": 1482,  # study files, variants, batches on Dask, parts, resume, optimisation
 }
 MAX_LINES = 600
