@@ -43,6 +43,13 @@ class Assembly:
         """A point's prefix for a corner's label: ``"left_"``; none for ``""``."""
         return f"{label}_" if label else ""
 
+    @property
+    def blocks(self) -> tuple[str, ...]:
+        """The blocks an input given per corner is in (a load case's ``left:``,
+        ``right:``): one per labelled corner; none for a corner's one, unlabelled (its
+        inputs at the top)."""
+        return tuple(label for label in self.labels if label)
+
     def check_sweep(self, sweep) -> None:
         """A sweep's target errors (an InputError naming its file), before any work."""
         raise NotImplementedError

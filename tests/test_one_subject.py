@@ -40,14 +40,10 @@ KIND_WORDS = {"axle", "corner"}
 KIND_TESTS = {
     "as_set.py": 1,  # isinstance(g, Geometry): a path or a Geometry
     "cli/commands/draw.py": 1,  # the axle's front view, a twin
-    "cli/commands/loads.py": 1,  # an axle's load cases: a block per side
     "cli/commands/sensitivity.py": 1,  # the axle's sensitivities, a twin
     "cli/commands/setup.py": 1,  # the axle's setup sheet, a twin
     "cli/commands/sweep.py": 1,  # the axle's printed summary, a twin
-    "cli/commands/validate.py": 1,  # the roll centre's tolerance, said
-    "cli/commands/view.py": 1,  # an axle's replay warns no transmission
     "drawing.py": 1,
-    "geometry.py": 2,  # the corner file's reader: its own scope key (an axle's file refused)
     "loads.py": 3,
     "plots.py": 1,
     "pointwise.py": 1,
