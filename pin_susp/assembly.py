@@ -22,7 +22,8 @@ class Assembly:
     the corners together (then each wheel's own height is no driver); ``streams``:
     whether a long sweep can be solved and written a chunk at a time
     (``run_sweep_chunks``); ``poses_at_steps``: whether ``pin-susp urdf --at`` can
-    write the joint values of one of its sweep's steps.
+    write the joint values of one of its sweep's steps; ``summary_columns``: the
+    columns a sweep's printed summary shows, in order (None: every metric column).
     """
 
     labels: tuple[str, ...]
@@ -30,6 +31,7 @@ class Assembly:
     source: str
     name: str
     anti_roll_rigid: bool = False
+    summary_columns: tuple[str, ...] | None = None
     streams: bool = False
     poses_at_steps: bool = False
 

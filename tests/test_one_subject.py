@@ -42,7 +42,6 @@ KIND_TESTS = {
     "cli/commands/draw.py": 1,  # the axle's front view, a twin
     "cli/commands/sensitivity.py": 1,  # the axle's sensitivities, a twin
     "cli/commands/setup.py": 1,  # the axle's setup sheet, a twin
-    "cli/commands/sweep.py": 1,  # the axle's printed summary, a twin
     "drawing.py": 1,
     "loads.py": 3,
     "plots.py": 1,
