@@ -199,6 +199,20 @@ s = len(labels) > 1
     assert [line for line, _ in found] == list(range(2, 16)), found
 
 
+def test_both_subjects_answer_what_the_consumers_ask():
+    """What a command asks instead of the kind: the blocks a per-corner input is in
+    (loads' cases) and the columns a sweep's summary shows."""
+    from pin_susp.subject import load_subject
+
+    examples = PACKAGE.parent / "examples"
+    corner = load_subject(examples / "double_wishbone.yaml")
+    axle = load_subject(examples / "axle_front.yaml")
+    assert corner.blocks == () and axle.blocks == ("left", "right")
+    assert corner.summary_columns is None  # every metric column
+    sided = [c for c in axle.summary_columns if c.endswith(tuple(map(axle.suffix, axle.labels)))]
+    assert sided and len(sided) == len(set(sided))
+
+
 if __name__ == "__main__":
     for name, lines in places().items():
         print(f"{name}: {len(lines)}")
