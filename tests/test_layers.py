@@ -426,7 +426,7 @@ LONG = {
     "drawing.py": 602,  # front/side views of a corner and an axle's front view
     "metrics.py": 689,  # the corner metrics, their registry, instant centres, anti geometry
     "sensitivity.py": 692,  # hardpoint sensitivities: virtual joints, corner and axle tables
-    "geometry.py": 712,  # the Geometry data, the geometry file's reader, wheel formulas
+    "geometry.py": 707,  # the Geometry data, the geometry file's reader, wheel formulas
     "viz.py": 731,  # meshcat scene, animation, force colours, the HTML page
     "loads.py": 740,  # load-case files, the statics' plan, member forces, summaries
     "plots.py": 850,  # reading results files, the kinematics, axle and force reports
