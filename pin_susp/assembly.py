@@ -22,7 +22,8 @@ class Assembly:
     the corners together (then each wheel's own height is no driver); ``streams``:
     whether a long sweep can be solved and written a chunk at a time
     (``run_sweep_chunks``); ``poses_at_steps``: whether ``pin-susp urdf --at`` can
-    write the joint values of one of its sweep's steps.
+    write the joint values of one of its sweep's steps; ``summary_columns``: the
+    columns a sweep's printed summary shows, in order (None: every metric column).
     """
 
     labels: tuple[str, ...]
@@ -30,6 +31,7 @@ class Assembly:
     source: str
     name: str
     anti_roll_rigid: bool = False
+    summary_columns: tuple[str, ...] | None = None
     streams: bool = False
     poses_at_steps: bool = False
 
@@ -42,6 +44,13 @@ class Assembly:
     def prefix(label: str) -> str:
         """A point's prefix for a corner's label: ``"left_"``; none for ``""``."""
         return f"{label}_" if label else ""
+
+    @property
+    def blocks(self) -> tuple[str, ...]:
+        """The blocks an input given per corner is in (a load case's ``left:``,
+        ``right:``): one per labelled corner; none for a corner's one, unlabelled (its
+        inputs at the top)."""
+        return tuple(label for label in self.labels if label)
 
     def check_sweep(self, sweep) -> None:
         """A sweep's target errors (an InputError naming its file), before any work."""

@@ -224,6 +224,14 @@ class AxleModel(Composed, Assembly):
         solver = NewtonSolver(self.kin, self.closures, targets, self.branches)
         return solver.solve(q, start, goal)
 
+    # Assembly surface for sweep: its summary's columns, the axle's and each side's main
+    summary_columns = tuple(
+        "heave roll body_roll camber_left camber_right camber_to_ground_left "
+        "camber_to_ground_right roadwheel_angle_left roadwheel_angle_right roll_center_y "
+        "roll_center_z track ride_height_change arb_twist heave_link_length ackermann "
+        "roll_stiffness arb_wheel_rate".split()
+    )
+
 
 Axle = AxleModel  # pin_susp.Axle, as pin_susp.Corner: an axle file → a model to sweep
 

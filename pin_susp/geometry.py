@@ -336,6 +336,20 @@ def warn_outside(what: str, value: float, low: float, high: float, unit_text: st
         )
 
 
+# The scopes of a geometry file (docs/geometry.md), this reader's first; another's:
+# what is said of its file, its own keys, what is said of them in a file without it.
+OTHER_SCOPES = {
+    "axle": (
+        "an axle file: the commands read corner files only so far (the Python API "
+        "reads axles: pin_susp.axle.load_axle)",
+        ("axle_config", "vehicle_config"),
+        "an axle's file (it has {key}) needs scope: axle",
+    ),
+}
+SCOPES = ("corner", *OTHER_SCOPES)
+CORNER_KEYS = ("type", "scope", "side", "name", "version", "units", "actuation", "spring", "config")
+
+
 def parse_geometry(data: dict, r: Reader, sha: str | None) -> Geometry:
     """The Geometry of a geometry file's data (mm) already read, its errors through
     ``r`` (naming the file and key); ``sha`` the file's hash. No plausibility
@@ -343,26 +357,11 @@ def parse_geometry(data: dict, r: Reader, sha: str | None) -> Geometry:
     variants, read from data they hold, warn (or not) for themselves."""
     from . import mechanisms
 
-    if isinstance(data, dict) and data.get("scope") != "axle":
-        for key in ("axle_config", "vehicle_config"):
-            if key in data:
-                r.fail("scope", f"an axle's file (it has {key}) needs scope: axle")
-    r.mapping(
-        data,
-        "",
-        required=("hardpoints",),
-        optional=(
-            "type",
-            "scope",
-            "side",
-            "name",
-            "version",
-            "units",
-            "actuation",
-            "spring",
-            "config",
-        ),
-    )
+    for scope, (_, keys, needs) in OTHER_SCOPES.items() if isinstance(data, dict) else ():
+        declared = data.get("scope")
+        for key in (k for k in keys if k in data and declared != scope):
+            r.fail("scope", needs.format(key=key))
+    r.mapping(data, "", required=("hardpoints",), optional=CORNER_KEYS)
     legacy = data.get("type")
     if isinstance(legacy, str) and legacy.endswith("_axle"):
         r.fail(
@@ -373,13 +372,9 @@ def parse_geometry(data: dict, r: Reader, sha: str | None) -> Geometry:
         )
     kind = r.choice(data.get("type", "double_wishbone"), "type", mechanisms.NAMES)
     mech = mechanisms.get(kind)
-    scope = r.choice(data.get("scope", "corner"), "scope", ("corner", "axle"))
-    if scope != "corner":
-        r.fail(
-            "scope",
-            "an axle file: the commands read corner files only so far (the Python API "
-            "reads axles: pin_susp.axle.load_axle)",
-        )
+    scope = r.choice(data.get("scope", SCOPES[0]), "scope", SCOPES)
+    if scope in OTHER_SCOPES:
+        r.fail("scope", OTHER_SCOPES[scope][0])
     side = r.choice(data.get("side", "left"), "side", ("left", "right"))
     name = r.text(data.get("name", "unnamed corner"), "name")
     if "version" in data:

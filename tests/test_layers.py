@@ -426,12 +426,12 @@ LONG = {
     "drawing.py": 602,  # front/side views of a corner and an axle's front view
     "metrics.py": 689,  # the corner metrics, their registry, instant centres, anti geometry
     "sensitivity.py": 692,  # hardpoint sensitivities: virtual joints, corner and axle tables
-    "geometry.py": 712,  # the Geometry data, the geometry file's reader, wheel formulas
+    "geometry.py": 707,  # the Geometry data, the geometry file's reader, wheel formulas
     "viz.py": 731,  # meshcat scene, animation, force colours, the HTML page
     "loads.py": 740,  # load-case files, the statics' plan, member forces, summaries
     "plots.py": 850,  # reading results files, the kinematics, axle and force reports
     "validate.py": 1032,  # the point-based, MuJoCo and Drake engines and the comparison
-    "axle.py": 629,  # the axle's model, its sweep and its columns
+    "axle.py": 637,  # the axle's model, its sweep and its columns
     "study.py": 1482,  # study files, variants, batches on Dask, parts, resume, optimisation
 }
 MAX_LINES = 600

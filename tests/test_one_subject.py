@@ -40,14 +40,9 @@ KIND_WORDS = {"axle", "corner"}
 KIND_TESTS = {
     "as_set.py": 1,  # isinstance(g, Geometry): a path or a Geometry
     "cli/commands/draw.py": 1,  # the axle's front view, a twin
-    "cli/commands/loads.py": 1,  # an axle's load cases: a block per side
     "cli/commands/sensitivity.py": 1,  # the axle's sensitivities, a twin
     "cli/commands/setup.py": 1,  # the axle's setup sheet, a twin
-    "cli/commands/sweep.py": 1,  # the axle's printed summary, a twin
-    "cli/commands/validate.py": 1,  # the roll centre's tolerance, said
-    "cli/commands/view.py": 1,  # an axle's replay warns no transmission
     "drawing.py": 1,
-    "geometry.py": 2,  # the corner file's reader: its own scope key (an axle's file refused)
     "loads.py": 3,
     "plots.py": 1,
     "pointwise.py": 1,
@@ -202,6 +197,20 @@ s = len(labels) > 1
 """
     found = kind_tests_in(ast.parse(source))
     assert [line for line, _ in found] == list(range(2, 16)), found
+
+
+def test_both_subjects_answer_what_the_consumers_ask():
+    """What a command asks instead of the kind: the blocks a per-corner input is in
+    (loads' cases) and the columns a sweep's summary shows."""
+    from pin_susp.subject import load_subject
+
+    examples = PACKAGE.parent / "examples"
+    corner = load_subject(examples / "double_wishbone.yaml")
+    axle = load_subject(examples / "axle_front.yaml")
+    assert corner.blocks == () and axle.blocks == ("left", "right")
+    assert corner.summary_columns is None  # every metric column
+    sided = [c for c in axle.summary_columns if c.endswith(tuple(map(axle.suffix, axle.labels)))]
+    assert sided and len(sided) == len(set(sided))
 
 
 if __name__ == "__main__":

@@ -245,31 +245,18 @@ def summary(results, path) -> None:
     print("  (every column, derivatives included, is in the CSV)")
 
 
-AXLE_SUMMARY = (
-    "heave",
-    "roll",
-    "body_roll",
-    "camber_left",
-    "camber_right",
-    "camber_to_ground_left",
-    "camber_to_ground_right",
-    "roadwheel_angle_left",
-    "roadwheel_angle_right",
-    "roll_center_y",
-    "roll_center_z",
-    "track",
-    "ride_height_change",
-    "arb_twist",
-    "heave_link_length",
-    "ackermann",
-    "roll_stiffness",
-    "arb_wheel_rate",
-)
+def sweep_summary(results, digest: Digest, path, columns: tuple[str, ...] | None) -> None:
+    """A sweep's printed summary: every metric column (``columns`` None), or those the
+    subject names (Assembly.summary_columns: an axle's own and each side's main)."""
+    if columns is None:
+        summary(digest, path)
+    else:
+        columns_summary(results, digest, path, columns)
 
 
-def axle_summary(results, digest: Digest, path) -> None:
-    """An axle's sweep: its steps and notes, then first, last, min and max of the
-    axle's columns and each side's main ones (every column is in the CSV)."""
+def columns_summary(results, digest: Digest, path, columns: tuple[str, ...]) -> None:
+    """Its steps and notes, then first, last, min and max of ``columns`` (every column
+    is in the CSV)."""
     import numpy as np
 
     ok = results["solver_converged"]
@@ -281,7 +268,7 @@ def axle_summary(results, digest: Digest, path) -> None:
         print(f"  {note}")
     shown = [
         (name, np.asarray(results[name], dtype=float))
-        for name in AXLE_SUMMARY
+        for name in columns
         if name in results.columns and not np.all(np.isnan(results[name]))
     ]
     some = any(np.isnan(v).any() for _, v in shown)  # a blank cell: say at how many steps

@@ -64,7 +64,7 @@ def load_inputs(geometry, sweep, cases):
 
     subject = load_subject(geometry)
     sweep = load_sweep(sweep)
-    cases = load_cases(cases, axle=len(subject.labels) > 1)  # an axle's: a block per side
+    cases = load_cases(cases, axle=bool(subject.blocks))  # a block per labelled corner
     subject.check_sweep(sweep)  # target errors before any work
     Statics(subject)  # no load path, or an anti-roll bar without its stiffness
     return subject, sweep, cases

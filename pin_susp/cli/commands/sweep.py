@@ -8,7 +8,14 @@ from __future__ import annotations
 import sys
 
 from ..options import check_image, check_outputs, run_arguments
-from ..report import Digest, axle_summary, progress_bar, report_failures, summary, warn_transmission
+from ..report import (
+    Digest,
+    progress_bar,
+    report_failures,
+    summary,
+    sweep_summary,
+    warn_transmission,
+)
 
 DESCRIPTION = (
     "Solve every step of SWEEP on GEOMETRY (a corner, or an axle: scope: axle) "
@@ -48,10 +55,7 @@ def run(args) -> int:
     warn_transmission(digest)
     plot = write_results(args, results)
     if not args.quiet:
-        if len(subject.labels) > 1:  # an axle's summary: its own columns, each side's main
-            axle_summary(results, digest, args.output)
-        else:
-            summary(digest, args.output)
+        sweep_summary(results, digest, args.output, subject.summary_columns)
         if plot:
             print(f"wrote {args.plot}")
     return report_failures(digest)

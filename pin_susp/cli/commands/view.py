@@ -64,8 +64,7 @@ def run(args) -> int:
         progress = progress_bar(sweep.steps, False)
         model.check_sweep(sweep)  # target errors before any work
         results = model.run_sweep(sweep, progress=progress)
-        if len(model.labels) == 1:  # a corner's (an axle's replay has not warned so far)
-            warn_transmission(results)
+        warn_transmission(results)  # each corner's rocker and spring, as sweep warns
     if results is not None:
         qs = [
             q if ok else None
