@@ -18,6 +18,7 @@ import pinocchio as pin
 
 from . import __version__
 from .bulk import rows_of, solve_all, tree_of
+from .compose import compose_tree
 from .constraints import (
     BallClosure,
     ContactPatchPoint,
@@ -197,56 +198,180 @@ class FrameMotion:
         return out_pos, out_rates
 
 
-class Linkage:
+class Composed:
+    """Labelled corners and the elements they share as one Pinocchio model at its design
+    state (README, How it works): what a corner (one corner, labelled ``""``) and an
+    axle (``left``, ``right``, with a rack, an anti-roll bar, a heave link) are built as.
+
+    ``_compose`` composes each corner's tree prefixed by its label (compose.compose_tree;
+    a lone corner labelled ``""`` keeps its own tree and names), adds the elements,
+    builds the model (:class:`Built`) and sets: ``tree``, ``urdf``, ``model``, ``kin``,
+    ``points`` (each corner's contact patch included), ``closures``, ``branches``,
+    ``q_design``, ``mobility``, ``dead_centres``, ``corner_points`` (label → its
+    corner's point names, unprefixed), ``output_points`` (every point written: each
+    corner's, with the elements' of its label, then the elements' shared ones) and
+    ``design_positions``.
+    """
+
+    # the shortest set of configurations whose motion is evaluated at once (bulk.py); a
+    # shorter one's one Pinocchio call after another (an axle's: the numbers it always
+    # had, to the last bit — its loads' forces move in the 12th digit otherwise)
+    motion_at_once_from = 0
+
+    def _compose(
+        self, corners: dict, elements=(), name: str = "", comment: str = "", visuals: bool = True
+    ) -> None:
+        self._corners = dict(corners)
+        trees = {label: g.mechanism.tree(g) for label, g in corners.items()}
+        if list(trees) == [""] and not elements:
+            self.tree = trees[""]  # one corner: its own tree
+        else:
+            self.tree = compose_tree(trees, name, elements)
+        # links near dead centre at design (warned when the file was read): the
+        # failure report names them as the cause of steps out of reach
+        self.dead_centres = dead_centres(self.tree)
+        built = Built(self.tree if visuals else replace(self.tree, visuals=[]), comment)
+        self.urdf, self.model, self.kin = built.urdf, built.model, built.kin
+        self.points: dict[str, FramePoint | ContactPatchPoint] = dict(built.points)
+        self.corner_points = {}
+        for label, g in corners.items():
+            p = f"{label}_" if label else ""
+            self.points[f"{p}contact_patch_center"] = ContactPatchPoint(
+                f"{p}contact_patch_center",
+                self.points[f"{p}wheel_center"],
+                self.points[f"{p}axle_inboard"],
+                self.points[f"{p}axle_outboard"],
+                g.wheel.radius,
+                f"{p}{g.mechanism.WHEEL_BODY}",
+            )
+            self.corner_points[label] = tuple(g.hardpoints) + DERIVED_POINTS
+        self.q_design = built.q_design
+        self.closures, self.branches = built.closures, built.branches
+        self.mobility = self.model.nv - sum(c.size for c in self.closures)
+        owned = {
+            (f"{label}_" if label else "") + n
+            for label, names in self.corner_points.items()
+            for n in names
+        }
+        extras = [n for n in self.tree.points if n not in owned]
+        self.output_points = []  # each corner's points, then its elements', then shared
+        prefixes = tuple(f"{label}_" for label in corners if label)
+        for label, names in self.corner_points.items():
+            p = f"{label}_" if label else ""
+            self.output_points += [p + n for n in names]
+            self.output_points += [n for n in extras if label and n.startswith(p)]
+        self.output_points += [n for n in extras if not prefixes or not n.startswith(prefixes)]
+        self.design_positions = self.positions(self.q_design)
+
+    def positions(self, q: np.ndarray) -> dict[str, np.ndarray]:
+        """World position (m) of every named point (prefixed by its label) at q."""
+        pin.framesForwardKinematics(self.model, self.kin.data, q)
+        return {n: self.points[n].position(self.kin).copy() for n in self.output_points}
+
+    def _drivers(self) -> None:
+        """The drivers of the rates, as the drive solver's rows and right-hand sides: each
+        corner's wheel-centre z, the rack (one, shared) where there is one, and each
+        toe-link corner's toe link length (a column of 1 on that closure's row: J·dq = e,
+        the row's value changed by one). ``driver_columns``: label → its corner's
+        columns (its hub z, then the rack or its toe link)."""
+        labels = list(self._corners)
+        prefix = {label: f"{label}_" if label else "" for label in labels}
+        z = np.array([0.0, 0.0, 1.0])
+        drive = [PointTarget(self.points[f"{prefix[lb]}wheel_center"], z) for lb in labels]
+        rack = self.model.existJointName("rack_slide")
+        if rack:
+            drive.append(JointTarget(self.model, "rack_slide"))
+        self._drive = NewtonSolver(self.kin, self.closures, drive, self.branches)
+        self.drive_rhs, self.driver_columns = self._drive.unit_rhs, {}
+        for c, (label, g) in enumerate(self._corners.items()):
+            self.driver_columns[label] = [c, len(labels)] if rack else [c]
+            if g.steering == "none" and g.steering_points:
+                toe = np.zeros((self._drive.nrows, 1))
+                toe[closure_row(self.closures, f"{prefix[label]}toe_link")] = 1.0
+                self.driver_columns[label].append(self.drive_rhs.shape[1])
+                self.drive_rhs = np.hstack([self.drive_rhs, toe])
+        frames = [n for n in self.output_points if "contact_patch_center" not in n]
+        self._frame_motion = FrameMotion(self.kin, frames, self.points, self.design_positions)
+
+    def label_motion(self, qs: list, tangents: list | None = None) -> dict:
+        """Every point (prefixed) at each configuration, as a jet.Dual per corner's label:
+        its rates along that corner's drivers (``driver_columns``: its hub z, the others
+        held, and the rack or its toe link) — name → {label: Dual(position (n, 3) m,
+        rates (k, n, 3))}. Each rate column is the tangent of the solution manifold,
+        J·dq = e_j (``tangents``' where the sweep's solve has it, dq per driver, else
+        solved here; every step at once on the model's tree, bulk.py), pushed through
+        the joint Jacobians; each contact patch follows by the chain rule. A None
+        configuration (a step that did not converge) gives NaN."""
+        k = self.drive_rhs.shape[1]
+
+        def known(i: int):
+            t = None if tangents is None else tangents[i]
+            return t if t is not None and t.shape[1] == k else None
+
+        def tangent_at(i: int, q: np.ndarray) -> np.ndarray:
+            t = known(i)
+            if t is not None:
+                self.kin.update(q)
+                return t
+            self._drive.evaluate(q)
+            return self._drive.tangent(self.drive_rhs)
+
+        def at_once(Q: np.ndarray, steps: list, placed: tuple) -> np.ndarray | None:
+            given = [known(i) for i in steps]
+            if all(t is not None for t in given):
+                return np.array(given)
+            rows = rows_of(self._drive)
+            if not rows.supported or rows.nrows != self.model.nv:
+                return None
+            zero = np.zeros((len(Q), len(self._drive.targets)))
+            _, J = rows.evaluate(Q, zero, placed=placed)
+            return solve_all(J, self.drive_rhs)
+
+        many = at_once if len(qs) >= self.motion_at_once_from else None
+        pos, rates = self._frame_motion(qs, tangent_at, k, many)
+        own = {}  # each label's drivers' rates, point by point: (m, k_label, n, 3)
+        for label, columns in self.driver_columns.items():
+            if columns == list(range(k)):
+                own[label] = np.moveaxis(rates, 2, 0)
+            else:  # each point's own rates contiguous
+                own[label] = np.ascontiguousarray(np.moveaxis(rates[columns], 2, 0))
+        out = {
+            name: {label: Dual(pos[:, j], own[label][j]) for label in own}
+            for j, name in enumerate(self._frame_motion.names)
+        }
+        for label, g in self._corners.items():
+            p = f"{label}_" if label else ""
+            wheel, inboard, outboard = (
+                out[f"{p}{n}"] for n in ("wheel_center", "axle_inboard", "axle_outboard")
+            )
+            out[f"{p}contact_patch_center"] = {
+                s: contact_patch(wheel[s], unit(outboard[s] - inboard[s]), g.wheel.radius)
+                for s in own
+            }
+        return out
+
+
+class Linkage(Composed):
     """The kinematic model of one corner at its geometry's design state."""
 
     def __init__(self, geometry: Geometry, visuals: bool = True):
         """``visuals``: the URDF's shapes (a study's variants, never drawn, go without)."""
         self.geometry = geometry
         self.mechanism = geometry.mechanism
-        self.tree = self.mechanism.tree(geometry)
-        # links near dead centre at design (warned when the file was read): the
-        # failure report names them as the cause of steps out of reach
-        self.dead_centres = dead_centres(self.tree)
         comment = (
             f"generated by pin_susp {__version__} from {Path(geometry.source).name};"
             " regenerate with: pin-susp urdf GEOMETRY -o FILE"
         )
-        built = Built(self.tree if visuals else replace(self.tree, visuals=[]), comment)
-        self.urdf, self.model, self.kin = built.urdf, built.model, built.kin
-        self.points: dict[str, FramePoint | ContactPatchPoint] = dict(built.points)
-        self.point_names = tuple(geometry.hardpoints) + DERIVED_POINTS
-        self.points["contact_patch_center"] = ContactPatchPoint(
-            "contact_patch_center",
-            self.points["wheel_center"],
-            self.points["axle_inboard"],
-            self.points["axle_outboard"],
-            geometry.wheel.radius,
-            self.mechanism.WHEEL_BODY,
-        )
-        self.q_design = built.q_design
-        self.closures, self.branches = built.closures, built.branches
-        self.mobility = self.model.nv - sum(c.size for c in self.closures)
+        self._compose({"": geometry}, comment=comment, visuals=visuals)
+        self.point_names = self.corner_points[""]
         self.actuators = ("rack",) if geometry.steering == "rack" else ()
-        self.design_positions = self.positions(self.q_design)
         # The drivers: wheel-centre z, and the rack or the fixed toe link's length (which
-        # steers a toe-link corner: its steer screw axis). Each is a column of the
-        # drive solver's right-hand side: the wheel-centre row, the rack row, or the
-        # toe link's closure row (J·dq = e: the row's value changed by one).
-        drive = [PointTarget(self.points["wheel_center"], np.array([0.0, 0.0, 1.0]))]
-        if geometry.steering == "rack":
-            drive.append(JointTarget(self.model, "rack_slide"))
-        self._drive = NewtonSolver(self.kin, self.closures, drive, self.branches)
+        # steers a toe-link corner: its steer screw axis).
+        self._drivers()
         self._check_mobility()
         self.drivers = (HUB_Z, RACK) if geometry.steering == "rack" else (HUB_Z,)
-        self.drive_rhs = self._drive.unit_rhs
         if geometry.steering == "none" and geometry.steering_points:
             self.drivers = (HUB_Z, TOE_LINK)
-            toe = np.zeros((self._drive.nrows, 1))
-            toe[closure_row(self.closures, "toe_link")] = 1.0
-            self.drive_rhs = np.hstack([self._drive.unit_rhs, toe])
-        frames = [name for name in self.point_names if name != "contact_patch_center"]
-        self._frame_motion = FrameMotion(self.kin, frames, self.points, self.design_positions)
         # The sense in which bump winds a torsion bar at design (motion_ratio's sign).
         self.spring_sense = 1.0
         if geometry.spring == "torsion_bar":
@@ -315,11 +440,6 @@ class Linkage:
             return ""
         return f"the wheel centre held, the joints at {', '.join(names)} still move"
 
-    def positions(self, q: np.ndarray) -> dict[str, np.ndarray]:
-        """World position (m) of every named point at configuration q."""
-        pin.framesForwardKinematics(self.model, self.kin.data, q)
-        return {name: self.points[name].position(self.kin).copy() for name in self.point_names}
-
     def motion(self, qs: list, tangents: list | None = None) -> dict[str, Dual]:
         """Every named point at each configuration, with its exact rates per driver.
 
@@ -333,32 +453,7 @@ class Linkage:
         The contact patch follows by the chain rule (jet.Dual). A None
         configuration (a step that did not converge) gives NaN.
         """
-
-        def tangent_at(i: int, q: np.ndarray) -> np.ndarray:
-            if tangents is not None and tangents[i] is not None:
-                self.kin.update(q)
-                return tangents[i]
-            self._drive.evaluate(q)
-            return self._drive.tangent(self.drive_rhs)
-
-        def at_once(Q: np.ndarray, steps: list, placed: tuple) -> np.ndarray | None:
-            if tangents is not None and all(tangents[i] is not None for i in steps):
-                return np.array([tangents[i] for i in steps])
-            rows = rows_of(self._drive)
-            if not rows.supported or rows.nrows != self.model.nv:
-                return None
-            zero = np.zeros((len(Q), len(self._drive.targets)))
-            _, J = rows.evaluate(Q, zero, placed=placed)
-            return solve_all(J, self.drive_rhs)
-
-        pos, rates = self._frame_motion(qs, tangent_at, len(self.drivers), at_once)
-        frames = self._frame_motion.names
-        points = {f: Dual(pos[:, i], rates[:, :, i]) for i, f in enumerate(frames)}
-        axis = unit(points["axle_outboard"] - points["axle_inboard"])
-        points["contact_patch_center"] = contact_patch(
-            points["wheel_center"], axis, self.geometry.wheel.radius
-        )
-        return points
+        return {name: by_label[""] for name, by_label in self.label_motion(qs, tangents).items()}
 
     def held_targets(self, targets: list) -> list:
         """The targets a sweep's steps hold: its own, and on a rack-steered corner whose

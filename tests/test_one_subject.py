@@ -30,7 +30,7 @@ from pathlib import Path
 PACKAGE = Path(__file__).resolve().parents[1] / "pin_susp"
 
 # The subjects' own modules: where the kinds are told apart, once.
-SUBJECTS = ("corner.py", "axle.py", "subject.py")
+SUBJECTS = ("corner.py", "axle.py", "axle_file.py", "subject.py")
 
 KINDS = {"Corner", "AxleModel", "Geometry", "AxleGeometry", "Results", "AxleResults"}
 ONE_KIND_ATTRIBUTES = {"geometries", "geometry", "axle"}
