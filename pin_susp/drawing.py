@@ -30,6 +30,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.transforms import Bbox  # noqa: E402
 
+from .assembly import Assembly  # noqa: E402
 from .errors import InputError  # noqa: E402
 from .geometry import unit, wheel_down  # noqa: E402
 from .metrics import PointSet, X, Y  # noqa: E402
@@ -49,10 +50,11 @@ def drawing_figure(corner, labels: bool = False):
     """
     fig, (front, side) = plt.subplots(1, 2, figsize=(14, 6.5))
     corners = [(corner, 1.0, "-")]
-    if corner.geometry.drawn is not None:
-        from .linkage import Linkage
+    from .viz import as_drawn
 
-        corners.insert(0, (Linkage(corner.geometry.drawn), 0.3, "--"))
+    drawn = as_drawn(corner)
+    if drawn is not None:
+        corners.insert(0, (drawn, 0.3, "--"))
     views = ((front, FRONT), (side, SIDE))
     for c, alpha, style in corners:
         _rods(views, c.tree.visuals, c.tree.materials, alpha, style)
@@ -438,7 +440,7 @@ def axle_drawing_figure(model, q=None, labels: bool = False, caption: str = "des
     _view_axes(front, f"Front view: {caption}", "y [mm] (+ left, seen from the front)", True)
     drawn, keep = _roll_centre_construction(front, model, q, sides)
     _fit_view(views, list(sides.values()), keep)
-    fig.suptitle(model.axle.name if model.axle is not None else model.tree.name)
+    fig.suptitle(model.name)
     if labels:
         more = [h for h in front.get_lines() if h.get_gid() == "heave_link"][:1]
         _legend(fig, sides["left"], ghost=False, construction=drawn, tree=model.tree, more=more)
@@ -468,14 +470,18 @@ def _axle_links(views, model, positions, sides) -> None:
         _segment(views, a, b, "--", color=colour, lw=1.0, gid="heave_link", label="heave link")
 
 
-class _AxleSide:
-    """One corner of an axle at a pose, read as the drawing reads a corner: its
-    geometry (as set), its own tree (the links drawn between its points) and, as
-    ``design_positions``, the pose's points (m) by the corner's names."""
+class _AxleSide(Assembly):
+    """One corner of an axle at a pose, read as the drawing reads a corner (an Assembly
+    of one corner, labelled ""): its geometry (as set), its own tree (the links drawn
+    between its points) and, as ``design_positions``, the pose's points (m) by the
+    corner's names."""
+
+    labels = ("",)
 
     def __init__(self, model, side: str, positions: dict[str, np.ndarray]):
-        g = model.geometries[side]
+        g = model.corners[side]
         self.geometry, self.tree = g, g.mechanism.tree(g)
+        self.corners = {"": g}
         self.design_positions = {n: positions[f"{side}_{n}"] for n in model.point_names[side]}
 
 

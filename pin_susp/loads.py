@@ -43,6 +43,7 @@ from .yamlio import Reader, load_yaml
 # |J| condition number above which a pose is at a toggle: a member's force is unbounded
 TOGGLE = 1e10
 CASE_KEYS = ("contact_patch", "wheel_center", "moment")
+SIDES = ("left", "right")  # an axle's corners: a block of loads each
 
 
 @dataclass(frozen=True)
@@ -55,6 +56,10 @@ class LoadCase:
     wheel_center: np.ndarray
     moment: np.ndarray
 
+    def wheel(self, label: str) -> LoadCase:
+        """The loads on a corner's wheel by its label: a corner's one (``""``)."""
+        return self
+
 
 @dataclass(frozen=True)
 class AxleLoadCase:
@@ -64,11 +69,19 @@ class AxleLoadCase:
     left: LoadCase
     right: LoadCase
 
+    def wheel(self, label: str) -> LoadCase:
+        """The loads on the wheel of the corner labelled ``left`` or ``right``."""
+        return getattr(self, label)
 
-def load_cases(source, axle: bool = False) -> list:
+
+def load_cases(source, axle: bool = False, labels: tuple[str, ...] | None = None) -> list:
     """Read a load-case file (docs/loads.md): ``cases:`` a list of {name,
-    contact_patch: {fx, fy, fz}, wheel_center: {…}, moment: {mx, my, mz}}; for an
-    axle (``axle``) each case's loads sit in ``left:`` and ``right:`` blocks."""
+    contact_patch: {fx, fy, fz}, wheel_center: {…}, moment: {mx, my, mz}}. The loads
+    are per corner of the subject whose ``labels`` are given (default: an axle's
+    ``left``, ``right`` with ``axle``, else a corner's ``""``): a corner labelled ``""``
+    has them at the case's top, each labelled one in a block of its label's name."""
+    labels = (SIDES if axle else ("",)) if labels is None else tuple(labels)
+    blocks = tuple(label for label in labels if label)  # the corners named in the file
     data, name, _ = load_yaml(source)
     r = Reader(name)
     r.mapping(data, "", required=("cases",), optional=("version",))
@@ -80,32 +93,31 @@ def load_cases(source, axle: bool = False) -> list:
     out, seen = [], set()
     for i, case in enumerate(cases):
         key = f"cases[{i}]"
-        if not axle and isinstance(case, dict):
-            for side in ("left", "right"):
+        if not blocks and isinstance(case, dict):
+            for side in SIDES:
                 if side in case:
                     r.fail(f"{key}.{side}", "a side block is for an axle's load cases")
-        sides = ("left", "right") if axle else ()
-        r.mapping(case, key, required=("name",), optional=(*CASE_KEYS, *sides))
+        r.mapping(case, key, required=("name",), optional=(*CASE_KEYS, *blocks))
         title = str(r.text(case["name"], f"{key}.name")).strip()
         if not title:
             r.fail(f"{key}.name", "empty: name the case")
         if title in seen:
             r.fail(f"{key}.name", f"{title!r} names two cases")
         seen.add(title)
-        if not axle:
+        if not blocks:
             out.append(_wheel_loads(case, key, title, r))
             continue
         for part in CASE_KEYS:
             if part in case:
                 r.fail(f"{key}.{part}", "an axle's loads go in left: and right: blocks")
-        if "left" not in case and "right" not in case:
+        if not any(b in case for b in blocks):
             r.fail(key, "an axle's case needs a left: or right: block of loads")
-        wheels = [
-            _wheel_loads(r.mapping(case.get(s, {}), f"{key}.{s}", optional=CASE_KEYS), f"{key}.{s}",
-                         str(title), r)
-            for s in ("left", "right")
-        ]  # fmt: skip
-        out.append(AxleLoadCase(str(title), *wheels))
+        wheels = {
+            b: _wheel_loads(r.mapping(case.get(b, {}), f"{key}.{b}", optional=CASE_KEYS),
+                            f"{key}.{b}", str(title), r)
+            for b in blocks
+        }  # fmt: skip
+        out.append(AxleLoadCase(str(title), **wheels))
     return out
 
 
@@ -147,28 +159,17 @@ def member_forces(corner, sweep, cases: list, solutions=None, results=None, prog
     from .corner import Results
     from .sweep import load_sweep
 
-    axle = hasattr(corner, "geometries")  # an AxleModel
     if not isinstance(sweep, Sweep):
         sweep = load_sweep(sweep)
     if not isinstance(cases, list):
-        cases = load_cases(cases, axle=axle)
+        cases = load_cases(cases, labels=corner.labels)
     if not cases:
         raise PinSuspError("member_forces: no load cases given")
     statics = _STATICS.get(corner) or _STATICS.setdefault(corner, Statics(corner))
     if solutions is None:
-        if axle:
-            from .axle import solve_axle_sweep
-
-            solutions = solve_axle_sweep(corner, sweep)
-        else:
-            solutions = corner.solve_steps(sweep)
+        solutions = corner.solve_steps(sweep)
     if results is None:
-        if axle:
-            from .axle import axle_results
-
-            results = axle_results(corner, sweep, solutions)
-        else:
-            results = Results.from_solutions(corner, solutions, sweep)
+        results = corner.sweep_results(sweep, solutions)
     names = statics.names
     W = statics.loads_matrix(cases)
     n, m = len(cases), len(solutions)
@@ -195,7 +196,7 @@ def member_forces(corner, sweep, cases: list, solutions=None, results=None, prog
         if name != "step_index":
             columns[name] = np.repeat(values, n)
             units[name] = results.units.get(name, "")
-    _warn_dead_centre_share(corner, cases, columns, axle)
+    _warn_dead_centre_share(corner, cases, columns)
     meta = dict(results.meta, not_two_force=statics.not_two_force())
     return Results(columns, units, meta)
 
@@ -205,7 +206,7 @@ def member_forces(corner, sweep, cases: list, solutions=None, results=None, prog
 SPRING_SHARE = (0.1, 10.0)
 
 
-def _warn_dead_centre_share(subject, cases: list, columns: dict, axle: bool) -> None:
+def _warn_dead_centre_share(subject, cases: list, columns: dict) -> None:
     """Where the model has a link near dead centre at design (deadcentre.py, warned
     when its file was read), a PlausibilityWarning for each load case whose spring
     takes a share of the tyre's vertical load outside SPRING_SHARE: the forces are
@@ -213,19 +214,16 @@ def _warn_dead_centre_share(subject, cases: list, columns: dict, axle: bool) -> 
     dead = list(getattr(subject, "dead_centres", ()))
     if not dead:
         return
-    source = subject.axle.source if axle and subject.axle is not None else None
-    if not axle:
-        source = subject.geometry.source
     low, high = SPRING_SHARE
-    for side in ("left", "right") if axle else ("",):
-        suffix = f"_{side}" if side else ""
-        spring = columns.get(f"force_spring{suffix}")
-        here = [t for t in dead if t.body.startswith(f"{side}_")] if side else dead
+    for label in subject.labels:
+        spring = columns.get(f"force_spring{subject.suffix(label)}")
+        here = [t for t in dead if t.body.startswith(subject.prefix(label))]
         if spring is None or not here:
             continue
         cause = ", ".join(f"{t.flow} is {t.margin:.1f}° from dead centre" for t in here)
+        source = subject.corners[label].source
         for k, case in enumerate(cases):
-            c = getattr(case, side) if side else case
+            c = case.wheel(label)
             fz = abs(float(c.contact_patch[2] + c.wheel_center[2]))
             force = np.abs(np.asarray(spring[k :: len(cases)], dtype=float))
             if not fz > 0.0 or np.isnan(force).all():
@@ -240,7 +238,7 @@ def _warn_dead_centre_share(subject, cases: list, columns: dict, axle: bool) -> 
                 else f"so the {body} multiplies the load as a lever near dead centre"
             )
             warnings.warn(
-                f"{source}: load case {case.name!r}: the {side + ' ' if side else ''}spring "
+                f"{source}: load case {case.name!r}: the {label + ' ' if label else ''}spring "
                 f"takes {'at most' if share < low else 'up to'} {share * fz:.3g} N of the "
                 f"{fz:.0f} N vertical load on the tyre "
                 f"(a car's takes about the load over its motion ratio): {cause} at design "
@@ -275,13 +273,10 @@ class Statics:
 
     def __init__(self, subject):
         self.subject, self.model = subject, subject.model
-        self.axle = hasattr(subject, "geometries")
-        sides = subject.geometries if self.axle else {"": subject.geometry}
-        self.source = subject.axle.source if self.axle and subject.axle else None
         held, compliance = [], []
-        for side, g in sides.items():
-            prefix = f"{side}_" if side else ""
-            source = self.source or g.source
+        for label, g in subject.corners.items():
+            prefix = subject.prefix(label)
+            source = g.source
             if g.spring == "none":
                 raise PinSuspError(
                     f"{source}: spring.type: none leaves bump without a load path (no member "
@@ -295,20 +290,12 @@ class Statics:
                 turn = RockerTurn(subject, prefix)
                 # + resisting bump, as the sweep's spring_torque: bump turns the rocker
                 # about a→b in the sense s·spring_sense (motion_ratio > 0 at design)
-                sense = subject.spring_sense[side] if self.axle else subject.spring_sense
-                turn.resisting = -g.sign * sense
+                turn.resisting = -g.sign * subject.spring_senses[label]
                 held.append(turn)
                 stiffness = None if g.spring_rate is None else g.spring_rate * 180 / np.pi
             compliance.append(stiffness)
-        bar = subject.axle if self.axle else None
-        if bar is not None and bar.anti_roll != "none" and not bar.anti_roll_rigid:
-            joints = (
-                ["left_arb_arm_pivot", "right_arb_arm_pivot"]
-                if bar.anti_roll == "u_bar"
-                else ["t_bar_pivot_b"]
-            )
-            held.append(BarTwist(self.model, joints))
-            k = bar.anti_roll_stiffness
+        for joints, k in subject.shared_springs:  # an axle's anti-roll bar, twisted
+            held.append(BarTwist(self.model, list(joints)))
             compliance.append(None if k is None else k * 180 / np.pi)  # N·m/rad
         if "rack_slide" in [self.model.names[j] for j in range(self.model.njoints)]:
             held.append(JointTarget(self.model, "rack_slide"))
@@ -316,7 +303,7 @@ class Statics:
         self.solver = NewtonSolver(subject.kin, [*subject.closures, *held], [])
         self.rows = self.solver.rows
         self.size = self.solver.nrows
-        source = self.source or subject.geometry.source
+        source = subject.source
         if self.size < self.model.nv:
             raise PinSuspError(
                 f"{source}: the closures, springs and rack hold {self.size} of the "
@@ -364,10 +351,9 @@ class Statics:
             else:  # the rack, held by the steering: the trackrods' pull on it is −λ
                 self.direct.append(("force_rack", col, 1, -1.0))
             col += row.size
-        sides = ("left", "right") if self.axle else ("",)
         self.wheels = [
-            (subject.points[_at(s, "wheel_center")], subject.points[_at(s, "contact_patch_center")])
-            for s in sides
+            (subject.points[f"{p}wheel_center"], subject.points[f"{p}contact_patch_center"])
+            for p in map(subject.prefix, subject.labels)
         ]
         kin = subject.kin
         kin.update_positions(subject.q_design)
@@ -423,12 +409,13 @@ class Statics:
         ]
         for body, j, *_ in self.joints:
             names += self._joint_names(body, j)
-        self.names = [_sided(n) for n in names] if self.axle else names
+        self.names = [_sided(n, subject.labels) for n in names]
 
     def _point(self, body: str, name: str) -> str:
-        """A corner point's name in the subject (an axle's carry the body's side)."""
-        side = body.split("_", 1)[0]
-        return f"{side}_{name}" if self.axle and side in ("left", "right") else name
+        """A corner point's name in the subject: a labelled corner's carry its prefix (an
+        axle's ``left_`` of its body ``left_upper_wishbone``)."""
+        label = body.split("_", 1)[0]
+        return self.subject.prefix(label) + name if label in self.subject.labels else name
 
     def _named(self, body: str, point: str) -> str:
         """A point's name in the subject: an axle's corner points carry their side."""
@@ -497,9 +484,7 @@ class Statics:
                 n for n, (b, _) in self.subject.tree.points.items() if b == arm and n != outboard
             ]
             along = [f"load_{_bushing(self._point(arm, n))}_along_leg" for n in j.defined_by]
-            names = [*legs, *along]
-            if self.axle:
-                names = [_sided(n) for n in names]
+            names = [_sided(n, self.subject.labels) for n in [*legs, *along]]
             out[arm] = (points, names[:2], names[2:])
         return out
 
@@ -508,7 +493,7 @@ class Statics:
     def loads_matrix(self, cases: list) -> np.ndarray:
         """W (9 per wheel × cases): each wheel's contact-patch force, wheel-centre force
         and moment, a case a column (an axle's case: its left and right parts)."""
-        parts = [(c,) if not self.axle else (c.left, c.right) for c in cases]
+        parts = [[c.wheel(label) for label in self.subject.labels] for c in cases]
         return np.array(
             [np.concatenate([np.r_[w.contact_patch, w.wheel_center, w.moment] for w in p])
              for p in parts], dtype=float
@@ -714,17 +699,14 @@ def _xyz(name: str) -> list[str]:
     return [f"{name}_{a}" for a in "xyz"]
 
 
-def _at(side: str, point: str) -> str:
-    return f"{side}_{point}" if side else point
-
-
-def _sided(name: str) -> str:
-    """An axle's column name with its side last: force_left_trackrod → force_trackrod_left,
-    load_left_lower_ball_joint_x → load_lower_ball_joint_x_left."""
+def _sided(name: str, labels: tuple[str, ...]) -> str:
+    """A column's name with its corner's label last: an axle's force_left_trackrod →
+    force_trackrod_left, load_left_lower_ball_joint_x → load_lower_ball_joint_x_left (a
+    corner's, labelled "", as it is)."""
     head, _, rest = name.partition("_")
-    for side in ("left", "right"):
-        if rest.startswith(side + "_"):
-            return f"{head}_{rest[len(side) + 1 :]}_{side}"
+    for label in labels:
+        if label and rest.startswith(label + "_"):
+            return f"{head}_{rest[len(label) + 1 :]}_{label}"
     return name
 
 

@@ -84,12 +84,9 @@ ASPECT = 4 / 3  # ... in a view at least this wide for its height
 
 
 def sides(model) -> list[tuple[str, object]]:
-    """(prefix of its points' names, Geometry) of each corner: a corner's own (prefix
-    ``""``), an axle's two (``"left_"``, ``"right_"``)."""
-    geometries = getattr(model, "geometries", None)
-    if geometries is None:
-        return [("", model.geometry)]
-    return [(f"{side}_", g) for side, g in geometries.items()]
+    """(prefix of its points' names, Geometry) of each of an Assembly's corners: a
+    corner's own (prefix ``""``), an axle's two (``"left_"``, ``"right_"``)."""
+    return [(model.prefix(label), g) for label, g in model.corners.items()]
 
 
 def _bare(model, name: str) -> str:
@@ -189,12 +186,14 @@ def roll_centres(results) -> np.ndarray:
 
 
 def design_results(model):
-    """An axle's results columns at its design state: one row, no sweep."""
-    from .axle import axle_results
+    """A subject's results columns at its design state: one row, no sweep."""
     from .solver import Solution
     from .sweep import Sweep
 
-    return axle_results(model, Sweep([]), [Solution(model.q_design, True, 0, 0.0)])
+    return model.sweep_results(Sweep([]), [Solution(model.q_design, True, 0, 0.0)])
+
+
+MARKED = {"roll_centre": roll_centres}  # a marker's place at each step, from the columns
 
 
 def as_drawn(model):
@@ -202,26 +201,16 @@ def as_drawn(model):
     one); None when it is set as drawn."""
     from dataclasses import replace
 
-    from .linkage import Linkage
-
-    geometries = [g for _, g in sides(model)]
-    if all(g.drawn is None for g in geometries):
-        return None
-    if not hasattr(model, "geometries"):
-        return Linkage(model.geometry.drawn)
-    from .axle import AxleModel
-
-    def drawn(g):  # its setup at the design values: AxleModel sets up nothing more
+    def drawn(g):  # its setup at the design values: the model sets up nothing more
         g = g.drawn or g
         shim = g.camber_shim
         if shim is not None:
             shim = replace(shim, setup_thickness=shim.design_thickness)
         return replace(g, camber_shim=shim, trackrod_length_delta=0.0, pushrod_length_delta=0.0)
 
-    left, right = (drawn(g) for g in geometries)
-    if model.axle is None:
-        return AxleModel(left, right)
-    return AxleModel(replace(model.axle, left=left, right=right))
+    if all(g.drawn is None for g in model.corners.values()):
+        return None
+    return model.with_corners({label: drawn(g) for label, g in model.corners.items()})
 
 
 def framing(points: np.ndarray, sign: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
@@ -406,10 +395,9 @@ class Scene:
             self.viewer[f"{ROOT}/{prefix}contact_patch"].set_object(
                 mg.Sphere(0.018), mg.MeshLambertMaterial(color=PATCH_COLOUR)
             )
-        # an axle's roll centre: where its design results put it
-        self.design_markers = {}
-        if hasattr(model, "geometries"):
-            self.design_markers["roll_centre"] = roll_centres(design_results(model))[0]
+        # the markers (an axle's roll centre): where its design results put them
+        design = design_results(model) if model.markers else None
+        self.design_markers = {name: MARKED[name](design)[0] for name in model.markers}
         for name in self.design_markers:
             colour, radius = MARKERS[name]
             self.viewer[f"{ROOT}/{name}"].set_object(
@@ -563,8 +551,8 @@ class Scene:
         out = {}
         for column in columns:
             name = column.removeprefix("force_")
-            bare, _, side = name.rpartition("_")
-            prefix = f"{side}_" if side in ("left", "right") and len(sides(model)) == 2 else ""
+            bare, _, label = name.rpartition("_")
+            prefix = model.prefix(label) if label in model.labels else ""
             if prefix:  # an axle's: force_<member>_<side> is its side's <side>_<member>
                 name = prefix + bare
             link = prefix + "coilover" if name == prefix + "spring" else name
@@ -597,8 +585,8 @@ class Scene:
 
         rows = np.asarray(forces["load_case"]) == case
         bounded = np.asarray(forces["loads_unbounded"], dtype=float)[rows] == 0.0
-        # a spring's column (an axle's: each side's) is its compression
-        sign = dict.fromkeys(["force_spring", "force_spring_left", "force_spring_right"], -1.0)
+        # a spring's column (each corner's) is its compression
+        sign = {f"force_spring{self.model.suffix(label)}": -1.0 for label in self.model.labels}
         tension = {
             node: sign.get(column, 1.0) * np.asarray(forces[column], dtype=float)[rows]
             for column, node in self.members(forces.columns).items()

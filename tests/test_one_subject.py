@@ -46,14 +46,11 @@ KIND_TESTS = {
     "cli/commands/sweep.py": 1,  # the axle's printed summary, a twin
     "cli/commands/validate.py": 1,  # the roll centre's tolerance, said
     "cli/commands/view.py": 1,  # an axle's replay warns no transmission
-    "drawing.py": 1,
     "geometry.py": 2,  # the corner file's reader: its own scope key (an axle's file refused)
-    "loads.py": 3,
     "plots.py": 1,
     "pointwise.py": 1,
     "study.py": 1,
     "validate.py": 3,
-    "viz.py": 4,
 }
 
 
