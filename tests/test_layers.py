@@ -269,7 +269,10 @@ def reach(edges: dict[str, set[str]], start: str) -> set[str]:
 # the as-set geometry (as_set.py) and write the rated spring's columns (rates.py); the
 # setup's analyses, the loads, the drawings and the 3D view build on them.
 MODEL = ("linkage", "as_set", "rates", "corner", "axle")
-ABOVE_MODEL = ("setup", "loads", "sensitivity", "drawing", "viz", "validate", "study", "cli")
+ABOVE_MODEL = (
+    "setup", "loads", "load_case", "statics", "sensitivity", "drawing", "viz", "validate",
+    "study", "cli",
+)  # fmt: skip
 # The report drawn from a results table (``Results.plot``) knows no model.
 MODEL_FREE = {"plots": ("linkage", "corner", "axle", "constraints", "solver")}
 
@@ -428,7 +431,6 @@ LONG = {
     "sensitivity.py": 692,  # hardpoint sensitivities: virtual joints, corner and axle tables
     "geometry.py": 712,  # the Geometry data, the geometry file's reader, wheel formulas
     "viz.py": 731,  # meshcat scene, animation, force colours, the HTML page
-    "loads.py": 740,  # load-case files, the statics' plan, member forces, summaries
     "plots.py": 850,  # reading results files, the kinematics, axle and force reports
     "validate.py": 1032,  # the point-based, MuJoCo and Drake engines and the comparison
     # the axle's tree, its file reader, its sweep and its columns; its Assembly surface
@@ -458,7 +460,7 @@ LAYERS = (
     ("solve", ("solver", "bulk", "march", "urdf", "linkage", "shim", "as_set")),
     ("columns", ("rates",)),  # a rated spring's columns, from the solve's rates
     ("subjects", ("assembly", "corner", "axle", "subject")),
-    ("analyses", ("setup", "loads", "sensitivity", "pointwise")),
+    ("analyses", ("setup", "loads", "load_case", "statics", "sensitivity", "pointwise")),
     (
         "outputs",
         ("mjcf", "validate", "study", "study_summary", "study_plots", "plots", "drawing", "viz"),

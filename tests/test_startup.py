@@ -34,6 +34,8 @@ HEAVY = (
     "mujoco",
     "pydrake",
     "pin_susp.loads",
+    "pin_susp.load_case",
+    "pin_susp.statics",
     "pin_susp.sensitivity",
     "pin_susp.study",
     "pin_susp.study_plots",
