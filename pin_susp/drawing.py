@@ -50,7 +50,7 @@ def drawing_figure(corner, labels: bool = False):
     """
     fig, (front, side) = plt.subplots(1, 2, figsize=(14, 6.5))
     corners = [(corner, 1.0, "-")]
-    from .viz import as_drawn
+    from .view_parts import as_drawn
 
     drawn = as_drawn(corner)
     if drawn is not None:
@@ -106,7 +106,7 @@ def _rods(views, visuals, materials, alpha, style) -> None:
 def _draw_corner(views, c, alpha, style) -> None:
     """What a corner shows between its points (``c.design_positions``): links and
     steering axis, tyre, hardpoints, and in front view the wheel's centre plane."""
-    from .viz import links, segments
+    from .view_parts import links, segments
 
     for name, (a, b) in segments(c, c.design_positions).items():
         axis = name == "steering_axis"
@@ -381,7 +381,7 @@ def _legend(fig, corner, ghost: bool, construction: bool, tree=None, more=()) ->
     tyre, construction; ``more``: other lines' handles."""
     from matplotlib.lines import Line2D
 
-    from .viz import links, segments
+    from .view_parts import links, segments
 
     tree = corner.tree if tree is None else tree
     colours = dict(tree.materials)
@@ -455,7 +455,7 @@ def axle_drawing_figure(model, q=None, labels: bool = False, caption: str = "des
 def _axle_links(views, model, positions, sides) -> None:
     """The axle's own links: the bar's droplinks (its distance closures that are no
     corner's), and the heave link between the rockers (thin: it only measures)."""
-    from .viz import LINK
+    from .view_parts import LINK
 
     own = {f"{s}_{c.name}" for s, side in sides.items() for c in side.tree.closures}
     bar = model.tree.materials.get("bar", (0.85, 0.75, 0.15, 1.0))[:3]

@@ -270,8 +270,8 @@ def reach(edges: dict[str, set[str]], start: str) -> set[str]:
 # setup's analyses, the loads, the drawings and the 3D view build on them.
 MODEL = ("linkage", "as_set", "rates", "corner", "axle")
 ABOVE_MODEL = (
-    "setup", "loads", "load_case", "statics", "sensitivity", "drawing", "viz", "validate",
-    "study", "cli",
+    "setup", "loads", "load_case", "statics", "sensitivity", "drawing", "viz", "view_parts",
+    "force_colours", "meshcat_server", "validate", "study", "cli",
 )  # fmt: skip
 # The report drawn from a results table (``Results.plot``) knows no model.
 MODEL_FREE = {"plots": ("linkage", "corner", "axle", "constraints", "solver")}
@@ -430,7 +430,6 @@ LONG = {
     "metrics.py": 689,  # the corner metrics, their registry, instant centres, anti geometry
     "sensitivity.py": 692,  # hardpoint sensitivities: virtual joints, corner and axle tables
     "geometry.py": 712,  # the Geometry data, the geometry file's reader, wheel formulas
-    "viz.py": 731,  # meshcat scene, animation, force colours, the HTML page
     "plots.py": 850,  # reading results files, the kinematics, axle and force reports
     "validate.py": 1032,  # the point-based, MuJoCo and Drake engines and the comparison
     # the axle's tree, its file reader, its sweep and its columns; its Assembly surface
@@ -463,7 +462,19 @@ LAYERS = (
     ("analyses", ("setup", "loads", "load_case", "statics", "sensitivity", "pointwise")),
     (
         "outputs",
-        ("mjcf", "validate", "study", "study_summary", "study_plots", "plots", "drawing", "viz"),
+        (
+            "mjcf",
+            "validate",
+            "study",
+            "study_summary",
+            "study_plots",
+            "plots",
+            "drawing",
+            "viz",
+            "view_parts",
+            "force_colours",
+            "meshcat_server",
+        ),
     ),  # fmt: skip
     ("cli", ("cli",)),
 )

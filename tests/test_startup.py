@@ -44,6 +44,9 @@ HEAVY = (
     "pin_susp.plots",
     "pin_susp.drawing",
     "pin_susp.viz",
+    "pin_susp.view_parts",
+    "pin_susp.force_colours",
+    "pin_susp.meshcat_server",
     "pin_susp.axle",
     # a double wishbone's corner loads no other mechanism
     "pin_susp.mechanisms.macpherson",
