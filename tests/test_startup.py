@@ -43,6 +43,8 @@ HEAVY = (
     "pin_susp.pointwise",
     "pin_susp.plots",
     "pin_susp.drawing",
+    "pin_susp.drawing_centres",
+    "pin_susp.drawing_labels",
     "pin_susp.viz",
     "pin_susp.view_parts",
     "pin_susp.force_colours",
