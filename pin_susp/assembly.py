@@ -23,7 +23,13 @@ class Assembly:
     whether a long sweep can be solved and written a chunk at a time
     (``run_sweep_chunks``); ``poses_at_steps``: whether ``pin-susp urdf --at`` can
     write the joint values of one of its sweep's steps; ``summary_columns``: the
-    columns a sweep's printed summary shows, in order (None: every metric column).
+    columns a sweep's printed summary shows, in order (None: every metric column);
+    ``spring_senses``: label → the
+    sense of its corner's spring (``Linkage.spring_sense``); ``shared_springs``: the
+    elastic elements its corners share, each (the joints whose turn twists it, its
+    stiffness in N·m/deg or None) — an axle's anti-roll bar, unless rigid;
+    ``markers``: what the 3D view marks from its results' columns (an axle's
+    ``roll_centre``).
     """
 
     labels: tuple[str, ...]
@@ -34,6 +40,9 @@ class Assembly:
     summary_columns: tuple[str, ...] | None = None
     streams: bool = False
     poses_at_steps: bool = False
+    spring_senses: dict
+    shared_springs: tuple = ()
+    markers: tuple[str, ...] = ()
 
     @staticmethod
     def suffix(label: str) -> str:
@@ -58,4 +67,18 @@ class Assembly:
 
     def solve_sweep(self, sweep, progress=None) -> tuple[list, object]:
         """Every step of a Sweep solved: the solutions and the results (run_sweep's)."""
+        raise NotImplementedError
+
+    def solve_steps(self, sweep, progress=None) -> list:
+        """Every step of a Sweep solved in order: the solutions (no columns)."""
+        raise NotImplementedError
+
+    def sweep_results(self, sweep, solutions: list):
+        """The results (every column) of a sweep's solved steps."""
+        raise NotImplementedError
+
+    def with_corners(self, corners: dict):
+        """The same subject on other corners' Geometries, by label (its shared elements
+        kept; each corner set up as its Geometry says): the drawings' and the 3D view's
+        ghost, as drawn, under the as-set one."""
         raise NotImplementedError

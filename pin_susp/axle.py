@@ -232,6 +232,34 @@ class AxleModel(Composed, Assembly):
         "roll_stiffness arb_wheel_rate".split()
     )
 
+    # Assembly surface for loads, viz and drawing
+    markers = ("roll_centre",)  # from roll_center_y, _z
+
+    @property
+    def spring_senses(self) -> dict[str, float]:
+        return self.spring_sense
+
+    @property
+    def shared_springs(self) -> tuple:
+        bar = self.axle
+        if bar is None or bar.anti_roll == "none" or bar.anti_roll_rigid:
+            return ()
+        u_bar = ("left_arb_arm_pivot", "right_arb_arm_pivot")
+        return (
+            (u_bar if bar.anti_roll == "u_bar" else ("t_bar_pivot_b",), bar.anti_roll_stiffness),
+        )
+
+    def solve_steps(self, sweep, progress=None) -> list:
+        return solve_axle_sweep(self, sweep, progress=progress)
+
+    def sweep_results(self, sweep, solutions: list) -> AxleResults:
+        return axle_results(self, sweep, solutions)
+
+    def with_corners(self, corners: dict[str, Geometry]) -> AxleModel:
+        if self.axle is None:
+            return AxleModel(corners["left"], corners["right"])
+        return AxleModel(replace(self.axle, **corners))
+
 
 Axle = AxleModel  # pin_susp.Axle, as pin_susp.Corner: an axle file → a model to sweep
 

@@ -312,6 +312,17 @@ class Corner(Linkage, Assembly):
                 f"(trackrod_inboard along y), got {len(moving_rack)}",
             )
 
+    # Assembly surface for loads, viz and drawing
+    @property
+    def spring_senses(self) -> dict[str, float]:
+        return {"": self.spring_sense}
+
+    def sweep_results(self, sweep: Sweep, solutions: list[Solution]) -> Results:
+        return Results.from_solutions(self, solutions, sweep)
+
+    def with_corners(self, corners: dict[str, Geometry]) -> Corner:
+        return Corner(corners[""], warn=False)
+
 
 class Results:
     """Columns of a solved sweep, in output units (mm, deg); see docs/results.md.

@@ -15,8 +15,10 @@ tyre is its silhouette: the two rim-edge circles, projected, cut at the road.
 (``axle_pose``: a step of its results), with each side's FVIC construction and
 the roll centre where the two contact-patch lines cross.
 
-The drawings build on the model (``axle.py``, the 3D view's links in ``viz.py``);
-the report drawn from results is ``plots.py``, below them.
+The instant-centre construction is ``drawing_centres.py``'s, the points' names
+placed by ``drawing_labels.py``. The drawings build on the model (``axle.py``, the
+links drawn between points in ``view_parts.py``); the report drawn from results is
+``plots.py``, below them.
 """
 
 from __future__ import annotations
@@ -28,17 +30,21 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-from matplotlib.transforms import Bbox  # noqa: E402
 
+from .assembly import Assembly  # noqa: E402
+from .drawing_centres import (  # noqa: E402
+    CONSTRUCTION,
+    FRONT,
+    SIDE,
+    in_mm,
+    instant_centres,
+    roll_centre_construction,
+)
+from .drawing_centres import PARALLEL as PARALLEL  # noqa: E402 (its old address too)
+from .drawing_labels import label_points  # noqa: E402
 from .errors import InputError  # noqa: E402
 from .geometry import unit, wheel_down  # noqa: E402
-from .metrics import PointSet, X, Y  # noqa: E402
 from .plots import ResultsFile  # noqa: E402
-
-FRONT, SIDE = (1, 2), (0, 2)  # the world axes each view shows, in mm
-IC_FAR = 20_000.0  # mm from the wheel centre: beyond this an instant centre is noted, not drawn
-CONSTRUCTION = "#c2185b"  # instant-centre construction: a colour no body has
-PARALLEL = "arms parallel: instant centre at infinity"
 
 
 def drawing_figure(corner, labels: bool = False):
@@ -49,22 +55,23 @@ def drawing_figure(corner, labels: bool = False):
     """
     fig, (front, side) = plt.subplots(1, 2, figsize=(14, 6.5))
     corners = [(corner, 1.0, "-")]
-    if corner.geometry.drawn is not None:
-        from .linkage import Linkage
+    from .view_parts import as_drawn
 
-        corners.insert(0, (Linkage(corner.geometry.drawn), 0.3, "--"))
+    drawn = as_drawn(corner)
+    if drawn is not None:
+        corners.insert(0, (drawn, 0.3, "--"))
     views = ((front, FRONT), (side, SIDE))
     for c, alpha, style in corners:
         _rods(views, c.tree.visuals, c.tree.materials, alpha, style)
         _draw_corner(views, c, alpha, style)
-    ground = _mm(corner)["contact_patch_center"][2]
+    ground = in_mm(corner)["contact_patch_center"][2]
     for ax, title, xl in (
         (front, "Front view", "y [mm] (+ left)"),
         (side, "Side view", "x [mm] (+ forward)"),
     ):
         ax.axhline(ground, color="0.5", lw=0.8)
         _view_axes(ax, title, xl, centreline=ax is front)
-    drawn, keep = _instant_centres(front, side, corner)
+    drawn, keep = instant_centres(front, side, corner)
     _fit_view(views, [c for c, _, _ in corners], keep)
     if corner.geometry.sign < 0:
         front.invert_xaxis()  # a right corner seen from the front: outboard to the left
@@ -74,7 +81,7 @@ def drawing_figure(corner, labels: bool = False):
         _legend(fig, corner, ghost=len(corners) > 1, construction=bool(drawn))
     fig.tight_layout(rect=(0, 0.06 if labels else 0, 1, 1))
     if labels:
-        _label_points(fig, views, {n: _mm(corner)[n] for n in corner.geometry.hardpoints})
+        label_points(fig, views, {n: in_mm(corner)[n] for n in corner.geometry.hardpoints})
     return fig
 
 
@@ -86,10 +93,6 @@ def _view_axes(ax, title: str, xlabel: str, centreline: bool) -> None:
     ax.set_ylabel("z [mm]")
     if centreline:  # the car's, in front view
         ax.axvline(0.0, color="0.5", lw=0.8, ls="-.")
-
-
-def _mm(c) -> dict[str, np.ndarray]:
-    return {k: v * 1e3 for k, v in c.design_positions.items()}
 
 
 def _rods(views, visuals, materials, alpha, style) -> None:
@@ -104,13 +107,13 @@ def _rods(views, visuals, materials, alpha, style) -> None:
 def _draw_corner(views, c, alpha, style) -> None:
     """What a corner shows between its points (``c.design_positions``): links and
     steering axis, tyre, hardpoints, and in front view the wheel's centre plane."""
-    from .viz import links, segments
+    from .view_parts import links, segments
 
     for name, (a, b) in segments(c, c.design_positions).items():
         axis = name == "steering_axis"
         colour = "goldenrod" if axis else f"#{links(c)[name][1]:06x}"
         _segment(views, a, b, ":" if axis else style, alpha=alpha, lw=1.5, color=colour)
-    p = _mm(c)
+    p = in_mm(c)
     for ax, view in views:
         outline = tyre_outline(c, view)
         ax.plot(*outline.T, style, color="0.15", alpha=alpha, lw=1.2, gid="tyre")
@@ -144,7 +147,7 @@ def tyre_outline(c, view: tuple[int, int]) -> np.ndarray:
     """
     from scipy.spatial import ConvexHull
 
-    p = _mm(c)
+    p = in_mm(c)
     spin = unit(p["axle_outboard"] - p["axle_inboard"])
     down, _ = wheel_down(spin)
     t = np.linspace(0.0, 2.0 * np.pi, 241)[:, None]
@@ -166,132 +169,13 @@ def _above(polygon: np.ndarray, ground: float) -> np.ndarray:
     return np.array([*out, out[0]])
 
 
-def _instant_centres(front, side, corner) -> tuple[list[str], list[np.ndarray]]:
-    """Draw the FVIC and SVIC constructions; which were drawn, and the points (mm) the
-    view should keep."""
-    design = {k: v[None] for k, v in corner.design_positions.items()}
-    # with the rates at design: a mechanism's instant centres may come from its twist
-    ps = PointSet(corner.motion([corner.q_design]), design, corner.geometry)
-    rays = _kingpin_rays(ps, corner.geometry, lambda n: corner.body_of(n) == "chassis")
-    p = _mm(corner)
-    drawn, keep = [], []
-    for ax, axis, view, name in ((front, X, FRONT, "FVIC"), (side, Y, SIDE, "SVIC")):
-        ic = _instant_centre(ps, axis)
-        problem = _too_far(ic, p["wheel_center"][list(view)], name)
-        if problem is not None:
-            _note(ax, problem)
-        else:
-            keep += _construction(ax, p, rays, view, ic, name)
-            drawn.append(name)
-    return drawn, keep
-
-
-def _kingpin_rays(ps: PointSet, geometry, on_chassis) -> list[np.ndarray]:
-    """Where the instant-centre construction starts (mm, upper first): the kingpin's
-    ends (ball joints, virtual or the top mount); without a kingpin (a trailing arm),
-    the chassis points of the wheel's body (``on_chassis(point)``)."""
-    from .jet import value
-
-    with np.errstate(invalid="ignore", divide="ignore"):
-        ends = ps.kingpin()
-    if ends is None:
-        names = geometry.mechanism.upright_points(geometry)
-        ends = [ps[n] for n in names if on_chassis(n)][:2]
-    return [value(e)[0] * 1e3 for e in reversed(ends)]
-
-
-def _instant_centre(ps: PointSet, axis: int) -> np.ndarray:
-    """The instant axis ∩ the view plane through WC normal to ``axis`` (mm, the view's
-    two coordinates); NaN when there is none."""
-    from .jet import value
-
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return np.array([value(x)[0] for x in ps.instant_axis_point(axis)], dtype=float) * 1e3
-
-
-def _too_far(ic: np.ndarray, wheel_centre: np.ndarray, name: str) -> str | None:
-    """Why an instant centre is not drawn (at infinity, or beyond IC_FAR), or None."""
-    if not np.all(np.isfinite(ic)):
-        return PARALLEL
-    far = float(np.linalg.norm(ic - wheel_centre))
-    if far > IC_FAR:
-        return f"arms nearly parallel: {name} {far / 1e3:.0f} m away, not drawn"
-    return None
-
-
-def _arms_to(ax, rays, view, ic, name, tag: str = "") -> None:
-    """The kingpin's ends to the IC (dashed) and the IC, named."""
-    v = list(view)
-    for end in rays:
-        line = np.array([end[v], ic])
-        ax.plot(*line.T, "--", color=CONSTRUCTION, lw=0.9, gid=f"{name.lower()}_arm{tag}")
-    ax.plot(*ic, "o", color=CONSTRUCTION, ms=4, gid=f"{name.lower()}{tag}")
-    ax.annotate(
-        name, ic, xytext=(4, -9), textcoords="offset points", fontsize=7, color=CONSTRUCTION
-    )
-
-
-def _construction(ax, p, rays, view, ic, name) -> list[np.ndarray]:
-    """From the kingpin's ends (ball joints, virtual or the top mount) to the IC
-    (dashed), the contact patch through it; front view: on to the centreline, the roll
-    centre of a symmetric axle. Returns the roll centre, if any."""
-    v = list(view)
-    _arms_to(ax, rays, view, ic, name)
-    cp = p["contact_patch_center"][v]
-    text = f"{name}: {'y' if name == 'FVIC' else 'x'} = {ic[0]:.0f} mm, z = {ic[1]:.0f} mm"
-    ends, keep = [0.0, 1.0], []  # along the line from CP (0) through the IC (1)
-    if name == "FVIC":
-        t = _roll_centre(cp, ic)
-        if t is None:
-            text += "\nRC (symmetric axle): further than 20 m, not drawn"
-        else:
-            ends.append(t)
-            keep.append(rc := cp + t * (ic - cp))
-            ax.plot(*rc, "D", color=CONSTRUCTION, ms=5, gid="roll_centre")
-            ax.annotate(
-                "RC (symmetric axle)",
-                rc,
-                xytext=(5, 5),
-                textcoords="offset points",
-                fontsize=7,
-                color=CONSTRUCTION,
-            )
-            text += f"\nRC (symmetric axle): z = {rc[1]:.0f} mm"
-    line = np.array([cp + t * (ic - cp) for t in (min(ends), max(ends))])
-    ax.plot(*line.T, "-.", color=CONSTRUCTION, lw=0.9, gid=f"{name.lower()}_contact_patch")
-    _note(ax, text)
-    return keep
-
-
-def _roll_centre(cp: np.ndarray, ic: np.ndarray) -> float | None:
-    """Where the line CP → FVIC meets the centreline y = 0, as a multiple of FVIC − CP;
-    None when that is further than IC_FAR (an FVIC straight above the patch)."""
-    run = ic[0] - cp[0]
-    if abs(run) * IC_FAR <= abs(cp[0]) * float(np.linalg.norm(ic - cp)):
-        return None
-    return -cp[0] / run
-
-
-def _note(ax, text: str) -> None:
-    ax.text(
-        0.02,
-        0.98,
-        text,
-        transform=ax.transAxes,
-        va="top",
-        fontsize=8,
-        gid="ic_note",
-        bbox={"facecolor": "white", "edgecolor": "0.7", "alpha": 0.85},
-    )
-
-
 def _fit_view(views, corners, keep) -> None:
     """Limits: the corners (and the centreline in front view) plus a margin; construction
     lines to a far instant centre run off the edge instead of shrinking the corner."""
-    ground = _mm(corners[-1])["contact_patch_center"][2]
+    ground = in_mm(corners[-1])["contact_patch_center"][2]
     for ax, view in views:
         pts = [tyre_outline(c, view) for c in corners]
-        pts += [np.array([q[list(view)] for q in _mm(c).values()]) for c in corners]
+        pts += [np.array([q[list(view)] for q in in_mm(c).values()]) for c in corners]
         if view == FRONT:
             near = [q for q in keep if abs(q[1] - ground) < 1000.0]  # a roll centre near the road
             pts.append(np.array([[0.0, ground], *near]))
@@ -302,84 +186,12 @@ def _fit_view(views, corners, keep) -> None:
         ax.set_ylim(lo[1] - pad, hi[1] + pad)
 
 
-LABEL_PLACES = (  # offset (points), alignment: tried in this order, the first free one wins
-    (4, 3, "left", "bottom"),
-    (4, -3, "left", "top"),
-    (-4, 3, "right", "bottom"),
-    (-4, -3, "right", "top"),
-    (0, 6, "center", "bottom"),
-    (0, -6, "center", "top"),
-    (4, 12, "left", "bottom"),  # a line further out, for crowded rows
-    (4, -12, "left", "top"),
-    (-4, 12, "right", "bottom"),
-    (-4, -12, "right", "top"),
-)
-
-
-def _label_points(fig, views, points: dict[str, np.ndarray]) -> None:
-    """Each point's name (points: name → position, mm) next to it, where it covers the
-    fewest other labels and points; points that coincide in a view share one label.
-    After the layout: it measures the labels on the page."""
-    renderer = fig.canvas.get_renderer()
-    for ax, view in views:
-        ax.apply_aspect()  # the box the equal aspect gives it, as drawn, not the layout's
-        xy = {n: p[list(view)] for n, p in points.items()}
-        dots = ax.transData.transform(np.array(list(xy.values())))
-        taken = [Bbox.from_bounds(x - 3, y - 3, 6, 6) for x, y in dots]
-        for group in _coincident(xy, 0.012 * float(np.ptp(ax.get_xlim()))):
-            taken.append(_place_label(ax, renderer, "\n".join(group), xy[group[0]], taken))
-
-
-def _coincident(xy: dict[str, np.ndarray], close: float) -> list[list[str]]:
-    """The names grouped by position: closer than ``close`` to a group's first point."""
-    groups: list[list[str]] = []
-    for name, q in xy.items():
-        group = next((g for g in groups if np.linalg.norm(xy[g[0]] - q) < close), None)
-        if group is None:
-            groups.append([name])
-        else:
-            group.append(name)
-    return groups
-
-
-def _place_label(ax, renderer, text: str, xy, taken: list) -> Bbox:
-    """Annotate ``xy`` at the first of LABEL_PLACES that overlaps nothing taken and stays
-    in the axes (else the least bad one); returns the label's box on the page."""
-    frame = ax.get_window_extent(renderer)
-    options = []
-    for dx, dy, ha, va in LABEL_PLACES:
-        label = ax.annotate(
-            text,
-            xy,
-            xytext=(dx, dy),
-            textcoords="offset points",
-            ha=ha,
-            va=va,
-            fontsize=6,
-            color="0.1",
-            gid="point_label",
-            bbox={"facecolor": "white", "edgecolor": "none", "alpha": 0.6, "pad": 0.5},
-        )
-        box = label.get_window_extent(renderer)
-        outside = box.width * box.height - _area(Bbox.intersection(box, frame))
-        options.append((sum(_area(Bbox.intersection(box, b)) for b in taken) + outside, label))
-    best = min(options, key=lambda o: o[0])[1]  # ties: the earlier, preferred place
-    for _, label in options:
-        if label is not best:
-            label.remove()
-    return best.get_window_extent(renderer).padded(2)  # a gap between neighbours
-
-
-def _area(box) -> float:
-    return 0.0 if box is None else box.width * box.height
-
-
 def _legend(fig, corner, ghost: bool, construction: bool, tree=None, more=()) -> None:
     """The colours: bodies (of ``tree``, default the corner's), links, steering axis,
     tyre, construction; ``more``: other lines' handles."""
     from matplotlib.lines import Line2D
 
-    from .viz import links, segments
+    from .view_parts import links, segments
 
     tree = corner.tree if tree is None else tree
     colours = dict(tree.materials)
@@ -433,27 +245,27 @@ def axle_drawing_figure(model, q=None, labels: bool = False, caption: str = "des
     extras = {n: positions[n] * 1e3 for n in model.output_points if n not in corner_points}
     if extras:  # the bar's and the heave link's points
         front.plot(*np.array([p[list(FRONT)] for p in extras.values()]).T, "o", color="0.2", ms=3)
-    road = [_mm(c)["contact_patch_center"][list(FRONT)] for c in sides.values()]
+    road = [in_mm(c)["contact_patch_center"][list(FRONT)] for c in sides.values()]
     front.axline(*road, color="0.5", lw=0.8, gid="road")
     _view_axes(front, f"Front view: {caption}", "y [mm] (+ left, seen from the front)", True)
-    drawn, keep = _roll_centre_construction(front, model, q, sides)
+    drawn, keep = roll_centre_construction(front, model, q, sides)
     _fit_view(views, list(sides.values()), keep)
-    fig.suptitle(model.axle.name if model.axle is not None else model.tree.name)
+    fig.suptitle(model.name)
     if labels:
         more = [h for h in front.get_lines() if h.get_gid() == "heave_link"][:1]
         _legend(fig, sides["left"], ghost=False, construction=drawn, tree=model.tree, more=more)
     fig.tight_layout(rect=(0, 0.06 if labels else 0, 1, 1))
     if labels:
-        named = {n: _mm(sides["left"])[n] for n in sides["left"].geometry.hardpoints}
+        named = {n: in_mm(sides["left"])[n] for n in sides["left"].geometry.hardpoints}
         named |= {n.removeprefix("left_"): p for n, p in extras.items() if n[:6] != "right_"}
-        _label_points(fig, views, named)
+        label_points(fig, views, named)
     return fig
 
 
 def _axle_links(views, model, positions, sides) -> None:
     """The axle's own links: the bar's droplinks (its distance closures that are no
     corner's), and the heave link between the rockers (thin: it only measures)."""
-    from .viz import LINK
+    from .view_parts import LINK
 
     own = {f"{s}_{c.name}" for s, side in sides.items() for c in side.tree.closures}
     bar = model.tree.materials.get("bar", (0.85, 0.75, 0.15, 1.0))[:3]
@@ -468,14 +280,18 @@ def _axle_links(views, model, positions, sides) -> None:
         _segment(views, a, b, "--", color=colour, lw=1.0, gid="heave_link", label="heave link")
 
 
-class _AxleSide:
-    """One corner of an axle at a pose, read as the drawing reads a corner: its
-    geometry (as set), its own tree (the links drawn between its points) and, as
-    ``design_positions``, the pose's points (m) by the corner's names."""
+class _AxleSide(Assembly):
+    """One corner of an axle at a pose, read as the drawing reads a corner (an Assembly
+    of one corner, labelled ""): its geometry (as set), its own tree (the links drawn
+    between its points) and, as ``design_positions``, the pose's points (m) by the
+    corner's names."""
+
+    labels = ("",)
 
     def __init__(self, model, side: str, positions: dict[str, np.ndarray]):
-        g = model.geometries[side]
+        g = model.corners[side]
         self.geometry, self.tree = g, g.mechanism.tree(g)
+        self.corners = {"": g}
         self.design_positions = {n: positions[f"{side}_{n}"] for n in model.point_names[side]}
 
 
@@ -493,62 +309,6 @@ def _posed_visuals(model, q) -> list:
         end = None if v.end is None else move.act(v.end)
         out.append(replace(v, start=move.act(v.start), end=end))
     return out
-
-
-def _roll_centre_construction(ax, model, q, sides) -> tuple[bool, list[np.ndarray]]:
-    """Each side's FVIC construction and the crossing of the contact-patch lines, the
-    roll centre; whether it was drawn, and the points (mm) the view should keep."""
-    from .vectors import roll_centre
-
-    # with the rates (solved here): a mechanism's FVIC may come from its twist
-    motion = model.motion([q])
-    d = model.design_positions
-    lines, notes = {}, []
-    for s, c in sides.items():
-        own = {k: motion[f"{s}_{k}"][s] for k in model.point_names[s]}
-        ps = PointSet(own, {k: d[f"{s}_{k}"][None] for k in model.point_names[s]}, c.geometry)
-        ic = _instant_centre(ps, X)
-        p = _mm(c)
-        problem = _too_far(ic, p["wheel_center"][list(FRONT)], "FVIC")
-        if problem is None:
-            on_chassis = lambda n, s=s: model.points[f"{s}_{n}"].body == "chassis"  # noqa: E731
-            _arms_to(ax, _kingpin_rays(ps, c.geometry, on_chassis), FRONT, ic, "FVIC", f"_{s}")
-            notes.append(f"FVIC {s}: y = {ic[0]:.0f} mm, z = {ic[1]:.0f} mm")
-        else:
-            notes.append(f"{s}: {problem}")
-        if np.all(np.isfinite(ic)):
-            lines[s] = (p["contact_patch_center"][list(FRONT)], ic, problem is None)
-    rc = None
-    if len(lines) == 2:
-        with np.errstate(invalid="ignore", divide="ignore"):
-            rc = np.array(roll_centre([(*cp, *ic) for cp, ic, _ in lines.values()]), dtype=float)
-        middle = 0.5 * (lines["left"][0] + lines["right"][0])
-        if not np.all(np.isfinite(rc)):
-            notes.append("RC: the contact-patch lines are parallel")
-            rc = None
-        elif (far := float(np.linalg.norm(rc - middle))) > IC_FAR:
-            notes.append(f"RC {far / 1e3:.0f} m away, not drawn")
-            rc = None
-        else:
-            ax.plot(*rc, "D", color=CONSTRUCTION, ms=6, gid="roll_centre")
-            ax.annotate(
-                "RC", rc, xytext=(6, 5), textcoords="offset points", fontsize=8, color=CONSTRUCTION
-            )
-            y, z = np.round(rc) + 0.0  # a centre a hair left of the centreline: 0, not -0
-            notes.insert(0, f"RC: y = {y:.0f} mm, z = {z:.0f} mm")
-    else:
-        missing = [s for s in sides if s not in lines]
-        notes.append("RC: no front-view instant centre on " + " and ".join(missing))
-    for s, (cp, ic, near) in lines.items():
-        ends = [0.0, 1.0] if near else [0.0]  # along CP (0) → FVIC (1)
-        if rc is not None:
-            ends.append(float((rc - cp) @ (ic - cp) / ((ic - cp) @ (ic - cp))))
-        if len(ends) == 1:  # a far FVIC, no roll centre: towards the FVIC, as long as CP_y
-            ends.append(abs(cp[0]) / float(np.linalg.norm(ic - cp)))
-        line = np.array([cp + t * (ic - cp) for t in (min(ends), max(ends))])
-        ax.plot(*line.T, "-.", color=CONSTRUCTION, lw=0.9, gid=f"fvic_contact_patch_{s}")
-    _note(ax, "\n".join(notes))
-    return rc is not None or any(near for *_, near in lines.values()), [] if rc is None else [rc]
 
 
 def axle_pose(model, results: ResultsFile, step: int) -> tuple[np.ndarray, str]:

@@ -26,326 +26,47 @@ rocker. The roll centre is a marker, placed from an axle's results columns
 the contact patches) and hidden where they are blank. It is seen from the
 left side, and the ground is widened to the axle's track.
 
-Under a load case (``pin-susp view GEOMETRY SWEEP --cases LOADS --case NAME``)
-the members are coloured by their force at each frame: the links drawn
-between their ends and the coilover (its compression is the spring's
-``force_spring``), and the URDF's rods that are two-force members (a
-wishbone's legs, a multilink's tree link). The colour is matplotlib's
-``coolwarm`` at 0.5 + 0.5·tension/scale: red in tension, blue in
-compression, grey at zero, the scale being the largest |force| of any
-coloured member over the sweep under that case; near-black at a toggle,
-where the force is unbounded. A wishbone leg that is not a two-force member
-(its arm carries a pushrod or a spring: its leg columns are blank) is
-yellow-green, off the ramp. An axle's are both corners' and its droplinks,
-under one scale; the bar's torque (``torque_arb``, N·m) is no force on that
-scale, and the bar keeps its own colour. One replay shows one case: meshcat's
-animation is one clip of poses and colours, and a selector would need
-either a copy of every member per case or code reaching into meshcat's
-player.
+Under a load case the members are coloured by their force (``force_colours.py``).
+What is drawn between the solved points, and the framing, is ``view_parts.py``'s
+(the 2D drawings draw them too); meshcat's server is ``meshcat_server.py``'s.
 """
 
 from __future__ import annotations
 
-import contextlib
-import os
-import signal
-import subprocess
-import sys
-import threading
-
 import numpy as np
 import pinocchio as pin
 
-ROOT = "pin_susp"
-LINKS = {  # name: (ends, colour, radius); other distance closures (links) as LINK
-    "trackrod": (("trackrod_inboard", "trackrod_outboard"), 0x2E9E4F, 0.006),
-    "toe_link": (("toe_link_inboard", "toe_link_outboard"), 0x2E9E4F, 0.006),
-    "pushrod": (("pushrod_outboard", "pushrod_inboard"), 0xB0B0B0, 0.007),
-    "coilover": (("strut_top", "strut_bottom"), 0xD02828, 0.012),
-    "droplink": ((), 0xD9BF26, 0.006),  # an axle's, from rocker to bar: the bar's gold
-    "heave_link": (("left_heave_link_rocker", "right_heave_link_rocker"), 0xD02828, 0.012),
-}
-LINK = (0x1F6BD9, 0.007)  # a multilink's links: the wishbones' blue
+from .force_colours import FORCE_MAP as FORCE_MAP  # the force colouring, by its old
+from .force_colours import NOT_TWO_FORCE as NOT_TWO_FORCE  # address too
+from .force_colours import UNBOUNDED as UNBOUNDED
+from .force_colours import force_caption as force_caption
+from .force_colours import force_colours, members, set_colour
+from .force_colours import force_key as force_key
+from .meshcat_server import meshcat_visualizer, start_server, stop_server
+from .meshcat_server import signals_held as signals_held
+from .view_parts import LINK as LINK  # what is drawn between points, by its old address
+from .view_parts import LINKS as LINKS
+from .view_parts import ROOT as ROOT
+from .view_parts import as_drawn, framing, links, outline, roll_centres, segments, sides
+from .view_parts import bounds as bounds
+
 AXIS_COLOUR, PATCH_COLOUR = 0xE8C020, 0xE83070
 GHOST = [0.55, 0.55, 0.6, 0.35]
 GROUND_COLOUR, GROUND_OPACITY = 0xB4B4A8, 0.3
 GROUND_SIZE, GROUND_THICKNESS = 1.5, 0.002  # m: a square under the corner, its top at the CP
 GROUND_SPAN = 1.2  # ... or this times the width of what is drawn, if wider (an axle)
 MARKERS = {"roll_centre": (0x00D8F0, 0.025)}  # name: colour, radius (m)
-FORCE_MAP = "coolwarm"  # matplotlib's: blue (compression) → grey (0) → red (tension)
-UNBOUNDED = (0.1, 0.1, 0.1)  # a member at a toggle: its force has no bound
-# a wishbone leg that is no two-force member (its arm carries a pushrod, say): no tension
-# to colour, and none of the ramp's colours (its blue would read as compression)
-NOT_TWO_FORCE = (0.6, 0.8, 0.2)  # yellow-green
-VIEW = np.array([1.6, 0.35, 0.7])  # camera direction: front, outboard (y by side), above
-FOV = 75.0  # degrees, vertical: meshcat's default camera (three.js PerspectiveCamera)
-FILL = 0.8  # the corner's share of the view's height, or of its width ...
-ASPECT = 4 / 3  # ... in a view at least this wide for its height
-
-
-def sides(model) -> list[tuple[str, object]]:
-    """(prefix of its points' names, Geometry) of each corner: a corner's own (prefix
-    ``""``), an axle's two (``"left_"``, ``"right_"``)."""
-    geometries = getattr(model, "geometries", None)
-    if geometries is None:
-        return [("", model.geometry)]
-    return [(f"{side}_", g) for side, g in geometries.items()]
-
-
-def _bare(model, name: str) -> str:
-    """A name without its side's prefix (an axle's ``left_trackrod``: ``trackrod``)."""
-    for prefix, _ in sides(model):
-        if prefix and name.startswith(prefix):
-            return name[len(prefix) :]
-    return name
-
-
-def segments(model, positions: dict[str, np.ndarray]) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """Lines that are not bodies of the tree: closure links, coilover, steering axis (m).
-
-    The steering axis runs from the upper ball joint down to the ground
-    (the contact patch's height), where scrub and trail are measured. An
-    axle's are per side, named with the side's prefix (``left_steering_axis``).
-    """
-    out = {}
-    for name, ((a, b), _, _) in links(model).items():
-        if a in positions and b in positions:
-            out[name] = (positions[a], positions[b])
-    from .metrics import PointSet
-
-    for prefix, g in sides(model):
-        own = {k[len(prefix) :]: v[None] for k, v in positions.items() if k.startswith(prefix)}
-        ps = PointSet(own, {}, g)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            ends = ps.kingpin()
-        if ends is not None:
-            lower, upper = ends[0][0], ends[1][0]
-            k = upper - lower
-            ground = own["contact_patch_center"][0, 2]
-            if abs(k[2]) > 1e-9 and np.all(np.isfinite(k)):
-                out[f"{prefix}steering_axis"] = (upper, lower + (ground - lower[2]) / k[2] * k)
-    return out
-
-
-def links(model) -> dict[str, tuple[tuple[str, str], int, float]]:
-    """The links drawn between their ends: the distance closures (an axle's droplinks
-    too), a coilover per corner, an axle's heave link."""
-    out = {}
-    for c in model.tree.closures:
-        if c.kind == "distance":
-            out[c.name] = (c.points, *LINKS.get(_bare(model, c.name), (None, *LINK))[1:])
-    for prefix, g in sides(model):
-        if "strut_top" in g.hardpoints:
-            (a, b), colour, radius = LINKS["coilover"]
-            out[f"{prefix}coilover"] = ((prefix + a, prefix + b), colour, radius)
-    if all(end in model.design_positions for end in LINKS["heave_link"][0]):
-        out["heave_link"] = LINKS["heave_link"]
-    return out
-
-
-def outline(*models) -> np.ndarray:
-    """Points (m, N×3) around what is drawn of the corners (or axles) at design.
-
-    Their design points, the rack's end on the car's centre plane, and the
-    tyre's two rims: circles of the wheel's radius at its inboard and
-    outboard faces.
-    """
-    points = []
-    angles = np.linspace(0.0, 2.0 * np.pi, 48, endpoint=False)
-    for model in models:
-        p = model.design_positions
-        points += list(p.values())
-        for prefix, g in sides(model):
-            points += _tyre(g, prefix, p, angles)
-    return np.array(points)
-
-
-def _tyre(g, prefix: str, p: dict, angles: np.ndarray) -> list[np.ndarray]:
-    """A corner's rack end on the centre plane, and its tyre's two rims (m)."""
-    points = []
-    if g.steering == "rack":  # the rack is drawn to the centre plane (y = 0)
-        points.append(p[prefix + g.steering_points[0]] * np.array([1.0, 0.0, 1.0]))
-    a, b = p[prefix + "wheel_inboard"], p[prefix + "wheel_outboard"]
-    axis = (b - a) / np.linalg.norm(b - a)
-    e1 = np.cross(axis, [1.0, 0.0, 0.0] if abs(axis[0]) < 0.9 else [0.0, 0.0, 1.0])
-    e1 /= np.linalg.norm(e1)
-    e2 = np.cross(axis, e1)
-    rim = g.wheel.radius * (np.outer(np.cos(angles), e1) + np.outer(np.sin(angles), e2))
-    return [*points, *(a + rim), *(b + rim)]
-
-
-def bounds(*models) -> tuple[np.ndarray, np.ndarray]:
-    """The box (lowest, highest corner, m) around what is drawn of the corners at design."""
-    points = outline(*models)
-    return points.min(axis=0), points.max(axis=0)
-
-
-def roll_centres(results) -> np.ndarray:
-    """An axle's roll centre at each step (m, N×3; NaN where blank), from its results
-    columns: y and z from ``roll_center_y``/``_z``, x midway between the contact
-    patches (the front view the roll centre is found in)."""
-    x = 0.5 * (results["left_contact_patch_center_x"] + results["right_contact_patch_center_x"])
-    return 1e-3 * np.column_stack([x, results["roll_center_y"], results["roll_center_z"]])
 
 
 def design_results(model):
-    """An axle's results columns at its design state: one row, no sweep."""
-    from .axle import axle_results
+    """A subject's results columns at its design state: one row, no sweep."""
     from .solver import Solution
     from .sweep import Sweep
 
-    return axle_results(model, Sweep([]), [Solution(model.q_design, True, 0, 0.0)])
+    return model.sweep_results(Sweep([]), [Solution(model.q_design, True, 0, 0.0)])
 
 
-def as_drawn(model):
-    """The model as drawn, without its shims and adjusters (a ghost under the as-set
-    one); None when it is set as drawn."""
-    from dataclasses import replace
-
-    from .linkage import Linkage
-
-    geometries = [g for _, g in sides(model)]
-    if all(g.drawn is None for g in geometries):
-        return None
-    if not hasattr(model, "geometries"):
-        return Linkage(model.geometry.drawn)
-    from .axle import AxleModel
-
-    def drawn(g):  # its setup at the design values: AxleModel sets up nothing more
-        g = g.drawn or g
-        shim = g.camber_shim
-        if shim is not None:
-            shim = replace(shim, setup_thickness=shim.design_thickness)
-        return replace(g, camber_shim=shim, trackrod_length_delta=0.0, pushrod_length_delta=0.0)
-
-    left, right = (drawn(g) for g in geometries)
-    if model.axle is None:
-        return AxleModel(left, right)
-    return AxleModel(replace(model.axle, left=left, right=right))
-
-
-def framing(points: np.ndarray, sign: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
-    """Where the camera looks and where it sits from there (m, world frame) to frame the points.
-
-    It looks along ``VIEW`` (outboard on the side ``sign``), z up, at a point
-    near the points' bounding-box centre, moved across the view until the
-    points' picture is centred; it is set back until every point is within
-    ``FILL`` of the view's half-height, and across within that of a view of
-    aspect ``ASPECT``.
-    """
-    u = VIEW * np.array([1.0, sign, 1.0])
-    u = u / np.linalg.norm(u)
-    right = np.cross(-u, [0.0, 0.0, 1.0])
-    right /= np.linalg.norm(right)
-    up = np.cross(right, -u)
-    points = np.asarray(points, dtype=float)
-    reach = FILL * np.tan(np.radians(FOV / 2)) * np.array([ASPECT, 1.0])
-    target = 0.5 * (points.min(axis=0) + points.max(axis=0))
-    for _ in range(30):
-        c = points - target
-        # c is in view when |c·right|, |c·up| <= reach·(distance - c·u)
-        across = np.abs(np.stack([c @ right, c @ up], axis=1)) / reach
-        distance = float(np.max(c @ u + across.max(axis=1)))
-        seen = np.stack([c @ right, c @ up], axis=1) / (distance - c @ u)[:, None]
-        middle = 0.5 * (seen.min(axis=0) + seen.max(axis=0))
-        if np.abs(middle).max() < 1e-5:
-            break
-        target = target + distance * (middle[0] * right + middle[1] * up)
-    return target, distance * u
-
-
-# meshcat's own server, with its web server bound to loopback (meshcat 0.3.2's
-# listens on every interface; its ZMQ socket is on 127.0.0.1 already). It asks
-# Linux to end it when its parent (the pin-susp process, argv[1]) dies, even by
-# SIGKILL: set here, after exec, not in a preexec_fn (unsafe in a threaded parent).
-_SERVER = """
-import os, signal, sys
-if sys.platform.startswith("linux"):
-    import ctypes
-    ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
-    if os.getppid() != int(sys.argv[1]):  # the parent died before that: go now
-        sys.exit(0)
-import tornado.web
-listen = tornado.web.Application.listen
-tornado.web.Application.listen = lambda app, port, address="127.0.0.1", **kw: listen(
-    app, port, address, **kw
-)
-sys.argv = ["meshcat-server"]
-from meshcat.servers.zmqserver import main
-main()
-"""
-
-
-@contextlib.contextmanager
-def signals_held(signals=(signal.SIGINT, signal.SIGTERM, signal.SIGHUP)):
-    """Inside, these signals wait; the first that came is handled once the block ends,
-    as it would have been (Ctrl+C: KeyboardInterrupt). For code that must not lose one:
-    an import that swallows KeyboardInterrupt (pinocchio.visualize imports trimesh,
-    whose imports catch BaseException), a server being stopped. Main thread only."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    came = []
-    previous = {}
-    for s in signals:
-        if signal.getsignal(s) is not None:  # None: a handler Python did not install
-            previous[s] = signal.signal(s, lambda number, _: came.append(number))
-    try:
-        yield
-    finally:
-        for s, handler in previous.items():
-            signal.signal(s, handler)
-        if came:
-            handler = previous[came[0]]
-            if callable(handler):
-                handler(came[0], None)  # raises, as it would have inside
-            elif handler == signal.SIG_DFL:
-                signal.raise_signal(came[0])
-
-
-def _meshcat_visualizer():
-    """Pinocchio's MeshcatVisualizer, imported with Ctrl+C held: its package imports
-    trimesh, which swallows an interrupt that comes while it loads."""
-    with signals_held():
-        from pinocchio.visualize import MeshcatVisualizer
-    return MeshcatVisualizer
-
-
-def start_server() -> tuple[subprocess.Popen, str]:
-    """A meshcat server on 127.0.0.1 that ends with this process (even on SIGKILL).
-
-    Returns the process and its ZMQ URL.
-    """
-    from meshcat.servers.zmqserver import match_zmq_url
-
-    proc = subprocess.Popen(
-        [sys.executable, "-u", "-c", _SERVER, str(os.getpid())],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.DEVNULL,
-        start_new_session=True,  # a Ctrl+C is ours to handle: we stop it in close()
-    )
-    try:
-        line = ""
-        while "zmq_url" not in line:
-            line = proc.stdout.readline().decode("utf-8", "replace")
-            if not line and proc.poll() is not None:
-                raise RuntimeError(f"the meshcat server exited at start (code {proc.returncode})")
-        proc.stdout.readline()  # its web URL: the viewer asks for it over ZMQ
-    except BaseException:  # an interrupt while it starts: it goes with us
-        _stop(proc)
-        raise
-    return proc, match_zmq_url(line.strip())
-
-
-def _stop(proc: subprocess.Popen) -> None:
-    """End a server process, at once if it does not end within 10 s."""
-    if proc.poll() is None:
-        proc.terminate()
-        try:
-            proc.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait()
+MARKED = {"roll_centre": roll_centres}  # a marker's place at each step, from the columns
 
 
 def _rod_transform(p0: np.ndarray, p1: np.ndarray) -> np.ndarray:
@@ -406,10 +127,9 @@ class Scene:
             self.viewer[f"{ROOT}/{prefix}contact_patch"].set_object(
                 mg.Sphere(0.018), mg.MeshLambertMaterial(color=PATCH_COLOUR)
             )
-        # an axle's roll centre: where its design results put it
-        self.design_markers = {}
-        if hasattr(model, "geometries"):
-            self.design_markers["roll_centre"] = roll_centres(design_results(model))[0]
+        # the markers (an axle's roll centre): where its design results put them
+        design = design_results(model) if model.markers else None
+        self.design_markers = {name: MARKED[name](design)[0] for name in model.markers}
         for name in self.design_markers:
             colour, radius = MARKERS[name]
             self.viewer[f"{ROOT}/{name}"].set_object(
@@ -419,7 +139,7 @@ class Scene:
         self.show()
 
     def _robot(self, model, name, colour):
-        MeshcatVisualizer = _meshcat_visualizer()
+        MeshcatVisualizer = meshcat_visualizer()
         visual = pin.buildGeomFromUrdfString(model.model, model.urdf, pin.GeometryType.VISUAL)
         viz = MeshcatVisualizer(model.model, visual, visual)
         viz.initViewer(viewer=self.viewer, loadModel=False)
@@ -506,7 +226,7 @@ class Scene:
                 target[f"{ROOT}/{name}"].set_transform(place)
             _set_visible(target[f"{ROOT}/{name}"], visible)
         for node, rgb in (colours or {}).items():
-            _set_colour(target[node], rgb)
+            set_colour(target[node], rgb)
 
     def animate(
         self,
@@ -545,83 +265,16 @@ class Scene:
         return page
 
     def members(self, columns) -> dict[str, str]:
-        """Force column → the node drawing that member (``pin-susp loads``' names): a link
-        drawn between its ends (``force_trackrod``, a multilink's links; the coilover for
-        ``force_spring``), else the as-set model's rod between the member's ends (a
-        wishbone's legs ``force_<arm>_front``/``_rear``, a multilink's tree link). An
-        axle's columns end with their side (``force_trackrod_left``: the link
-        ``left_trackrod``; ``force_droplink_right``: ``right_droplink``)."""
+        """Force column → the node drawing that member (force_colours.members)."""
         model, viz = self.robots[-1]
-        drawn = segments(model, model.design_positions)
-        data = model.model.createData()
-        placed = viz.visual_model.createData()
-        pin.updateGeometryPlacements(model.model, data, viz.visual_model, placed, model.q_design)
-        middles = [
-            (o, placed.oMg[i].translation) for i, o in enumerate(viz.visual_model.geometryObjects)
-        ]
-        p = model.design_positions
-        out = {}
-        for column in columns:
-            name = column.removeprefix("force_")
-            bare, _, side = name.rpartition("_")
-            prefix = f"{side}_" if side in ("left", "right") and len(sides(model)) == 2 else ""
-            if prefix:  # an axle's: force_<member>_<side> is its side's <side>_<member>
-                name = prefix + bare
-            link = prefix + "coilover" if name == prefix + "spring" else name
-            if not column.startswith("force_") or name == "rack":
-                continue
-            if link in drawn:
-                out[column] = f"{ROOT}/links/{link}"
-                continue
-            arm, _, end = name.rpartition("_")
-            for a, b in (
-                (f"{name}_inboard", f"{name}_outboard"),
-                (f"{arm}_inboard_{end}", f"{arm}_outboard"),
-            ):
-                if a in p and b in p:
-                    middle = 0.5 * (p[a] + p[b])
-                    rod = next((o for o, m in middles if np.linalg.norm(m - middle) < 1e-9), None)
-                    if rod is not None:
-                        out[column] = viz.getViewerNodeName(rod, pin.GeometryType.VISUAL)
-        return out
+        return members(model, viz, columns)
 
     def force_colours(self, forces, case: str) -> tuple[dict[str, np.ndarray], float]:
-        """Each member's colour at each step of ``forces`` (a Results or ResultsFile of
-        ``pin-susp loads``) under the load case ``case``: {node: rgb rows}, and the scale
-        (N): the largest |force| of a coloured member over the sweep. Tension red,
-        compression blue, grey at zero (``FORCE_MAP``); UNBOUNDED where the force is
-        blank (a toggle). A member whose column is blank at every other step (a leg of
-        an arm that carries more than its ball joint: no two-force member) is
-        NOT_TWO_FORCE, off the ramp; ``self.not_two_force`` lists those nodes."""
-        import matplotlib
-
-        rows = np.asarray(forces["load_case"]) == case
-        bounded = np.asarray(forces["loads_unbounded"], dtype=float)[rows] == 0.0
-        # a spring's column (an axle's: each side's) is its compression
-        sign = dict.fromkeys(["force_spring", "force_spring_left", "force_spring_right"], -1.0)
-        tension = {
-            node: sign.get(column, 1.0) * np.asarray(forces[column], dtype=float)[rows]
-            for column, node in self.members(forces.columns).items()
-        }
-        # a leg blank wherever the forces are bounded is no two-force member (its arm
-        # carries the pushrod): NOT_TWO_FORCE, off the scale
-        bent = [n for n, t in tension.items() if bounded.any() and not np.isfinite(t).any()]
-        self.not_two_force = bent
-        tension = {n: t for n, t in tension.items() if n not in bent}
-        scale = max(
-            (float(np.nanmax(np.abs(t), initial=0.0)) for t in tension.values()), default=0.0
-        )
-        ramp = matplotlib.colormaps[FORCE_MAP]
-        out = {}
-        for node, t in tension.items():
-            share = t / scale if scale > 0.0 else np.zeros_like(t)
-            rgb = ramp(0.5 + 0.5 * np.nan_to_num(share))[:, :3]
-            rgb[~np.isfinite(t)] = UNBOUNDED
-            out[node] = rgb
-        for node in bent:
-            rgb = np.tile(NOT_TWO_FORCE, (len(bounded), 1))
-            rgb[~bounded] = UNBOUNDED
-            out[node] = rgb
+        """Each member's colour at each step of ``forces`` under the load case ``case``,
+        and the scale (force_colours.force_colours); ``self.not_two_force``: the legs
+        that are no two-force member, coloured NOT_TWO_FORCE."""
+        model, viz = self.robots[-1]
+        out, scale, self.not_two_force = force_colours(model, viz, forces, case)
         return out, scale
 
     def close(self) -> None:
@@ -637,7 +290,7 @@ class Scene:
         socket = getattr(window, "zmq_socket", None)
         if socket is not None and not socket.closed:
             socket.close(linger=0)
-        _stop(proc)
+        stop_server(proc)
 
 
 CornerScene = Scene  # its name from before axles
@@ -660,65 +313,6 @@ class _LastAnimation:
 
     def lower(self) -> dict:
         return self.command
-
-
-def _set_colour(node, rgb) -> None:
-    """A member's colour (rgb, 0 to 1): of the node's mesh, or of an animation frame (a
-    colour track on the mesh's material)."""
-    from meshcat.animation import AnimationFrameVisualizer
-
-    rgb = [float(c) for c in rgb]
-    if isinstance(node, AnimationFrameVisualizer):
-        node["<object>"].set_property("material.color", "color", rgb)
-    else:
-        node.set_property("color", [*rgb, 1.0])
-
-
-def force_key(case: str, scale: float, note: str = "", bent: bool = False) -> str:
-    """The colours' key, one line of text: the case, the scale, what red and blue are;
-    ``bent``: some legs are no two-force members (their colour said too)."""
-    return (
-        f"members coloured by force under {case!r}{f' ({note})' if note else ''}: "
-        f"red tension, blue compression, grey 0, full colour at {scale:.0f} N "
-        "(the largest |force| over the sweep); near-black: unbounded (a toggle)"
-        + (
-            "; yellow-green: a wishbone leg that is not a two-force member (its arm "
-            "carries more than its ball joint: see its *_bushing_along_leg columns)"
-            if bent
-            else ""
-        )
-    )
-
-
-def force_caption(case: str, scale: float, source: str = "", bent: bool = False) -> str:
-    """The key as an HTML block over the replay: a colour bar from −scale to +scale
-    (``bent``: and the colour of a leg that is no two-force member)."""
-    import html
-
-    import matplotlib
-
-    ramp = matplotlib.colormaps[FORCE_MAP]
-    stops = ", ".join(matplotlib.colors.to_hex(ramp(t)) for t in np.linspace(0.0, 1.0, 9))
-    black = matplotlib.colors.to_hex(UNBOUNDED)
-    return (
-        '<div id="force_key" style="position:fixed;left:8px;top:8px;z-index:10;'
-        "font:12px sans-serif;background:rgba(255,255,255,0.85);padding:6px 8px;"
-        f'border-radius:4px">Load case <b>{html.escape(case)}</b>'
-        f"{html.escape(f' ({source})') if source else ''}<br>"
-        f'<div style="width:220px;height:10px;margin:4px 0;background:linear-gradient('
-        f'to right, {stops})"></div>'
-        f'<div style="display:flex;justify-content:space-between;width:220px">'
-        f"<span>−{scale:.0f} N</span><span>0</span><span>+{scale:.0f} N</span></div>"
-        f"compression ← → tension; "
-        f'<span style="color:{black}">■</span> unbounded (toggle)'
-        + (
-            f'<br><span style="color:{matplotlib.colors.to_hex(NOT_TWO_FORCE)}">■</span> '
-            "not a two-force member (no tension: its arm carries more than its ball joint)"
-            if bent
-            else ""
-        )
-        + "</div>"
-    )
 
 
 def _set_visible(node, visible: bool) -> None:

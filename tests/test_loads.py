@@ -687,3 +687,29 @@ def test_a_spring_below_zero_force_is_warned_of(tmp_path, capsys):
     header, rows = _read(out)
     force = [float(r[header.index("spring_force")]) for r in rows]
     assert force[0] < 0.0 < force[-1]
+
+
+def test_a_load_case_file_is_read_by_the_subjects_labels(tmp_path):
+    """``load_cases(path, labels=subject.labels)``: a corner's loads at each case's top
+    (labels ``""``), an axle's in a block per labelled corner — as ``axle=`` reads them."""
+    from pin_susp.loads import AxleLoadCase
+
+    corner = load_cases(EXAMPLES / "loads.yaml", labels=("",))
+    flat = load_cases(EXAMPLES / "loads.yaml")
+    assert [c.name for c in corner] == [c.name for c in flat]
+    for a, b in zip(corner, flat, strict=True):
+        assert all(list(getattr(a, k)) == list(getattr(b, k)) for k in ("contact_patch", "moment"))
+    assert all(c.wheel("") is c for c in corner)
+    path = tmp_path / "axle_loads.yaml"
+    path.write_text(
+        "cases:\n  - name: bump\n    left: {contact_patch: {fx: 0, fy: 0, fz: 3000}}\n"
+        "    right: {moment: {mx: 5, my: 0, mz: 0}}\n"
+    )
+    (case,) = load_cases(path, labels=("left", "right"))
+    (same,) = load_cases(path, axle=True)
+    assert isinstance(case, AxleLoadCase) and case.name == same.name == "bump"
+    for label in ("left", "right"):
+        for part in ("contact_patch", "wheel_center", "moment"):
+            assert list(getattr(case.wheel(label), part)) == list(getattr(same.wheel(label), part))
+    assert list(case.wheel("left").contact_patch) == [0.0, 0.0, 3000.0]
+    assert list(case.wheel("right").moment) == [5.0, 0.0, 0.0]

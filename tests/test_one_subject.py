@@ -42,13 +42,10 @@ KIND_TESTS = {
     "cli/commands/draw.py": 1,  # the axle's front view, a twin
     "cli/commands/sensitivity.py": 1,  # the axle's sensitivities, a twin
     "cli/commands/setup.py": 1,  # the axle's setup sheet, a twin
-    "drawing.py": 1,
-    "loads.py": 3,
     "plots.py": 1,
     "pointwise.py": 1,
     "study.py": 1,
     "validate.py": 3,
-    "viz.py": 4,
 }
 
 

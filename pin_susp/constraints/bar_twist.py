@@ -11,7 +11,7 @@ class BarTwist(Row):
     """An anti-roll bar's twist (1 row, rad per dq): a U-bar's left arm's turn minus the
     right's (both about the bar's axis), a T-bar's crossbar turn about its stem. A held
     row: its residual is zero, its Jacobian the constant ±1 in the joints' columns. Its
-    multiplier is the bar's torque (loads.py)."""
+    multiplier is the bar's torque (statics.py)."""
 
     size = 1
     name = "arb"

@@ -11,7 +11,7 @@ class RockerTurn(Row):
     """The rocker's turn about its axis â = unit(b − a) (1 row, rad per dq): a held row —
     its residual is zero, only its Jacobian counts, J = âᵀ·W_rocker (the angular
     Jacobian rows of a frame on the rocker). Its multiplier is the torsion bar's torque
-    (loads.py)."""
+    (statics.py)."""
 
     size = 1
     angular = True
