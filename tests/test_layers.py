@@ -432,7 +432,6 @@ LONG = {
     "plots.py": 850,  # reading results files, the kinematics, axle and force reports
     "validate.py": 1032,  # the point-based, MuJoCo and Drake engines and the comparison
     "axle.py": 1323,  # the axle's tree, its file reader, its sweep and its columns
-    "study.py": 1482,  # study files, variants, batches on Dask, parts, resume, optimisation
 }
 MAX_LINES = 600
 

@@ -51,7 +51,7 @@ KIND_TESTS = {
     "loads.py": 3,
     "plots.py": 1,
     "pointwise.py": 1,
-    "study.py": 1,
+    "study/spec.py": 1,
     "validate.py": 3,
     "viz.py": 4,
 }
