@@ -430,7 +430,6 @@ LONG = {
     "viz.py": 731,  # meshcat scene, animation, force colours, the HTML page
     "loads.py": 740,  # load-case files, the statics' plan, member forces, summaries
     "plots.py": 850,  # reading results files, the kinematics, axle and force reports
-    "validate.py": 1032,  # the point-based, MuJoCo and Drake engines and the comparison
     "axle.py": 1323,  # the axle's tree, its file reader, its sweep and its columns
 }
 MAX_LINES = 600

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..subject import is_axle_data
 from ..yamlio import Reader, load_yaml, read_once
 from .data import AXES, Job, Term, Variable
 from .derivatives import holds_wheels
@@ -112,7 +113,7 @@ def _load_study(source: str | Path) -> Study:
     sweep_path = str(here / r.text(data["sweep"], "sweep"))
     geometry_data, _, geometry_sha = load_yaml(geometry_path)
     sweep_data, _, sweep_sha = load_yaml(sweep_path)
-    axle = geometry_data.get("scope") == "axle"
+    axle = is_axle_data(geometry_data)  # the kind, read where subjects are (subject.py)
     design = _Design(geometry_data, geometry_path, sweep_path, axle)
     variables = _variables(data, design, r)
     study = Study(
@@ -224,22 +225,17 @@ class _Design:
     """The study's geometry and sweep solved at design: names to check the file against."""
 
     def __init__(self, geometry: dict, geometry_path: str, sweep_path: str, axle: bool):
-        self.axle = axle
         # errors name the files, as `pin-susp sweep` would
         subject = build(geometry, geometry_path, axle)
         from ..sweep import load_sweep
 
         self.sweep = load_sweep(sweep_path)
-        design = at_design(self.sweep)
-        if axle:
-            from ..axle import axle_results, solve_axle_sweep
-
-            self.results = axle_results(subject, design, solve_axle_sweep(subject, design))
-            self.points = {s: list(subject.geometries[s].hardpoints) for s in ("left", "right")}
-        else:
-            subject.solver_for(self.sweep.targets, self.sweep.source)
-            self.results = subject.run_sweep(design)
-            self.points = {None: list(subject.geometry.hardpoints)}
+        subject.check_sweep(self.sweep)
+        self.results = subject.solve_sweep(at_design(self.sweep))[1]
+        # each corner's hardpoints by its label (None for a corner's one, unlabelled);
+        # the labels a variable's side names (none on a corner)
+        self.points = {label or None: list(g.hardpoints) for label, g in subject.corners.items()}
+        self.sides = tuple(label for label in subject.labels if label)
         self.columns = [c for c in self.results.columns if c != "step_index"]
 
     def check_defined(self, name: str, key: str, r: Reader) -> None:
@@ -279,10 +275,10 @@ def _variables(data: dict, design: _Design, r: Reader) -> list[Variable]:
         key = f"variables[{i}]"
         v = r.mapping(item, key, required=("point", "axis", "range"), optional=("side",))
         side = None
-        if design.axle:
+        if design.sides:
             if "side" not in v:
                 r.fail(f"{key}.side", "missing key: on an axle each variable names its side")
-            side = r.choice(v["side"], f"{key}.side", ("left", "right"))
+            side = r.choice(v["side"], f"{key}.side", design.sides)
         elif "side" in v:
             r.fail(f"{key}.side", "a corner has one side: side is for an axle's variables")
         point = r.text(v["point"], f"{key}.point")
