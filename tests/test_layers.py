@@ -429,7 +429,6 @@ LONG = {
     "geometry.py": 712,  # the Geometry data, the geometry file's reader, wheel formulas
     "viz.py": 731,  # meshcat scene, animation, force colours, the HTML page
     "loads.py": 740,  # load-case files, the statics' plan, member forces, summaries
-    "plots.py": 850,  # reading results files, the kinematics, axle and force reports
     "axle.py": 1323,  # the axle's tree, its file reader, its sweep and its columns
 }
 MAX_LINES = 600
