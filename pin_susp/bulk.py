@@ -41,6 +41,7 @@ from .solver import MAX_STEP
 # A sweep shorter than this is marched step by step (the coarse pass would be most of it).
 MIN_STEPS = 200
 COARSE_STEPS = 32  # about this many coarse steps, whatever the sweep's length
+COARSE_GROUP = 4  # every this many-th coarse step marched, the others solved at once
 MAX_ITERATIONS = 8
 
 _TREES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
