@@ -16,6 +16,11 @@ def is_axle_file(path) -> bool:
     from .yamlio import load_yaml
 
     data, _, _ = load_yaml(path)
+    return is_axle_data(data)
+
+
+def is_axle_data(data: dict) -> bool:
+    """Whether a geometry file's data, as read, is an axle's (``scope: axle``)."""
     return data.get("scope") == "axle"
 
 

@@ -430,10 +430,7 @@ LONG = {
     "metrics.py": 689,  # the corner metrics, their registry, instant centres, anti geometry
     "sensitivity.py": 692,  # hardpoint sensitivities: virtual joints, corner and axle tables
     "geometry.py": 707,  # the Geometry data, the geometry file's reader, wheel formulas
-    "plots.py": 850,  # reading results files, the kinematics, axle and force reports
-    "validate.py": 1032,  # the point-based, MuJoCo and Drake engines and the comparison
     "axle.py": 665,  # the axle's model, its sweep and its columns
-    "study.py": 1482,  # study files, variants, batches on Dask, parts, resume, optimisation
 }
 MAX_LINES = 600
 
