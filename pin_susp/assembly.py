@@ -91,6 +91,15 @@ class Assembly:
 
     # -- setup and sensitivity (setup.py, sensitivity.py, their commands) ----------
 
+    @classmethod
+    def as_drawn(cls, path, label: str | None = None) -> Assembly:
+        """The subject of a geometry file as the file draws it, for the setup analyses:
+        its labels, its corners as drawn, its source, name and setup answers, but no
+        model built and no setup applied (a setup that cannot be applied is the setup
+        analysis's to report). ``label``: a setup option's (``--side``), refused here
+        where the kind has no such label, before the file is read further."""
+        raise NotImplementedError
+
     @property
     def drawn_corners(self) -> dict:
         """label → the corner's Geometry as drawn, with its setup values (its shim stack

@@ -376,6 +376,14 @@ class AxleAssembly(Assembly):
     axle: AxleGeometry | None
     static_columns = (("track", "track"), ("roll_center_y", "RC y"), ("roll_center_z", "RC z"))
 
+    @classmethod
+    def as_drawn(cls, path, label: str | None = None) -> AxleAssembly:
+        drawn = cls.__new__(cls)  # no model built: the setup surface alone
+        drawn.axle = axle = load_axle(path)
+        drawn.source, drawn.name = axle.source, axle.name
+        drawn.corners = {"left": axle.left, "right": axle.right}
+        return drawn
+
     def setup_labels(self, label: str | None = None) -> tuple[str, ...]:
         chosen = super().setup_labels(label)
         if label is not None and self.setup_owner("right") != "right":
