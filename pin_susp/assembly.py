@@ -138,3 +138,48 @@ class Assembly:
         """The subject's file data with each given corner's setup (label → Geometry)
         written in."""
         raise NotImplementedError
+
+    # -- hardpoint sensitivities (sensitivity.py, its command) ---------------------
+
+    # the points its shared elements add (an axle's bar and heave link), no corner's
+    # hardpoints: their sensitivities are not computed
+    element_points: frozenset[str] = frozenset()
+    # its own columns of its corners together that its sensitivities give, after each
+    # corner's (an axle's track, roll centre, ...; a corner: none)
+    sensitivity_columns: tuple[str, ...] = ()
+
+    def corner_linkage(self, label: str):
+        """The Linkage of a labelled corner alone, as set: its sensitivities' model."""
+        from .linkage import Linkage
+
+        return Linkage(self.corners[label])
+
+    def sensitivity_sweep(self, sweep) -> tuple[list, object]:
+        """A sweep solved for its sensitivities: its steps' solutions, and the results the
+        failure report reads (the steps without sensitivities): here every column."""
+        return self.solve_sweep(sweep)
+
+    def held_at(self, sweep, step: int) -> list | None:
+        """What its sensitivities hold at a sweep's step: the sweep's targets there (None:
+        each corner's wheel-centre height and rack as solved there)."""
+        from dataclasses import replace
+
+        return [replace(t, values=t.values[step]) for t in sweep.targets]
+
+    def sensitivity_held(self) -> str | None:
+        """What its sensitivities hold, as its table and CSV say it (None: the sweep's
+        targets, or the design's, unsaid)."""
+        return None
+
+    def sensitivity_groups(self, columns: list[str]) -> list[tuple[str, list]]:
+        """The printed table's groups, (heading, columns): each labelled corner's own
+        (a corner's one: every column, no heading); a corner that takes another's setup
+        (a mirrored axle's right side) mirrors it, and is left out."""
+        groups = []
+        for label in self.labels:
+            if self.setup_owner(label) == label:
+                suffix = self.suffix(label)
+                names = [n for n in columns if n.endswith(suffix)]
+                heading = f"the {label} corner (columns suffixed {suffix}):" if label else ""
+                groups.append((heading, names))
+        return groups

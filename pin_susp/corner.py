@@ -337,6 +337,9 @@ class Corner(Linkage, Assembly):
             raise self._no_sides(self.source)
         return self.labels
 
+    def corner_linkage(self, label: str) -> Corner:
+        return self  # its one corner's Linkage: itself
+
     @staticmethod
     def _no_sides(source) -> InputError:
         return InputError("--side", "", f"{source} is a corner (--side sets one side of an axle)")
