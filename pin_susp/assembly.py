@@ -29,7 +29,9 @@ class Assembly:
     elastic elements its corners share, each (the joints whose turn twists it, its
     stiffness in N·m/deg or None) — an axle's anti-roll bar, unless rigid;
     ``markers``: what the 3D view marks from its results' columns (an axle's
-    ``roll_centre``).
+    ``roll_centre``); ``elements``: the elements its corners share (pin_susp/elements/:
+    an axle's anti-roll bar and heave link; none for a corner), the point-based
+    formulation's too (pointwise.ELEMENTS).
     """
 
     labels: tuple[str, ...]
@@ -43,6 +45,7 @@ class Assembly:
     spring_senses: dict
     shared_springs: tuple = ()
     markers: tuple[str, ...] = ()
+    elements: tuple = ()
 
     @staticmethod
     def suffix(label: str) -> str:

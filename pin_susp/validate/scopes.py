@@ -18,7 +18,7 @@ from ..axle import (
 from ..jet import Dual
 from ..jet import value as plain
 from ..metrics import METRICS, TOE_LINK, metric_columns
-from ..pointwise import Along, PointwiseAxle, PointwiseCorner, Y, Z, axle_targets
+from ..pointwise import Along, PointwiseLinkage, Y, Z, axle_targets, labelled
 
 RATE_METRICS = {m.name for m in METRICS if m.rates}
 
@@ -59,8 +59,8 @@ class CornerScope:
     def results(self, sweep):
         return self.subject.run_sweep(sweep)
 
-    def pointwise(self) -> PointwiseCorner:
-        return PointwiseCorner(self.subject.geometry)
+    def pointwise(self) -> PointwiseLinkage:
+        return PointwiseLinkage(*labelled(self.subject.corners, self.subject.elements))
 
     def step_targets(self, sweep) -> list[list]:
         held = self.subject.held_targets(sweep.targets)  # the rack at design if not given
@@ -135,8 +135,8 @@ class AxleScope:
         model = self.subject
         return axle_results(model, sweep, solve_axle_sweep(model, sweep))
 
-    def pointwise(self) -> PointwiseAxle:
-        return PointwiseAxle(self.subject.axle, self.subject.geometries)
+    def pointwise(self) -> PointwiseLinkage:
+        return PointwiseLinkage(*labelled(self.subject.corners, self.subject.elements))
 
     def step_targets(self, sweep) -> list[list]:
         model = self.subject
