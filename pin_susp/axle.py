@@ -260,6 +260,12 @@ class AxleModel(Composed, Assembly):
             return AxleModel(corners["left"], corners["right"])
         return AxleModel(replace(self.axle, **corners))
 
+    # Assembly surface for validate
+    noun = "axle"
+
+    def metric_columns_of(self, points: dict) -> dict:
+        return axle_metric_columns(self, points)
+
 
 Axle = AxleModel  # pin_susp.Axle, as pin_susp.Corner: an axle file → a model to sweep
 

@@ -323,6 +323,15 @@ class Corner(Linkage, Assembly):
     def with_corners(self, corners: dict[str, Geometry]) -> Corner:
         return Corner(corners[""], warn=False)
 
+    # Assembly surface for validate
+    noun = "corner"
+
+    def held_sweep(self, sweep: Sweep) -> Sweep:
+        return replace(sweep, targets=self.held_targets(sweep.targets))
+
+    def motion_points(self, by_label: dict) -> dict:
+        return {name: p[""] for name, p in by_label.items()}
+
 
 class Results:
     """Columns of a solved sweep, in output units (mm, deg); see docs/results.md.

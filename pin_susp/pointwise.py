@@ -30,7 +30,6 @@ from .mechanisms import Pointwise
 
 Y = np.array([0.0, 1.0, 0.0])
 Z = np.array([0.0, 0.0, 1.0])
-SIDES = ("left", "right")
 WHEEL_POINTS = ("axle_midpoint", "wheel_center", "wheel_inboard", "wheel_outboard")
 # Residual evaluations a solve may take. A reachable step from the design state takes
 # at most 8 on every example (a closed pose is a root: Levenberg-Marquardt converges
@@ -338,7 +337,7 @@ class PointwiseAxle(PointwiseLinkage):
 
     def targets(self, sweep_targets, values) -> list:
         """One step of a sweep's targets (its own design state for heave and roll)."""
-        return axle_targets(sweep_targets, values, self.design)
+        return targets_at(sweep_targets, values, self.design)
 
 
 def labelled(corners: dict[str, Geometry], elements=(), hardpoints: dict | None = None):
@@ -374,20 +373,46 @@ def labelled(corners: dict[str, Geometry], elements=(), hardpoints: dict | None 
     return spec, hp, wheels, racks, planes
 
 
-def axle_targets(sweep_targets, values, design: dict) -> list:
-    """One step of an axle sweep's targets as point-based targets: ``values`` in SI as
-    axle.target_values gives them (heave m, roll rad, a point's coordinate m,
-    absolute); ``design``: the design points (m), for heave's and roll's zero."""
-    left, right = design["left_wheel_center"][2], design["right_wheel_center"][2]
+def sweep_values(sweep_targets, design: dict) -> np.ndarray:
+    """A sweep's target values in SI, a row per step: heave m, roll rad, a point's
+    coordinate m (absolute: a relative one from ``design``, the design points, m, by
+    their labelled names)."""
+    columns = []
+    for t in sweep_targets:
+        v = np.asarray(t.values, dtype=float)
+        if t.quantity == "roll":
+            columns.append(np.radians(v))
+        elif t.quantity == "heave":
+            columns.append(v * 1e-3)
+        else:
+            v = v * 1e-3
+            if t.mode == "relative":
+                v = v + design[_named(t)] @ t.unit_direction
+            columns.append(v)
+    return np.column_stack(columns)
+
+
+def targets_at(sweep_targets, values, design: dict) -> list:
+    """One step of a sweep's targets as point-based targets: ``values`` in SI as
+    :func:`sweep_values` gives them; ``design``: the design points (m), for heave's and
+    roll's zero (an axle's). A point's target names it by its corner's label (``side``:
+    ``left_wheel_center``; none: ``wheel_center``)."""
     out = []
     for t, value in zip(sweep_targets, values, strict=True):
-        if t.quantity == "heave":
-            out.append(Heave(0.5 * (left + right), float(value)))
-        elif t.quantity == "roll":
-            out.append(Roll(left - right, float(value)))
+        if t.quantity in ("heave", "roll"):
+            left, right = design["left_wheel_center"][2], design["right_wheel_center"][2]
+            if t.quantity == "heave":
+                out.append(Heave(0.5 * (left + right), float(value)))
+            else:
+                out.append(Roll(left - right, float(value)))
         else:
-            out.append(Along(f"{t.side}_{t.point}", t.unit_direction, float(value)))
+            out.append(Along(_named(t), t.unit_direction, float(value)))
     return out
+
+
+def _named(target) -> str:
+    """A sweep target's point by its labelled name (its corner's ``side``, if any)."""
+    return Assembly.prefix(target.side or "") + target.point
 
 
 def _anti_roll_bar(bar: AntiRollBar, corners: dict[str, Geometry], spec, hp) -> list:

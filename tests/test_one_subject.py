@@ -44,7 +44,6 @@ KIND_TESTS = {
     "cli/commands/sensitivity.py": 1,  # the axle's sensitivities, a twin
     "cli/commands/setup.py": 1,  # the axle's setup sheet, a twin
     "study/spec.py": 1,  # is_axle_data: the study's axle flag (its variants' data, sensitivities)
-    "validate/scopes.py": 1,  # the corner's or the axle's scope: two views, one per kind
 }
 
 
