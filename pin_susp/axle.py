@@ -16,7 +16,6 @@ import numpy as np
 import pinocchio as pin
 
 from . import __version__
-from .assembly import Assembly
 from .axle_file import (  # noqa: F401 (the axle file's names, as they were)
     ANTI_ROLL,
     AXLE_KEYS,
@@ -25,6 +24,7 @@ from .axle_file import (  # noqa: F401 (the axle file's names, as they were)
     SIDE_EXTRAS,
     SIDES,
     VEHICLE_KEYS,
+    AxleAssembly,
     AxleGeometry,
     AxleReader,
     load_axle,
@@ -60,7 +60,7 @@ def axle_tree(left: Geometry, right: Geometry, name: str = "axle", elements=None
     return compose_tree(trees, name, () if elements is None else elements_of(elements))
 
 
-class AxleModel(Composed, Assembly):
+class AxleModel(Composed, AxleAssembly):
     """The composed model: its URDF, Pinocchio model, points (``left_…``, ``right_…``,
     contact patches included), closures and branches, at the design state.
 
@@ -260,9 +260,7 @@ class AxleModel(Composed, Assembly):
             return AxleModel(corners["left"], corners["right"])
         return AxleModel(replace(self.axle, **corners))
 
-    # Assembly surface for validate
-    noun = "axle"
-
+    # Assembly surface for validate (its noun: AxleAssembly's)
     def metric_columns_of(self, points: dict) -> dict:
         return axle_metric_columns(self, points)
 

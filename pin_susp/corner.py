@@ -323,6 +323,18 @@ class Corner(Linkage, Assembly):
     def with_corners(self, corners: dict[str, Geometry]) -> Corner:
         return Corner(corners[""], warn=False)
 
+    # Assembly surface for setup and sensitivity
+    def setup_labels(self, label: str | None = None) -> tuple[str, ...]:
+        if label is not None:
+            problem = f"{self.source} is a corner (--side sets one side of an axle)"
+            raise InputError("--side", "", problem)
+        return self.labels
+
+    def setup_data(self, geometries: dict[str, Geometry]) -> dict:
+        from .as_set import geometry_data
+
+        return geometry_data(geometries[""])
+
     # Assembly surface for validate
     noun = "corner"
 

@@ -39,10 +39,8 @@ KIND_WORDS = {"axle", "corner"}
 
 # Today's places, by file (below pin_susp/): a ratchet that only goes down.
 KIND_TESTS = {
-    "as_set.py": 1,  # isinstance(g, Geometry): a path or a Geometry
     "cli/commands/draw.py": 1,  # the axle's front view, a twin
     "cli/commands/sensitivity.py": 1,  # the axle's sensitivities, a twin
-    "cli/commands/setup.py": 1,  # the axle's setup sheet, a twin
     "study/spec.py": 1,  # is_axle_data: the study's axle flag (its variants' data, sensitivities)
 }
 
