@@ -32,7 +32,16 @@ class Assembly:
     stiffness in N·m/deg or None) — an axle's anti-roll bar, unless rigid;
     ``markers``: what the 3D view marks from its results' columns (an axle's
     ``roll_centre``); ``static_columns``: the columns of its corners together a setup
-    sheet adds to each row (an axle's track and roll centre).
+    sheet adds to each row (an axle's track and roll centre); ``elements``: the elements
+    its corners share (pin_susp/elements/: an axle's anti-roll bar and heave link; none
+    for a corner), the point-based formulation's too (pointwise.ELEMENTS); ``noun``:
+    what a message calls it (``corner``, ``axle``).
+
+    Both are a :class:`~pin_susp.linkage.Composed` too: ``tree``, ``urdf``,
+    ``output_points`` (every point written, each prefixed by its label),
+    ``design_positions``, ``corner_points`` (label → its corner's point names,
+    unprefixed), ``driver_columns`` (label → the columns of its drivers: its hub z, the
+    rack, its toe link).
     """
 
     labels: tuple[str, ...]
@@ -49,6 +58,14 @@ class Assembly:
     # setup and sensitivity: the subject's own static columns of its corners set
     # together, (column, heading) in mm (an axle's track and roll centre; a corner: none)
     static_columns: tuple[tuple[str, str], ...] = ()
+    elements: tuple = ()
+    noun: str = "assembly"
+    tree: object
+    urdf: str
+    output_points: list[str]
+    design_positions: dict
+    corner_points: dict
+    driver_columns: dict
 
     @staticmethod
     def suffix(label: str) -> str:
@@ -74,6 +91,32 @@ class Assembly:
     def solve_sweep(self, sweep, progress=None) -> tuple[list, object]:
         """Every step of a Sweep solved: the solutions and the results (run_sweep's)."""
         raise NotImplementedError
+
+    def held_sweep(self, sweep):
+        """The sweep as its steps hold it: its targets, and the rack's at design where it
+        gives every other (``sweep_notes`` says so)."""
+        raise NotImplementedError
+
+    def metric_columns_of(self, points: dict) -> dict:
+        """Every metric column (name → (values, unit)) from its points with their rates
+        along the drivers (name → {label: jet.Dual}, as ``label_motion`` gives them, or
+        an engine's): each corner's columns, suffixed by its label (an axle adds its
+        own)."""
+        from .metrics import metric_columns
+
+        out = {}
+        for label, g in self.corners.items():
+            p, design = self.prefix(label), self.design_positions
+            own = {n: points[p + n][label] for n in self.corner_points[label]}
+            at = {n: design[p + n][None] for n in self.corner_points[label]}
+            columns = metric_columns(g, own, at, self.spring_senses[label])
+            out.update({name + self.suffix(label): c for name, c in columns.items()})
+        return out
+
+    def motion_points(self, by_label: dict) -> dict:
+        """Points with a Dual per label (name → {label: Dual}, ``label_motion``'s) in the
+        form its ``motion`` gives them: as they are (a corner's: its one Dual each)."""
+        return by_label
 
     def solve_steps(self, sweep, progress=None) -> list:
         """Every step of a Sweep solved in order: the solutions (no columns)."""

@@ -260,6 +260,10 @@ class AxleModel(Composed, AxleAssembly):
             return AxleModel(corners["left"], corners["right"])
         return AxleModel(replace(self.axle, **corners))
 
+    # Assembly surface for validate (its noun: AxleAssembly's)
+    def metric_columns_of(self, points: dict) -> dict:
+        return axle_metric_columns(self, points)
+
 
 Axle = AxleModel  # pin_susp.Axle, as pin_susp.Corner: an axle file → a model to sweep
 

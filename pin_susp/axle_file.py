@@ -390,6 +390,7 @@ class AxleAssembly(Assembly):
 
     axle: AxleGeometry | None
     static_columns = (("track", "track"), ("roll_center_y", "RC y"), ("roll_center_z", "RC z"))
+    noun = "axle"  # validate's messages
     element_points = frozenset(n for ns in (*SIDE_EXTRAS.values(), *CENTER.values()) for n in ns)
     sensitivity_columns = AXLE_COLUMNS
 

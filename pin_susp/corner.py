@@ -349,6 +349,15 @@ class Corner(Linkage, Assembly):
 
         return geometry_data(geometries[""])
 
+    # Assembly surface for validate
+    noun = "corner"
+
+    def held_sweep(self, sweep: Sweep) -> Sweep:
+        return replace(sweep, targets=self.held_targets(sweep.targets))
+
+    def motion_points(self, by_label: dict) -> dict:
+        return {name: p[""] for name, p in by_label.items()}
+
 
 class Results:
     """Columns of a solved sweep, in output units (mm, deg); see docs/results.md.
