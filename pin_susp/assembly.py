@@ -182,6 +182,16 @@ class Assembly:
         written in."""
         raise NotImplementedError
 
+    # -- drawings (drawing.py, pin-susp draw) ----------------------------------------
+
+    # the views its drawing shows: a corner's front and side; the front alone where its
+    # corners stand side by side on one road (an axle's: the roll centre where each
+    # contact patch's line through its instant centre crosses the other)
+    drawing_views: tuple[str, ...] = ("front", "side")
+    # whether it is drawn at a step of its sweep results too (draw --from-results), not
+    # only at its design state
+    drawn_at_steps: bool = False
+
     # -- hardpoint sensitivities (sensitivity.py, its command) ---------------------
 
     # the points its shared elements add (an axle's bar and heave link), no corner's

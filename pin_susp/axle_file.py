@@ -393,6 +393,8 @@ class AxleAssembly(Assembly):
     noun = "axle"  # validate's messages
     element_points = frozenset(n for ns in (*SIDE_EXTRAS.values(), *CENTER.values()) for n in ns)
     sensitivity_columns = AXLE_COLUMNS
+    drawing_views = ("front",)
+    drawn_at_steps = True
 
     @classmethod
     def as_drawn(cls, path, label: str | None = None) -> AxleAssembly:
