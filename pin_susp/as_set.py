@@ -15,7 +15,9 @@ the inverse solve for targets — are ``setup.py``, above the corner.
 
 from __future__ import annotations
 
+import copy
 from dataclasses import replace
+from functools import singledispatch
 
 import numpy as np
 
@@ -28,7 +30,7 @@ from .constraints import (
     pick_branch,
 )
 from .errors import InputError
-from .geometry import Geometry, load_geometry
+from .geometry import MM, Geometry, load_geometry
 from .linkage import Linkage
 from .solver import NewtonSolver
 
@@ -40,9 +42,16 @@ PARAMETER_KEYS = {
 Z = np.array([0.0, 0.0, 1.0])
 
 
+@singledispatch
 def as_geometry(g) -> Geometry:
-    """A Geometry from a path, a dict or a Geometry (as Corner accepts)."""
-    return g if isinstance(g, Geometry) else load_geometry(g)
+    """A Geometry from a path, a dict or a Geometry (as Corner accepts): a path or a
+    dict read by ``load_geometry``, a Geometry as it is."""
+    return load_geometry(g)
+
+
+@as_geometry.register
+def _as_read(g: Geometry) -> Geometry:
+    return g
 
 
 def apply_setup(g) -> Geometry:
@@ -129,3 +138,43 @@ def static_holds(corner, q_static: np.ndarray) -> list:
         wc = corner.positions(q_static)["wheel_center"][2]
         holds.append(PointTarget(corner.points["wheel_center"], Z, wc))
     return holds
+
+
+# ---------------------------------------------------------------- the setup written back
+
+
+def geometry_data(g: Geometry) -> dict:
+    """The geometry file's data with the setup values of g written in (mm)."""
+    data = copy.deepcopy(g.data)
+    config = data.setdefault("config", {})
+    if g.camber_shim is not None:
+        config["camber_shim"]["setup_thickness"] = g.camber_shim.setup_thickness / MM
+    adjusters = {}
+    if g.trackrod_length_delta:
+        adjusters["trackrod_length_delta"] = g.trackrod_length_delta / MM
+    if g.pushrod_length_delta:
+        adjusters["pushrod_length_delta"] = g.pushrod_length_delta / MM
+    if adjusters:
+        config["setup"] = adjusters
+    else:
+        config.pop("setup", None)
+    return data
+
+
+def axle_data(axle, geometries: dict) -> dict:
+    """The axle file's data (an AxleGeometry's) with each given side's setup values
+    written in (``axle_config.<side>_setup``, mm). A mirrored axle's right side is the
+    left's: only left_setup is written."""
+    data = copy.deepcopy(axle.data)
+    config = data["axle_config"]
+    for side, g in geometries.items():
+        if axle.mirrored and side == "right":
+            continue
+        corner = geometry_data(g)["config"]
+        written = {"camber_shim": corner["camber_shim"]} if "camber_shim" in corner else {}
+        written |= corner.get("setup", {})
+        if written:
+            config[f"{side}_setup"] = written
+        else:
+            config.pop(f"{side}_setup", None)
+    return data

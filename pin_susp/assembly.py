@@ -46,7 +46,8 @@ class Assembly(Composed):
     elastic elements its corners share, each (the joints whose turn twists it, its
     stiffness in N·m/deg or None) — an axle's anti-roll bar, unless rigid;
     ``markers``: what the 3D view marks from its results' columns (an axle's
-    ``roll_centre``).
+    ``roll_centre``); ``static_columns``: the columns of its corners together a setup
+    sheet adds to each row (an axle's track and roll centre).
 
     One model (linkage.Composed) and one sweep path for every subject: its targets
     read per label (a point target names its corner by ``side``, none for a corner's
@@ -83,6 +84,9 @@ class Assembly(Composed):
     checks_counts_first: bool = True
     tangents_by_drivers: bool = False
     results_class: type = None  # the class of its sweep's Results
+    # setup and sensitivity: the subject's own static columns of its corners set
+    # together, (column, heading) in mm (an axle's track and roll centre; a corner: none)
+    static_columns: tuple[tuple[str, str], ...] = ()
 
     @staticmethod
     def suffix(label: str) -> str:
@@ -404,3 +408,44 @@ class Assembly(Composed):
             del solutions, tangents, converged
             yield results
             del results  # before the next chunk is solved: one chunk held at a time
+
+    # -- setup and sensitivity (setup.py, sensitivity.py, their commands) ----------
+
+    @property
+    def drawn_corners(self) -> dict:
+        """label → the corner's Geometry as drawn, with its setup values (its shim stack
+        and length deltas as the file gives them): what the setup analyses vary."""
+        return {label: g.drawn or g for label, g in self.corners.items()}
+
+    def setup_labels(self, label: str | None = None) -> tuple[str, ...]:
+        """The labels a setup option sets (``--side``): every corner's, or ``label``'s
+        alone."""
+        if label is None:
+            return self.labels
+        if label not in self.labels:
+            known = " or ".join(self.labels)
+            raise InputError("--side", "", f"unknown side {label!r} ({known})")
+        return (label,)
+
+    def setup_owner(self, label: str) -> str:
+        """The label whose setup a corner takes: its own (a mirrored axle's right side:
+        the left's)."""
+        return label
+
+    def file_key(self, label: str, key: str) -> str:
+        """A key of a corner's setup as the subject's file names it (a corner's own file:
+        as it is)."""
+        return key
+
+    def setup_error(self, label: str, exc: InputError) -> InputError:
+        """A corner's setup error as the subject reports it: a labelled corner's names its
+        label, and its file's key as the file spells it."""
+        if not label:
+            return exc
+        key = self.file_key(label, exc.key) if exc.source == self.source else exc.key
+        return InputError(exc.source, key, f"{label} corner: {exc.problem}")
+
+    def setup_data(self, geometries: dict) -> dict:
+        """The subject's file data with each given corner's setup (label → Geometry)
+        written in."""
+        raise NotImplementedError

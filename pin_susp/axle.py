@@ -15,7 +15,6 @@ from dataclasses import replace
 import numpy as np
 
 from . import __version__
-from .assembly import Assembly
 from .axle_file import (  # noqa: F401 (the axle file's names, as they were)
     ANTI_ROLL,
     AXLE_KEYS,
@@ -24,6 +23,7 @@ from .axle_file import (  # noqa: F401 (the axle file's names, as they were)
     SIDE_EXTRAS,
     SIDES,
     VEHICLE_KEYS,
+    AxleAssembly,
     AxleGeometry,
     AxleReader,
     load_axle,
@@ -55,7 +55,7 @@ def axle_tree(left: Geometry, right: Geometry, name: str = "axle", elements=None
     return compose_tree(trees, name, () if elements is None else elements_of(elements))
 
 
-class AxleModel(Assembly):
+class AxleModel(AxleAssembly):
     """The composed model: its URDF, Pinocchio model, points (``left_…``, ``right_…``,
     contact patches included), closures and branches, at the design state.
 

@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .assembly import Assembly
 from .compose import SHARED, compose_tree
 from .deadcentre import warn_dead_centres
 from .elements import elements_of
@@ -363,3 +364,41 @@ def mirror_corner(corner: dict) -> dict:
             if k in shim:
                 flip(shim[k])
     return out
+
+
+# Assembly surface for setup and sensitivity (AxleModel's; kept out of axle.py, at its cap)
+class AxleAssembly(Assembly):
+    """An axle's answers to what takes an Assembly (AxleModel's, from its file
+    ``self.axle``, an AxleGeometry): its own static columns of both sides together, the
+    sides a setup sets (a mirrored axle: both, from the left's), the keys its file names
+    and the setup written back into it."""
+
+    axle: AxleGeometry | None
+    static_columns = (("track", "track"), ("roll_center_y", "RC y"), ("roll_center_z", "RC z"))
+
+    def setup_labels(self, label: str | None = None) -> tuple[str, ...]:
+        chosen = super().setup_labels(label)
+        if label is not None and self.setup_owner("right") != "right":
+            raise InputError(
+                "--side",
+                "",
+                f"{self.source} is a mirrored axle (no hardpoints.right): its right side takes "
+                "the left's setup, so one setup sets both sides; give the right corner's own "
+                "points (hardpoints.right, with axle_config.right_setup) to set one side alone",
+            )
+        return chosen
+
+    def setup_owner(self, label: str) -> str:
+        mirrored = self.axle is not None and self.axle.mirrored
+        return "left" if mirrored and label == "right" else label
+
+    def file_key(self, label: str, key: str) -> str:
+        try:
+            AxleReader(self.source, self.setup_owner(label)).fail(key, "")
+        except InputError as renamed:
+            return renamed.key
+
+    def setup_data(self, geometries: dict[str, Geometry]) -> dict:
+        from .as_set import axle_data
+
+        return axle_data(self.axle, geometries)

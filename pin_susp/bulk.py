@@ -41,6 +41,7 @@ from .solver import MAX_STEP
 # A sweep shorter than this is marched step by step (the coarse pass would be most of it).
 MIN_STEPS = 200
 COARSE_STEPS = 32  # about this many coarse steps, whatever the sweep's length
+COARSE_GROUP = 4  # every this many-th coarse step marched, the others solved at once
 MAX_ITERATIONS = 8
 
 _TREES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
@@ -145,28 +146,6 @@ class Tree:
             out[i] = _apply(R[i], axis)
         return out
 
-    def point_jacobian(self, joint: int, p: np.ndarray, o: np.ndarray, a: np.ndarray):
-        """d(p)/dv (n, 3, nv) of points p (n, 3) fixed to ``joint``: a revolute joint k
-        among its supports moves them at a_k × (p − o_k), a prismatic one at a_k."""
-        J = np.zeros((p.shape[0], 3, self.nv))
-        revolute, prismatic = self._moves[joint]
-        if revolute[0]:
-            ks, vs = revolute
-            J[:, :, vs] = cross(a[ks], p - o[ks]).transpose(1, 2, 0)
-        if prismatic[0]:
-            ks, vs = prismatic
-            J[:, :, vs] = a[ks].transpose(1, 2, 0)
-        return J
-
-    def angular_jacobian(self, joint: int, a: np.ndarray) -> np.ndarray:
-        """d(ω)/dv (n, 3, nv) of ``joint``'s body: the axes of the revolute joints among
-        its supports."""
-        J = np.zeros((a.shape[1], 3, self.nv))
-        ks, vs = self._moves[joint][0]
-        if ks:
-            J[:, :, vs] = a[ks].transpose(1, 2, 0)
-        return J
-
     def twist_jacobian(self, joint: int, o: np.ndarray, a: np.ndarray) -> np.ndarray:
         """The joint frame's LOCAL_WORLD_ALIGNED Jacobian (n, 6, nv): the velocity of its
         origin, then its angular velocity."""
@@ -247,6 +226,28 @@ class Frames:
         self.joint = [model.frames[f].parentJoint for f in self.ids]
         self.offset = [model.frames[f].placement.translation.copy() for f in self.ids]
         self.turn = [model.frames[f].placement.rotation.copy() for f in self.ids]
+        # every frame's Jacobian terms, all frames' in one array: term t is the motion of
+        # frame term_frame[t] by joint term_joint[t] (its column cols[f] in v), the
+        # revolute terms first (a × (p − o)), then the prismatic ones (a)
+        revolute, prismatic = [], []
+        for f, j in enumerate(self.joint):
+            (rk, rv), (pk, pv) = tree._moves[j]
+            revolute += [(f, k, v) for k, v in zip(rk, rv, strict=True)]
+            prismatic += [(f, k, v) for k, v in zip(pk, pv, strict=True)]
+        terms = revolute + prismatic
+        self._revolute = len(revolute)
+        self._term_frame = np.array([f for f, _, _ in terms], dtype=int)
+        self._term_joint = np.array([k for _, k, _ in terms], dtype=int)
+        self.cols, self._terms = [], []  # per frame: its columns in v, its terms' indices
+        for f in range(len(self.ids)):
+            mine = [t for t, (g, _, _) in enumerate(terms) if g == f]
+            self.cols.append(np.array([terms[t][2] for t in mine], dtype=int))
+            self._terms.append(np.array(mine, dtype=int))
+        # a frame's terms are one slice when they are all revolute or all prismatic
+        self._slices = [
+            slice(int(t[0]), int(t[-1]) + 1) if len(t) and np.all(np.diff(t) == 1) else t
+            for t in self._terms
+        ]
 
     def evaluate(self, q: np.ndarray, jacobians: bool = True, placed=None):
         """Positions (list of (n, 3)) and Jacobians (list of (n, 3, nv), or None);
@@ -255,9 +256,35 @@ class Frames:
         P = self.positions(R, o)
         if not jacobians:
             return P, None
-        a = self.tree.axes(R)
-        J = [self.tree.point_jacobian(j, p, o, a) for j, p in zip(self.joint, P, strict=True)]
+        Jc, _ = self.compact(P, o, self.tree.axes(R))
+        n, nv = q.shape[0], self.tree.nv
+        J = []
+        for cols, terms in zip(self.cols, Jc, strict=True):
+            dense = np.zeros((n, 3, nv))
+            if len(cols):
+                dense[:, :, cols] = terms.transpose(1, 2, 0)
+            J.append(dense)
         return P, J
+
+    def compact(self, P: list, o: np.ndarray, a: np.ndarray, angular: bool = False):
+        """Every frame's Jacobian in the columns that move it (``cols``), all frames' in
+        one pass: linear rows (s, n, 3) per frame, and the angular ones too if
+        ``angular`` (else None). A revolute joint k moves a point p at a_k × (p − o_k), a
+        prismatic one at a_k; the angular rows are a_k, or zero."""
+        joints, frames = self._term_joint, self._term_frame
+        axes = a[joints]  # (T, n, 3)
+        linear = axes.copy()
+        r = self._revolute
+        if r:
+            where = np.stack(P)[frames[:r]] - o[joints[:r]]
+            linear[:r] = cross(axes[:r], where)
+        turning = None
+        if angular:
+            turning = axes
+            turning[r:] = 0.0
+        pick = self._slices
+        Jc = [linear[t] for t in pick]
+        return Jc, None if turning is None else [turning[t] for t in pick]
 
     def positions(self, R: np.ndarray, o: np.ndarray) -> list[np.ndarray]:
         """Each frame's position (n, 3) from the joints' placements (Tree.placements)."""
@@ -269,14 +296,6 @@ class Frames:
         return [
             _times(R[j], t) if only is None or f in only else None
             for f, (j, t) in enumerate(zip(self.joint, self.turn, strict=True))
-        ]
-
-    def angular_jacobians(self, a: np.ndarray, only=None) -> list:
-        """Each frame's angular Jacobian rows (n, 3, nv): its joint's (Tree.axes: a);
-        ``only``: the indices of the frames wanted (the others None)."""
-        return [
-            self.tree.angular_jacobian(j, a) if only is None or f in only else None
-            for f, j in enumerate(self.joint)
         ]
 
     def motion(self, P: list, o: np.ndarray, state) -> tuple[list, list]:
@@ -311,15 +330,16 @@ class Rows:
         self.turning = {f for row, k, _ in self.items if row.angular for f in k}
         self.frames = Frames(tree, frames)
 
-    def _at(self, q, P, Jp, R) -> ManyFrames:
+    def _at(self, q, P, o, R, jacobian: bool) -> ManyFrames:
         """The frames' data for the rows (rotations and angular Jacobians if any row
-        reads them); R: the joints' world rotations (Tree.placements)."""
-        rotations = angular = None
+        reads them); R, o: the joints' world placements (Tree.placements)."""
+        rotations = None
+        Jc = Wc = None
         if self.angular:
             rotations = self.frames.rotations(R, self.turning)
-            if Jp is not None:
-                angular = self.frames.angular_jacobians(self.tree.axes(R), self.turning)
-        return ManyFrames(P, Jp, rotations, angular, q, self.tree.nv)
+        if jacobian:
+            Jc, Wc = self.frames.compact(P, o, self.tree.axes(R), self.angular)
+        return ManyFrames(P, self.frames.cols, Jc, Wc, rotations, q, self.tree.nv)
 
     def evaluate(self, q: np.ndarray, values: np.ndarray, jacobian: bool = True, placed=None):
         """Residuals (n, nrows) and Jacobians (n, nrows, nv) at q (n, nq) with the target
@@ -327,8 +347,8 @@ class Rows:
         ``placed``: Tree.placements(q) when the caller has it already."""
         n = q.shape[0]
         placed = self.tree.placements(q) if placed is None else placed
-        P, Jp = self.frames.evaluate(q, jacobian, placed)
-        at = self._at(q, P, Jp, placed[0])
+        P = self.frames.positions(*placed)
+        at = self._at(q, P, placed[1], placed[0], jacobian)
         r = np.empty((n, self.nrows))
         J = np.zeros((n, self.nrows, self.tree.nv)) if jacobian else None
         first = self.first_target
@@ -342,7 +362,7 @@ class Rows:
         velocity q̇ and acceleration ``qdd``; P: the frames' positions): with q̈ = 0, the
         drift J̇·q̇ of the second-order closure solve J·q̈ = −J̇·q̇ (Row.drift_many)."""
         V, A = self.frames.motion(P, o, state)
-        at = self._at(None, P, None, R)
+        at = self._at(None, P, o, R, False)
         out = np.empty((len(qdd), self.nrows))
         for row, k, i in self.items:
             row.drift_many(at, k, V, A, qdd, out, i)

@@ -151,6 +151,18 @@ class Corner(Assembly, Linkage):
     def with_corners(self, corners: dict[str, Geometry]) -> Corner:
         return Corner(corners[""], warn=False)
 
+    # Assembly surface for setup and sensitivity
+    def setup_labels(self, label: str | None = None) -> tuple[str, ...]:
+        if label is not None:
+            problem = f"{self.source} is a corner (--side sets one side of an axle)"
+            raise InputError("--side", "", problem)
+        return self.labels
+
+    def setup_data(self, geometries: dict[str, Geometry]) -> dict:
+        from .as_set import geometry_data
+
+        return geometry_data(geometries[""])
+
 
 class Results:
     """Columns of a solved sweep, in output units (mm, deg); see docs/results.md.

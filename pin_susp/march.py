@@ -17,7 +17,7 @@ import time
 import numpy as np
 import pinocchio as pin
 
-from .bulk import COARSE_STEPS, MIN_STEPS, newton_all, on_branches, rows_of, solve_all
+from .bulk import COARSE_GROUP, COARSE_STEPS, MIN_STEPS, newton_all, on_branches, rows_of, solve_all
 from .solver import TOLERANCE, NewtonSolver, Solution, explained
 
 
@@ -155,23 +155,17 @@ def solve_sweep(solver, values: np.ndarray, q: np.ndarray, previous: np.ndarray,
         return None
     stride = max(2, n // COARSE_STEPS)
     coarse = np.unique(np.r_[np.arange(stride - 1, n, stride), n - 1])
-    keep = solver.keep_jacobian
-    solver.keep_jacobian = True  # exact tangents at the coarse solutions
-    try:
-        tangents: list = []
-        marched = march(solver, values[coarse], q, previous, tangents=tangents)
-    finally:
-        solver.keep_jacobian = keep
-    if not all(s.converged for s in marched):
-        return None
-    # the predictions: cubic Hermite between coarse neighbours (the design state, or the
-    # given start, before the first)
-    q0 = np.vstack([q[None], np.array([s.q for s in marched])])
-    v0 = np.vstack([previous[None], values[coarse]])
     start_tangent = tangent_at(solver, q, previous)
     if start_tangent is None:
         return None
-    T0 = np.stack([start_tangent, *tangents])  # (m + 1, nv, k)
+    solved = coarse_path(solver, rows, values[coarse], q, previous, start_tangent)
+    if solved is None:
+        return None
+    # the predictions: cubic Hermite between coarse neighbours (the design state, or the
+    # given start, before the first)
+    q0 = np.vstack([q[None], solved[0]])
+    v0 = np.vstack([previous[None], values[coarse]])
+    T0 = np.concatenate([start_tangent[None], solved[1]])  # (m + 1, nv, k)
     segment = np.searchsorted(coarse, np.arange(n))  # step i lies in (coarse[s-1], coarse[s]]
     guess = hermite(q0, v0, T0, segment, values)
     qs, T, iterations, error = newton_all(rows, guess, values, TOLERANCE)
@@ -183,6 +177,44 @@ def solve_sweep(solver, values: np.ndarray, q: np.ndarray, previous: np.ndarray,
     if progress is not None:
         progress(n, n)
     return solutions, T
+
+
+def coarse_path(solver, rows, values: np.ndarray, q, previous, start_tangent):
+    """The coarse steps solved with their exact tangents, (q (m, nq), T (m, nv, k)), or
+    None: every COARSE_GROUP-th one marched (``march``: its continuation and branch
+    checks), the others all at once from their Hermite predictions between those
+    (``newton_all``, each on its design branches); all of them marched when that
+    fails. (Pinocchio's march costs a Python evaluation per iteration; a batched one
+    costs about as much for all the coarse steps at once.)"""
+    m = len(values)
+    sparse = np.unique(np.r_[np.arange(COARSE_GROUP - 1, m, COARSE_GROUP), m - 1])
+    if len(sparse) < m:
+        marched = _march_exact(solver, values[sparse], q, previous)
+        if marched is None:
+            return None
+        q0 = np.vstack([q[None], marched[0]])
+        v0 = np.vstack([previous[None], values[sparse]])
+        T0 = np.concatenate([start_tangent[None], marched[1]])
+        guess = hermite(q0, v0, T0, np.searchsorted(sparse, np.arange(m)), values)
+        qs, T, _, _ = newton_all(rows, guess, values, TOLERANCE)
+        if qs is not None and on_branches(solver, qs):
+            return qs, T
+    return _march_exact(solver, values, q, previous)
+
+
+def _march_exact(solver, values: np.ndarray, q, previous):
+    """``values``' steps marched with exact tangents: (q (m, nq), T (m, nv, k)), or None
+    if any step does not converge."""
+    keep = solver.keep_jacobian
+    solver.keep_jacobian = True  # exact tangents at the solutions
+    try:
+        tangents: list = []
+        marched = march(solver, values, q, previous, tangents=tangents)
+    finally:
+        solver.keep_jacobian = keep
+    if not all(s.converged for s in marched):
+        return None
+    return np.array([s.q for s in marched]), np.array(tangents)
 
 
 def tangent_at(solver, q: np.ndarray, values: np.ndarray) -> np.ndarray | None:

@@ -20,7 +20,6 @@ through both gives dq₂/dp, and the metrics' exact derivatives follow.
 
 from __future__ import annotations
 
-import copy
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -28,6 +27,8 @@ import pinocchio as pin
 
 from .as_set import PARAMETER_KEYS, as_geometry, static_holds
 from .as_set import apply_setup as apply_setup  # the as-set geometry, by its old address
+from .as_set import axle_data as axle_data  # the setup written back, by their old address
+from .as_set import geometry_data as geometry_data
 from .constraints import (
     DistanceClosure,
     JointTarget,
@@ -342,24 +343,6 @@ def _unreachable(g: Geometry, targets: dict, p, why: str) -> InputError:
     return InputError(g.source, "targets", f"{wanted} not reachable: {why}")
 
 
-def geometry_data(g: Geometry) -> dict:
-    """The geometry file's data with the setup values of g written in (mm)."""
-    data = copy.deepcopy(g.data)
-    config = data.setdefault("config", {})
-    if g.camber_shim is not None:
-        config["camber_shim"]["setup_thickness"] = g.camber_shim.setup_thickness / MM
-    adjusters = {}
-    if g.trackrod_length_delta:
-        adjusters["trackrod_length_delta"] = g.trackrod_length_delta / MM
-    if g.pushrod_length_delta:
-        adjusters["pushrod_length_delta"] = g.pushrod_length_delta / MM
-    if adjusters:
-        config["setup"] = adjusters
-    else:
-        config.pop("setup", None)
-    return data
-
-
 def setup_sheet(
     g,
     shim: list[float] = (),
@@ -400,118 +383,108 @@ def setup_sheet(
     return rows
 
 
-# ---------------------------------------------------------------- an axle
+# ---------------------------------------------------------------- a subject
 #
-# Each side of an axle is its corner (docs/axle.md): AxleModel applies each side's
-# setup as the corner does, the rack held at design, and with the rack held the
-# sides share nothing else. So an axle's setup sheet, sensitivities and inverse
-# solve are each side's corner's; the axle adds its own static columns (track,
-# roll centre) of both sides together. A mirrored axle (no hardpoints.right) has
-# one setup: the right side takes the left's shim stack and length deltas.
-
-AXLE_STATIC = (("track", "track"), ("roll_center_y", "RC y"), ("roll_center_z", "RC z"))
-
-
-def set_sides(axle, side: str | None = None) -> tuple[str, ...]:
-    """The sides a setup option sets: both by default, or ``side`` alone on an axle
-    with its own right points (a mirrored axle has one setup for both sides)."""
-    from .axle import SIDES
-
-    if side is None:
-        return SIDES
-    if side not in SIDES:
-        raise InputError("--side", "", f"unknown side {side!r} (left or right)")
-    if axle.mirrored:
-        raise InputError(
-            "--side",
-            "",
-            f"{axle.source} is a mirrored axle (no hardpoints.right): its right side takes "
-            "the left's setup, so one setup sets both sides; give the right corner's own "
-            "points (hardpoints.right, with axle_config.right_setup) to set one side alone",
-        )
-    return (side,)
+# Each labelled corner of a subject (a corner's one, an axle's left and right,
+# docs/axle.md) is set up as a corner is, the rack held at design; with the rack held
+# the corners share nothing else. So a subject's setup sheet, sensitivities and
+# inverse solve are each corner's, by label; the subject adds its own static columns
+# of its corners together (``Assembly.static_columns``: an axle's track, roll centre).
+# A corner that takes another's setup (a mirrored axle's right side: the left's) is
+# set with it (``Assembly.setup_owner``).
 
 
-def _on_axle(axle, side: str, work):
-    """Run a corner's setup ``work()`` for one side; its errors name the axle file's key
-    (``axle_config.left_setup.camber_shim``) and the side."""
-    from .axle import AxleReader
-
+def on_corner(subject, label: str, work):
+    """Run a corner's setup ``work()``; its errors as the subject reports them (an axle's
+    name its file's key, ``axle_config.left_setup.camber_shim``, and the side)."""
     try:
         return work()
     except InputError as exc:
-        problem = f"{side} corner: {exc.problem}"
-        if exc.source != axle.source:  # an option (--shim) or the targets
-            raise InputError(exc.source, exc.key, problem) from None
-        reader = AxleReader(axle.source, "left" if axle.mirrored else side)
-        try:
-            reader.fail(exc.key, problem)
-        except InputError as renamed:
-            raise renamed from None
+        raise subject.setup_error(label, exc) from None
 
 
-def axle_setup_sheet(axle, shim=(), trackrod=(), pushrod=(), side: str | None = None) -> dict:
-    """Per side (``{"left": rows, "right": rows}``): the as-set state, then one row per
-    listed value (mm) of one adjuster, as :func:`setup_sheet`. The values go to both
-    sides, or to ``side`` alone; a side not set has its as-set row only."""
-    chosen = set_sides(axle, side)
+def subject_setup_sheet(subject, shim=(), trackrod=(), pushrod=(), label=None) -> dict:
+    """Per label (a corner's ``{"": rows}``, an axle's ``{"left": rows, "right": rows}``):
+    the as-set state, then one row per listed value (mm) of one adjuster, as
+    :func:`setup_sheet`. The values go to every corner, or to ``label``'s alone; a corner
+    not set has its as-set row only."""
+    chosen = subject.setup_labels(label)
+    drawn = subject.drawn_corners
     out = {}
-    for s in ("left", "right"):
+    for s in subject.labels:
         lists = (shim, trackrod, pushrod) if s in chosen else ()
-        out[s] = _on_axle(axle, s, lambda s=s, lists=lists: setup_sheet(axle.corner(s), *lists))
+        out[s] = on_corner(subject, s, lambda s=s, lists=lists: setup_sheet(drawn[s], *lists))
     return out
 
 
-def solve_axle_setup(axle, targets: dict[str, float], side: str | None = None) -> dict:
-    """Per side (``{"left": InverseResult, "right": ...}``), the inverse solve of
-    :func:`solve_setup` on that side's corner: its own shim, trackrod and pushrod for
-    the targets (camber, toe, ride height), on both sides or on ``side`` alone (the
-    other: its setup as it is, 0 iterations). A mirrored axle is solved on the left;
-    its right side takes the left's setup (the mirrored corner at those values, 0
-    iterations: it hits the same targets)."""
-    chosen = set_sides(axle, side)
+def solve_subject_setup(subject, targets: dict[str, float], label=None) -> dict:
+    """Per label, the inverse solve of :func:`solve_setup` on that corner: its own shim,
+    trackrod and pushrod for the targets (camber, toe, ride height), on every corner or
+    on ``label``'s alone (the others: their setup as it is, 0 iterations). A corner that
+    takes another's setup (a mirrored axle's right side) is that one's at the values
+    found (0 iterations: it hits the same targets)."""
+    chosen = subject.setup_labels(label)
+    drawn = subject.drawn_corners
+    found = {}
+    for s in chosen:
+        if subject.setup_owner(s) == s:
+            found[s] = on_corner(subject, s, lambda s=s: solve_setup(drawn[s], targets))
     out = {}
-    for s in ("left",) if axle.mirrored else chosen:
-        out[s] = _on_axle(axle, s, lambda s=s: solve_setup(axle.corner(s), targets))
-    for s in ("left", "right"):
-        if s not in out:
-            g = axle.corner(s)
-            p = setup_values(out["left"].geometry if axle.mirrored else g)
-            model = SetupModel(g)
-            before = _on_axle(axle, s, lambda g=g, model=model: model.state(setup_values(g)))
-            after = _on_axle(axle, s, lambda model=model, p=p: model.state(p))
-            out[s] = InverseResult(with_setup(g, p), before, after, 0)
+    for s in subject.labels:
+        if s in found:
+            out[s] = found[s]
+            continue
+        g, owner = drawn[s], subject.setup_owner(s)
+        p = setup_values(found[owner].geometry if owner in found else g)
+        model = SetupModel(g)
+        before = on_corner(subject, s, lambda g=g, model=model: model.state(setup_values(g)))
+        after = on_corner(subject, s, lambda model=model, p=p: model.state(p))
+        out[s] = InverseResult(with_setup(g, p), before, after, 0)
     return out
 
 
-def axle_static(axle, states: dict) -> dict[str, float]:
-    """The axle's static columns (track, roll centre y and z, mm) with each side set as
-    in its SetupState: the axle model at its design state."""
-    from .axle import AxleModel, axle_results
+def static_state(subject, states: dict) -> dict[str, float]:
+    """The subject's own static columns (``Assembly.static_columns``, mm) with each
+    corner set as in its SetupState (label → state): the subject at its design state;
+    none for a corner."""
     from .solver import Solution
     from .sweep import Sweep
 
-    sides = {s: with_setup(axle.corner(s), state.setup * MM) for s, state in states.items()}
-    model = AxleModel(replace(axle, **sides))
-    state = Solution(model.q_design, True, 0, 0.0)
-    results = axle_results(model, Sweep([], "<static state>"), [state])
-    return {name: float(results[name][0]) for name, _ in AXLE_STATIC}
+    if not subject.static_columns:
+        return {}
+    drawn = subject.drawn_corners
+    model = subject.with_corners(
+        {s: with_setup(drawn[s], state.setup * MM) for s, state in states.items()}
+    )
+    solution = Solution(model.q_design, True, 0, 0.0)
+    results = model.sweep_results(Sweep([], "<static state>"), [solution])
+    return {name: float(results[name][0]) for name, _ in subject.static_columns}
 
 
-def axle_data(axle, geometries: dict) -> dict:
-    """The axle file's data with each given side's setup values written in
-    (``axle_config.<side>_setup``, mm). A mirrored axle's right side is the left's:
-    only left_setup is written."""
-    data = copy.deepcopy(axle.data)
-    config = data["axle_config"]
-    for side, g in geometries.items():
-        if axle.mirrored and side == "right":
-            continue
-        corner = geometry_data(g)["config"]
-        written = {"camber_shim": corner["camber_shim"]} if "camber_shim" in corner else {}
-        written |= corner.get("setup", {})
-        if written:
-            config[f"{side}_setup"] = written
-        else:
-            config.pop(f"{side}_setup", None)
-    return data
+# an axle's, by their old names (the axle file as read: an AxleGeometry)
+
+
+def _axle_model(axle):
+    from .axle import AxleModel
+
+    return AxleModel(axle)
+
+
+def set_sides(axle, side: str | None = None) -> tuple[str, ...]:
+    """The sides a setup option sets (``Assembly.setup_labels``)."""
+    return _axle_model(axle).setup_labels(side)
+
+
+def axle_setup_sheet(axle, shim=(), trackrod=(), pushrod=(), side: str | None = None) -> dict:
+    """:func:`subject_setup_sheet` of an axle file's model, per side."""
+    return subject_setup_sheet(_axle_model(axle), shim, trackrod, pushrod, side)
+
+
+def solve_axle_setup(axle, targets: dict[str, float], side: str | None = None) -> dict:
+    """:func:`solve_subject_setup` of an axle file's model, per side."""
+    return solve_subject_setup(_axle_model(axle), targets, side)
+
+
+def axle_static(axle, states: dict) -> dict[str, float]:
+    """:func:`static_state` of an axle file's model: track, roll centre y and z (mm)."""
+    return static_state(_axle_model(axle), states)

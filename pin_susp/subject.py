@@ -16,6 +16,11 @@ def is_axle_file(path) -> bool:
     from .yamlio import load_yaml
 
     data, _, _ = load_yaml(path)
+    return is_axle_data(data)
+
+
+def is_axle_data(data: dict) -> bool:
+    """Whether a geometry file's data, as read, is an axle's (``scope: axle``)."""
     return data.get("scope") == "axle"
 
 
@@ -31,9 +36,10 @@ def subject_class(path) -> type[Assembly]:
     return Corner
 
 
-def load_subject(path) -> Assembly:
+def load_subject(path, warn: bool = True) -> Assembly:
     """The subject of a geometry file, set up: a Corner (its shim and adjusters applied)
-    or an AxleModel (both corners as set, the axle's shared elements)."""
+    or an AxleModel (both corners as set, the axle's shared elements). ``warn``: a
+    corner's PlausibilityWarning for each implausible design metric (Corner's)."""
     if is_axle_file(path):
         from .axle import AxleModel, load_axle
 
@@ -41,4 +47,4 @@ def load_subject(path) -> Assembly:
     from .corner import Corner
     from .geometry import load_geometry
 
-    return Corner(load_geometry(path))
+    return Corner(load_geometry(path), warn=warn)

@@ -297,10 +297,10 @@ def _room_for(monkeypatch, parts: int):
     """Writes run out of room (ENOSPC, a full disk) after ``parts`` part files."""
     import errno
 
-    from pin_susp import study as studies
     from pin_susp.io.atomic import atomic_write
+    from pin_susp.study import folder
 
-    real, written = studies._write_parquet, []
+    real, written = folder.write_parquet, []
 
     def write(table, path):
         if len(written) >= parts:
@@ -310,7 +310,7 @@ def _room_for(monkeypatch, parts: int):
         written.append(path)
         real(table, path)
 
-    monkeypatch.setattr(studies, "_write_parquet", write)
+    monkeypatch.setattr(folder, "write_parquet", write)
     return written
 
 
@@ -376,12 +376,12 @@ def test_a_damaged_part_file_is_named_and_its_batch_solved_again_on_resume(
 
     import pyarrow.parquet as pq
 
-    from pin_susp import study as studies
+    from pin_susp.study import folder
 
     def stop(*args):  # every batch written, then Ctrl+C
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(studies, "_assemble", stop)
+    monkeypatch.setattr(folder, "assemble", stop)
     argv = ["study", small_study, "-o", tmp_path / "a", "--scheduler", "none", "--steps"]
     assert run(argv, capsys)[0] == 128 + signal.SIGINT
     monkeypatch.undo()

@@ -13,7 +13,8 @@ fails; one removed must leave the list too. The ways of asking:
 - the geometry file's ``scope`` compared (``data.get("scope") == "axle"``), or any
   value compared to ``"axle"`` or ``"corner"``;
 - an axle's elements tested for (``model.axle is None``, ``axle is not None``);
-- a call of ``is_axle`` or ``is_axle_file`` (or a definition of ``is_axle``);
+- a call of ``is_axle``, ``is_axle_file`` or ``is_axle_data`` (or a definition of
+  ``is_axle``);
 - the number of a subject's corners compared (``len(subject.labels) > 1``): a twin
   still chosen by kind, only spelt through the labels.
 
@@ -38,14 +39,11 @@ KIND_WORDS = {"axle", "corner"}
 
 # Today's places, by file (below pin_susp/): a ratchet that only goes down.
 KIND_TESTS = {
-    "as_set.py": 1,  # isinstance(g, Geometry): a path or a Geometry
     "cli/commands/draw.py": 1,  # the axle's front view, a twin
     "cli/commands/sensitivity.py": 1,  # the axle's sensitivities, a twin
-    "cli/commands/setup.py": 1,  # the axle's setup sheet, a twin
-    "plots.py": 1,
     "pointwise.py": 1,
-    "study.py": 1,
-    "validate.py": 3,
+    "study/spec.py": 1,  # is_axle_data: the study's axle flag (its variants' data, sensitivities)
+    "validate/scopes.py": 1,  # the corner's or the axle's scope: two views, one per kind
 }
 
 
@@ -108,7 +106,7 @@ def kind_tests_in(tree: ast.AST) -> list[tuple[int, str]]:
                 a = node.args[1]
                 if isinstance(a, ast.Constant) and a.value in ONE_KIND_ATTRIBUTES:
                     found.append((node.lineno, f"{name}(…, {a.value!r})"))
-            elif name in ("is_axle", "is_axle_file"):
+            elif name in ("is_axle", "is_axle_file", "is_axle_data"):
                 found.append((node.lineno, f"{name}(…)"))
         elif isinstance(node, ast.Compare):
             sides = [node.left, *node.comparators]

@@ -464,7 +464,7 @@ def test_resume_solves_only_the_missing_batches(
         solved.append(index)
         return original(job, index, *rest)
 
-    monkeypatch.setattr(studies, "run_batch", counting)
+    monkeypatch.setattr(studies.tasks, "run_batch", counting)
     if on_dask:
         _wait_for(lambda: cluster.held() == 0, "the cluster's workers idle")
         before = cluster.executed()

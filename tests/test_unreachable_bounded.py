@@ -15,7 +15,7 @@ import pin_susp
 from pin_susp import pointwise, solver
 from pin_susp.axle import AxleModel, load_axle, solve_axle_sweep
 from pin_susp.sweep import load_sweep
-from pin_susp.validate import _scope
+from pin_susp.validate import scope_of
 
 # The sweep: examples/roll.yaml to 89° over 11 steps (steps 1–10 out of reach).
 ROLL_89 = {
@@ -58,7 +58,7 @@ def counted(model, monkeypatch):
 
 
 def pointwise_solves(subject, sweep, monkeypatch):
-    scope = _scope(subject)
+    scope = scope_of(subject)
     model = scope.pointwise()
     counts = counted(model, monkeypatch)
     residuals = []

@@ -34,7 +34,8 @@ class BallClosure(Row):
         a, b = k
         r[:, i : i + 3] = at.P[b] - at.P[a]
         if J is not None:
-            J[:, i : i + 3] = at.Jp[b] - at.Jp[a]
+            at.add_rows(J, i, b)
+            at.add_rows(J, i, a, -1.0)
 
     def drift_many(self, at, k, V, A, qdd, out, i) -> None:
         a, b = k

@@ -42,7 +42,9 @@ class DistanceClosure(Row):
         length = np.sqrt(np.einsum("ni,ni->n", d, d))
         r[:, i] = length - self.length
         if J is not None:
-            J[:, i] = np.einsum("ni,niv->nv", d / length[:, None], at.Jp[b] - at.Jp[a])
+            u = d / length[:, None]
+            at.add(J, i, b, u)
+            at.add(J, i, a, u, sign=-1.0)
 
     def drift_many(self, at, k, V, A, qdd, out, i) -> None:
         a, b = k

@@ -35,8 +35,10 @@ class HeaveTarget(Row):
     def fill_many(self, at, k, value, r, J, i) -> None:
         a, b = k
         r[:, i] = 0.5 * (at.P[a][:, 2] + at.P[b][:, 2]) - self.design - value
-        if J is not None:
-            J[:, i] = 0.5 * (at.Jp[a][:, 2] + at.Jp[b][:, 2])
+        if J is not None:  # ½ is exact: ½·J_a + ½·J_b is ½·(J_a + J_b) to the bit
+            for f in k:
+                if len(at.cols[f]):
+                    J[:, i, at.cols[f]] += 0.5 * at.Jc[f][:, :, 2].T
 
     def drift_many(self, at, k, V, A, qdd, out, i) -> None:
         a, b = k

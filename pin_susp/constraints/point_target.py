@@ -55,6 +55,12 @@ class PointTarget(Row):
                 J[i] = d[axis] * at.Jp[f][axis]
 
     def fill_many(self, at, k, value, r, J, i) -> None:
+        if self._direct:
+            (f,) = k
+            r[:, i] = at.P[f] @ self.direction - value
+            if J is not None and len(at.cols[f]):
+                J[:, i, at.cols[f]] = (at.Jc[f] @ self.direction).T
+            return
         p, jac = self.point.from_frames_many(
             [at.P[f] for f in k], None if J is None else [at.Jp[f] for f in k]
         )

@@ -94,10 +94,9 @@ class RollTarget(Row):
             return
         scale = 1.0 / (a * a + b * b)
         rise, kk = (b * scale)[:, None], (a * scale)[:, None]
-        row = np.zeros((len(a), at.nv))
-        for side, f in enumerate(k):
+        zero = np.zeros(len(a))
+        for side, f in enumerate(k):  # d(row) = ±(k·(dWC_y + c·ω) − rise·dWC_z)
             sign = -1.0 if side == 0 else 1.0
-            Jp, W = at.Jp[f], at.W[f]
-            turn = sum(cw[:, None] * W[:, m] for m, cw in enumerate(c[side]))
-            row += sign * kk * (Jp[:, 1] + turn) - sign * rise * Jp[:, 2]
-        J[:, i] = row
+            lin = np.stack([zero, sign * kk[:, 0], -sign * rise[:, 0]], axis=1)
+            ang = (sign * kk) * np.stack(c[side], axis=1)
+            at.add(J, i, f, lin, ang)

@@ -45,14 +45,85 @@ class StepFrames:
 
 
 class ManyFrames:
-    """The same for n configurations (bulk.Frames): ``P`` positions (n, 3), ``Jp``
-    linear Jacobians (n, 3, nv) or None, ``R`` rotations (n, 3, 3) and ``W`` angular
-    Jacobians (n, 3, nv) when a row is angular (else None), ``q`` (n, nq), ``nv``."""
+    """The same for n configurations (bulk.Frames): ``P`` positions (n, 3); each frame's
+    Jacobian compact — ``cols[f]`` the columns of v that move it (its supporting joints),
+    ``Jc[f]`` its linear rows in those columns (s, n, 3) and ``Wc[f]`` its angular ones
+    (s, n, 3; when a row is angular, else None) — or ``Jc`` None (residual only); ``Jp``
+    and ``W`` the same as dense (n, 3, nv) arrays per frame, built when first read;
+    ``R`` rotations (n, 3, 3) when a row is angular (else None), ``q`` (n, nq), ``nv``.
 
-    __slots__ = ("P", "Jp", "R", "W", "q", "nv")
+    ``add(J, i, f, lin, ang=None, sign)`` adds sign·(lin·J_f + ang·W_f) to row i of J
+    (n, nrows, nv): a row that is a weighted sum of frames' Jacobian rows writes only
+    the columns that move its frames."""
 
-    def __init__(self, P, Jp, R, W, q, nv):
-        self.P, self.Jp, self.R, self.W, self.q, self.nv = P, Jp, R, W, q, nv
+    __slots__ = ("P", "cols", "Jc", "Wc", "R", "q", "nv", "_dense")
+
+    def __init__(self, P, cols, Jc, Wc, R, q, nv):
+        self.P, self.cols, self.Jc, self.Wc = P, cols, Jc, Wc
+        self.R, self.q, self.nv = R, q, nv
+        self._dense = {}
+
+    def _expand(self, f: int, terms, key) -> np.ndarray:
+        out = self._dense.get(key)
+        if out is None:
+            out = np.zeros((len(self.P[f]), 3, self.nv))
+            if len(self.cols[f]):
+                out[:, :, self.cols[f]] = terms[f].transpose(1, 2, 0)
+            self._dense[key] = out
+        return out
+
+    @property
+    def Jp(self):
+        """Each frame's linear Jacobian rows, dense (n, 3, nv); None when residual only."""
+        if self.Jc is None:
+            return None
+        return _Lazy(lambda f: self._expand(f, self.Jc, ("J", f)), len(self.P))
+
+    @property
+    def W(self):
+        """Each frame's angular Jacobian rows, dense (n, 3, nv) (angular rows only)."""
+        if self.Wc is None:
+            return None
+        return _Lazy(lambda f: self._expand(f, self.Wc, ("W", f)), len(self.P))
+
+    def add(self, J: np.ndarray, i: int, f: int, lin, ang=None, sign: float = 1.0) -> None:
+        """J[:, i] += sign·(lin·J_f + ang·W_f), lin and ang (n, 3) or None, in f's columns."""
+        cols = self.cols[f]
+        if not len(cols):
+            return
+        x = None if lin is None else np.einsum("snk,nk->ns", self.Jc[f], lin)
+        if ang is not None:
+            turn = np.einsum("snk,nk->ns", self.Wc[f], ang)
+            x = turn if x is None else x + turn
+        if sign > 0:
+            J[:, i, cols] += x
+        else:
+            J[:, i, cols] -= x
+
+    def add_rows(self, J: np.ndarray, i: int, f: int, sign: float = 1.0) -> None:
+        """J[:, i : i + 3] += sign·J_f (its linear rows), in f's columns."""
+        cols = self.cols[f]
+        if not len(cols):
+            return
+        if sign > 0:
+            J[:, i : i + 3, cols] += self.Jc[f].transpose(1, 2, 0)
+        else:
+            J[:, i : i + 3, cols] -= self.Jc[f].transpose(1, 2, 0)
+
+
+class _Lazy:
+    """A read-only list whose items are made when first read."""
+
+    __slots__ = ("_make", "_n")
+
+    def __init__(self, make, n: int):
+        self._make, self._n = make, n
+
+    def __getitem__(self, f: int):
+        return self._make(f)
+
+    def __len__(self) -> int:
+        return self._n
 
 
 class Row:

@@ -103,10 +103,11 @@ SETUP_COLUMNS = ("shim_thickness", "trackrod_length_delta", "pushrod_length_delt
 
 
 def run(args) -> int:
+    import numpy as np
+
     from ... import setup
-    from ...geometry import load_geometry
     from ...io.atomic import all_or_none
-    from ...subject import is_axle_file
+    from ...subject import load_subject
 
     check_outputs(args, args.output, args.csv)
     targets = {
@@ -120,97 +121,64 @@ def run(args) -> int:
     }
     if args.output is not None and not targets:
         raise PinSuspError("-o writes a solved setup: give --camber, --toe or --ride-height-change")
-    if is_axle_file(args.geometry):
-        return _setup_axle(args, targets)
-    if args.side is not None:
-        raise PinSuspError(f"--side: {args.geometry} is a corner (--side sets one side of an axle)")
-    geometry = load_geometry(args.geometry)
-    title = f"{geometry.name}: setup sheet ({geometry.source})"
-    link = _link(geometry)
+    # each corner's sheet as a corner's (its own shim and adjusters), the subject's own
+    # static columns of its corners together (an axle's), or the inverse solve per corner
+    subject = load_subject(args.geometry, warn=False)
+    chosen = subject.setup_labels(args.side)
+    drawn = subject.drawn_corners
+    link = _link(drawn[subject.labels[0]])
     if targets:
-        found = setup.solve_setup(geometry, targets)
-        print(title)
-        _sheet([found.before, found.after], ["before", "after"], _link(geometry))
-        _hit(targets, found.iterations)
-        with all_or_none():
-            if args.output is not None:
-                _write_setup(setup.geometry_data(found.geometry), geometry.name, args.output)
-            if args.csv is not None:
-                _sheet_csv([found.before, found.after], ["before", "after"], args.csv, link)
-        wrote(args.output, args.csv)
-        return 0
-    rows = setup.setup_sheet(geometry, args.shim, args.trackrod, args.pushrod)
-    labels = _sheet_labels(args, link)
-    print(title)
-    _sheet(rows, labels, link)
-    if args.sensitivities:
-        _sensitivities(rows[0], geometry, args.thread_pitch)
-    if args.csv is not None:
-        _sheet_csv(rows, labels, args.csv, link)
-    wrote(args.csv)
-    return 0
-
-
-def _setup_axle(args, targets: dict) -> int:
-    """An axle: each side's sheet as its corner's (its own shim and adjusters), the axle's
-    static columns of both sides together, or the inverse solve per side."""
-    import numpy as np
-
-    from ... import setup
-    from ...axle import SIDES, load_axle
-    from ...io.atomic import all_or_none
-
-    axle = load_axle(args.geometry)
-    chosen = setup.set_sides(axle, args.side)
-    link = _link(axle.left)
-    if targets:
-        found = setup.solve_axle_setup(axle, targets, args.side)
-        rows = {s: [found[s].before, found[s].after] for s in SIDES}
+        found = setup.solve_subject_setup(subject, targets, args.side)
+        rows = {s: [found[s].before, found[s].after] for s in subject.labels}
         labels = ["before", "after"]
     else:
-        rows = setup.axle_setup_sheet(axle, args.shim, args.trackrod, args.pushrod, args.side)
+        rows = setup.subject_setup_sheet(subject, args.shim, args.trackrod, args.pushrod, args.side)
         labels = _sheet_labels(args, link)
-    # the axle's columns per row: both sides as set in that row (a side not set: as set)
+    # the subject's columns per row: its corners as set in that row (one not set: as set)
     statics = [
-        setup.axle_static(axle, {s: rows[s][min(i, len(rows[s]) - 1)] for s in SIDES})
+        setup.static_state(subject, {s: rows[s][min(i, len(rows[s]) - 1)] for s in rows})
         for i in range(len(labels))
     ]
-    print(f"{axle.name}: setup sheet per side ({axle.source})")
-    for s in SIDES:
-        if s == "right" and axle.mirrored:
+    per = " per side" if subject.blocks else ""
+    print(f"{subject.name}: setup sheet{per} ({subject.source})")
+    for s in subject.labels:
+        owner = subject.setup_owner(s)
+        if owner != s:
             print(
-                "  right corner (the left mirrored: it takes the left's setup, the same shim "
-                "stack and length deltas):"
+                f"  {s} corner (the {owner} mirrored: it takes the {owner}'s setup, the same "
+                "shim stack and length deltas):"
             )
-        else:
+        elif s:
             setting = "" if s in chosen else f"; not set: --side {args.side}"
-            print(f"  {s} corner (axle_config.{s}_setup{setting}):")
+            print(f"  {s} corner ({subject.file_key(s, 'config.setup')}{setting}):")
         _sheet(rows[s], labels[: len(rows[s])], link)
-        if targets and found[s].iterations:
+        if targets and (found[s].iterations or not s):  # a corner not set: no hit
             _hit(targets, found[s].iterations)
         if args.sensitivities and not targets:
-            _sensitivities(rows[s][0], axle.corner(s), args.thread_pitch)
-    print("  axle (both sides as set in each row):")
-    print(f"  {'':9}" + "".join(f"{head:>12}" for _, head in setup.AXLE_STATIC))
-    print(f"  {'':9}" + "".join(f"{'mm':>12}" for _ in setup.AXLE_STATIC))
-    for label, row in zip(labels, statics, strict=True):
-        cells = (round(row[name], 3) + 0.0 for name, _ in setup.AXLE_STATIC)
-        print(
-            f"  {label:9}"
-            + "".join(f"{v:>12.3f}" if np.isfinite(v) else f"{'-':>12}" for v in cells)
-        )
+            _sensitivities(rows[s][0], drawn[s], args.thread_pitch)
+    columns = subject.static_columns
+    if columns:
+        print("  axle (both sides as set in each row):")
+        print(f"  {'':9}" + "".join(f"{head:>12}" for _, head in columns))
+        print(f"  {'':9}" + "".join(f"{'mm':>12}" for _ in columns))
+        for label, row in zip(labels, statics, strict=True):
+            cells = (round(row[name], 3) + 0.0 for name, _ in columns)
+            print(
+                f"  {label:9}"
+                + "".join(f"{v:>12.3f}" if np.isfinite(v) else f"{'-':>12}" for v in cells)
+            )
     with all_or_none():
         if args.output is not None:
-            data = setup.axle_data(axle, {s: found[s].geometry for s in chosen})
-            _write_setup(data, axle.name, args.output)
+            data = subject.setup_data({s: found[s].geometry for s in chosen})
+            _write_setup(data, subject.name, args.output)
         if args.csv is not None:
-            sides = [(s, i) for s in SIDES for i in range(len(rows[s]))]
+            rows_of = [(s, i) for s in subject.labels for i in range(len(rows[s]))]
             _sheet_csv(
-                [rows[s][i] for s, i in sides],
-                [f"{s} {labels[i]}" for s, i in sides],
+                [rows[s][i] for s, i in rows_of],
+                [" ".join(filter(None, (s, labels[i]))) for s, i in rows_of],
                 args.csv,
                 link,
-                [statics[i] for _, i in sides],
+                [statics[i] for _, i in rows_of],
             )
     wrote(args.output, args.csv)
     return 0

@@ -1,0 +1,140 @@
+"""Where a study's batches run on Dask (docs/studies.md): a LocalCluster on 127.0.0.1
+or an existing scheduler, checked to answer; the dashboard's address; the batches
+submitted and gathered as they finish.
+"""
+
+from __future__ import annotations
+
+import os
+
+from ..errors import PinSuspError
+
+
+def on_dask(client, task, job, cut, table, todo, steps, finished) -> None:
+    from distributed import as_completed
+
+    [remote] = client.scatter([job], broadcast=True, hash=False)
+    futures = [
+        client.submit(task, remote, i, cut[i], table[cut[i]], steps, pure=False, retries=2)
+        for i in todo
+    ]
+    try:
+        for future in as_completed(futures):
+            finished(future.result())
+            future.release()
+    finally:
+        client.cancel(futures)
+
+
+class dask_client:
+    """A Dask client: on a LocalCluster (127.0.0.1) or an existing scheduler."""
+
+    def __init__(self, scheduler: str, workers: int | None):
+        self.scheduler, self.workers = scheduler, workers
+        self.cluster = self.client = None
+
+    def __enter__(self):
+        import logging
+
+        from distributed import Client, LocalCluster
+
+        for name in ("distributed", "distributed.worker", "distributed.scheduler"):
+            logging.getLogger(name).setLevel(logging.ERROR)
+        if self.scheduler == "local":
+            n = self.workers or os.cpu_count() or 1
+            self.cluster = LocalCluster(
+                n_workers=n,
+                threads_per_worker=1,
+                processes=True,
+                host="127.0.0.1",
+                dashboard_address="127.0.0.1:0",  # its HTTP server runs even without bokeh
+                silence_logs=logging.ERROR,
+            )
+            self.client = Client(self.cluster)
+            return self.client
+        if not self.scheduler.startswith("tcp://"):
+            raise PinSuspError(
+                f"--scheduler {self.scheduler}: expected an address like tcp://HOST:PORT, "
+                "'local' or 'none'"
+            )
+        _reachable(self.scheduler)
+        self.client = _connect(Client, self.scheduler, seconds=8.0)  # an answer in < 10 s
+        if self.workers is not None:
+            raise PinSuspError("--workers is for the local cluster; a scheduler has its own")
+        return self.client
+
+    def __exit__(self, *exc):
+        if self.client is not None:
+            self.client.close()
+        if self.cluster is not None:
+            self.cluster.close()
+
+
+def _connect(client_class, address: str, seconds: float):
+    """A Client of the scheduler at ``address``, or one clear error within ``seconds``
+    (a port that accepts and never speaks Dask would otherwise hold the handshake)."""
+    import threading
+
+    box = {}
+
+    def connect() -> None:
+        try:
+            box["client"] = client_class(address, timeout=f"{seconds:g}s")
+        except BaseException as exc:  # reported below, in the caller's thread
+            box["error"] = exc
+
+    thread = threading.Thread(target=connect, daemon=True, name="pin-susp-connect")
+    thread.start()
+    thread.join(seconds + 1.0)
+    if "client" in box:
+        return box["client"]
+    why = "no answer" if thread.is_alive() else type(box.get("error")).__name__
+    raise PinSuspError(
+        f"--scheduler {address}: no Dask scheduler answered within {seconds:g} s ({why}): "
+        "is it a Dask scheduler's address?"
+    )
+
+
+def _reachable(address: str) -> None:
+    """A TCP scheduler's port must take a connection (Dask would retry a refusal until
+    its timeout): one clear line at once, or after 5 s of silence."""
+    import socket
+    from urllib.parse import urlsplit
+
+    if not address.startswith("tcp://"):
+        return
+    try:
+        parts = urlsplit(address)
+        host, port = parts.hostname, parts.port
+    except ValueError:
+        host = port = None
+    if not host or not port:
+        raise PinSuspError(f"--scheduler {address}: expected tcp://HOST:PORT")
+    try:
+        socket.create_connection((host, port), timeout=5.0).close()
+    except OSError as exc:
+        why = "timed out" if isinstance(exc, TimeoutError) else exc.strerror or str(exc)
+        raise PinSuspError(
+            f"--scheduler {address}: no Dask scheduler answers there ({why})"
+        ) from None
+
+
+def _has_dashboard() -> bool:
+    import importlib.util
+
+    return importlib.util.find_spec("bokeh") is not None
+
+
+def dashboard(client, local: bool) -> str | None:
+    """The dashboard's address, when it has one to show (on this machine: with bokeh)."""
+    if local and not _has_dashboard():
+        return None
+    try:
+        if "dashboard" not in client.scheduler_info().get("services", {}):
+            return None
+        if not local and not client.run_on_scheduler(_has_dashboard):  # pages need bokeh
+            return None
+        return client.dashboard_link
+    except Exception:  # the link is a courtesy: never a reason to fail
+        return None
+    return None

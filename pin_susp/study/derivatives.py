@@ -1,0 +1,131 @@
+"""What the exact hardpoint sensitivities give a study (docs/studies.md): the
+optimiser's Jacobian, and Monte Carlo's first-order prediction of each summary column.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .data import AXES, Variable, shares, term_miss
+from .variants import Variant
+
+if TYPE_CHECKING:
+    from .spec import Study
+
+
+def objective_jacobian(v: Variant, sweep) -> np.ndarray:
+    """d r / d variables from the exact hardpoint sensitivities at every step and at
+    design (a relative term's reference moves too); a curve's target moves with its
+    x column. A step without a number (see term_miss) has a zero row."""
+    job = v.job
+    k = len(job.variables)
+    n = sweep.steps
+    if v.results is None:
+        return np.zeros((len(job.terms) * n, k))
+    at_design, steps = sensitivities(v.subject, sweep, v.results, job.axle)
+    columns = _columns(at_design.hardpoints, job.variables)
+    blocks = []
+    for t, w in zip(job.terms, shares(job.terms, n), strict=True):
+        counted = term_miss(t, v.results, v.static)[1]
+        rows = np.zeros((n, k))
+        ref = _pick(at_design, t.metric, columns) if t.relative else 0.0
+        for i, s in steps.items():
+            if not counted[i]:
+                continue
+            d = _pick(s, t.metric, columns) - ref
+            if t.curve is not None and t.curve_x in s.values:
+                d = d - t.slope(v.results[t.curve_x][i]) * _pick(s, t.curve_x, columns)
+            rows[i] = d
+        blocks.append(w * rows)
+    return np.vstack(blocks)
+
+
+def _columns(hardpoints: list[str], variables: list[Variable]) -> tuple:
+    return (
+        np.array([hardpoints.index(v.key) for v in variables]),
+        np.array([AXES.index(v.axis) for v in variables]),
+    )
+
+
+def _pick(s, name: str, columns) -> np.ndarray:
+    """d(column)/d(each variable) from a Sensitivity (per mm)."""
+    if name not in s.values:
+        return np.zeros(len(columns[0]))
+    return np.nan_to_num(s.values[name][columns])
+
+
+def sensitivities(subject, sweep, results, axle: bool) -> tuple:
+    """The exact hardpoint sensitivities at design and at each converged step:
+    (Sensitivity, {step: Sensitivity}), one-sided names on an axle."""
+    from dataclasses import replace
+
+    if axle:
+        from ..sensitivity import AxleSensitivity
+
+        model = AxleSensitivity(subject, one_sided=True)
+        at_design = model.at()
+        steps = {}
+        if holds_wheels(sweep):  # else the steps' sensitivities hold other quantities
+            steps = {
+                i: model.at(results.meta["q"][i], step=i)
+                for i in range(len(results))
+                if results["solver_converged"][i]
+            }
+        return at_design, steps
+    from ..sensitivity import HardpointSensitivity
+
+    model = HardpointSensitivity(subject)
+    at_design = model.at(subject.q_design)
+    steps = {}
+    for i in range(len(results)):
+        if results["solver_converged"][i]:
+            targets = [replace(t, values=t.values[i]) for t in sweep.targets]
+            steps[i] = model.at(results.meta["q"][i], targets, step=i)
+    return at_design, steps
+
+
+def holds_wheels(sweep) -> bool:
+    """Whether an axle's sweep holds what its sensitivities hold: each wheel centre's
+    height and the rack (its roll and heave targets hold other quantities)."""
+    keys = set()
+    for t in sweep.targets:
+        if t.quantity is not None:
+            return False
+        d = tuple(t.unit_direction.tolist())
+        if (t.point, d) == ("wheel_center", (0.0, 0.0, 1.0)):
+            keys.add(t.side)
+        elif t.point != "trackrod_inboard":
+            return False
+    return keys == {"left", "right"}
+
+
+def linear_prediction(study: Study, variants) -> dict[str, np.ndarray] | None:
+    """The first-order prediction of each summary column from the exact hardpoint
+    sensitivities at design and at every step (no re-solve): name → values per
+    variant, for ``<metric>_static``, ``_min`` and ``_max`` — on an axle the steps'
+    only where its sweep holds what the sensitivities hold (holds_wheels)."""
+    from ..sweep import load_sweep
+
+    job = study.job()
+    sweep = load_sweep(study.sweep_data)
+    design = Variant(job, np.zeros(len(study.variables)), sweep, every_column=True)
+    if design.results is None or not design.converged:
+        return None
+    at_design, steps = sensitivities(design.subject, sweep, design.results, study.axle)
+    columns = _columns(at_design.hardpoints, study.variables)
+    d = variants[study.names].to_numpy(dtype=float)
+    out = {}
+    for m in study.summary:
+        if m not in at_design.values:
+            continue
+        out[f"{m}_static"] = float(design.static[m][0]) + d @ _pick(at_design, m, columns)
+        if not steps:  # an axle's roll or heave sweep: the static column alone
+            continue
+        per_step = np.stack(
+            [design.results[m][i] + d @ _pick(s, m, columns) for i, s in steps.items()], axis=1
+        )
+        out[f"{m}_min"] = per_step.min(axis=1)
+        out[f"{m}_max"] = per_step.max(axis=1)
+    return out

@@ -1,0 +1,94 @@
+"""What the engines share (README, How it works): the point-based engine's points and
+rates, a target's rows through an engine's sites, the engines' contact patches, the
+counter of their warnings.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..constraints import ContactPatchPoint
+from ..pointwise import as_target
+from .scopes import scope_of
+
+STEP = 1e-3  # m: the drivers' step for the engines' rates (±STEP, ±2·STEP)
+
+
+def pointwise_points(subject, sweep) -> list[dict | None]:
+    """The point-based formulation's points at every step, with their rates along the
+    drivers; None where it did not converge.
+
+    The rates: the tangent of its own equations, J·dx = e for the driver's row
+    (the held target's, or the toe link's distance), solved in the least-squares
+    sense (its rigid-part distances are redundant, the system is consistent);
+    the points then move along dx (Richardson differences of the explicit point
+    formulas, error ~1e-12).
+    """
+    scope = scope_of(subject)
+    model = scope.pointwise()
+    out = []
+    for targets in scope.step_targets(sweep):
+        x, residual = model.solve(targets)
+        if not residual < 1e-12:
+            out.append(None)
+            continue
+        points = model.points(x)
+        held = scope.held(points)
+        J = model.jacobian(x, held)
+        rhs = np.zeros((len(J), scope.drivers))
+        first = len(model.pairs)
+        for j in range(len(held)):
+            rhs[first + j, j] = 1.0
+        for j, (a, b) in enumerate(scope.links, start=len(held)):  # a link's length
+            row = next(i for i, (p, q, _) in enumerate(model.pairs) if {p, q} == {a, b})
+            rhs[row, j] = 1.0
+        dx = np.linalg.lstsq(J, rhs, rcond=None)[0]
+        rates = {name: np.zeros((scope.drivers, 3)) for name in points}
+        h = 1e-4
+        for j in range(scope.drivers):
+            at = {s: model.points(x + s * h * dx[:, j]) for s in (-2, -1, 1, 2)}
+            for name in points:
+                d1, d2 = at[1][name] - at[-1][name], at[2][name] - at[-2][name]
+                rates[name][j] = (8.0 * d1 - d2) / (12.0 * h)
+        out.append(scope.duals(points, rates))
+    return out
+
+
+def target_rows(engine, p, targets) -> tuple[list, list]:
+    """Each target's residual at the positions ``p`` and its row (the chain rule through
+    the engine's sites' Jacobians): one rule for the MuJoCo and the Drake engines."""
+    errors, rows = [], []
+    for t in map(as_target, targets):
+        errors.append(t.error(p))
+        rows.append(
+            sum(g @ engine.sites[name].jacobian(engine) for name, g in t.gradient(p).items())
+        )
+    return errors, rows
+
+
+def with_contact_patches(sites: dict, scope) -> dict:
+    """An engine's points with each wheel's contact patch (from its wheel centre and
+    spin axis, as pin_susp's), named ``<prefix>contact_patch_center``."""
+    for prefix, (radius, body) in scope.wheels.items():
+        sites[f"{prefix}contact_patch_center"] = ContactPatchPoint(
+            f"{prefix}contact_patch_center",
+            sites[f"{prefix}wheel_center"],
+            sites[f"{prefix}axle_inboard"],
+            sites[f"{prefix}axle_outboard"],
+            radius,
+            body,
+        )
+    return sites
+
+
+class Warnings:
+    """A MuJoCo warning handler that only counts (and keeps the first)."""
+
+    def __init__(self):
+        self.count = 0
+        self.first = ""
+
+    def __call__(self, message: str) -> None:
+        if not self.count:
+            self.first = " ".join(str(message).split())
+        self.count += 1
