@@ -17,11 +17,12 @@ import numpy as np
 import pinocchio as pin
 
 from .bulk import Frames, tree_of
-from .constraints import WORLD, PointTarget
+from .constraints import WORLD, JointTarget, PointTarget
 from .elements import rack
 from .errors import InputError
-from .linkage import Composed
+from .linkage import Composed, Linkage
 from .march import march
+from .metrics import metric_columns, point_columns
 from .solver import NewtonSolver, Solution
 from .sweep import Sweep, Target, check_held, load_sweep
 
@@ -372,6 +373,89 @@ class Assembly(Composed):
             for i, tangent in zip(kept, per_target @ inverse, strict=True):
                 found[i] = tangent
         return found
+
+    # ------------------------------------------------------------ columns
+
+    def metric_columns(self, points: dict, only=None) -> dict:
+        """name → (values, unit): each corner's metric columns (metrics.METRICS, with its
+        label's suffix), then the shared elements' (an axle's pair of corners: heave,
+        roll, the roll centre, ..., and its rates), from ``points`` (name → {label:
+        jet.Dual}, label_motion's or any engine's points in that form). ``only``: the
+        set of corner columns wanted (a study's summary), else every one."""
+        out, sides = {}, {}
+        for label, g in self.corners.items():
+            p, names = self.prefix(label), self.corner_points[label]
+            design = {k: self.design_positions[p + k][None] for k in names}
+            own = {k: points[p + k][label] for k in names}
+            sides[label] = metric_columns(g, own, design, self.spring_senses[label], only)
+            suffix = self.suffix(label)
+            out |= {f"{name}{suffix}": c for name, c in sides[label].items()}
+        for element in self.shared:
+            if hasattr(element, "columns_of"):
+                out |= element.columns_of(self, points, sides)
+        return out
+
+    def label_corner(self, label: str, plain: dict, qs: list) -> tuple:
+        """A corner of its own for one label's rated spring, and its configurations at
+        ``qs``: a lone unlabelled corner is the model itself; a labelled one its own
+        Linkage posed at its wheel centre's height and the rack's travel at each step
+        (rates.SpringRates along its own hub z with the rack held). ``plain``: every
+        point's positions (n, 3) m."""
+        if not label:
+            return self, qs
+        g = self.corners[label]
+        corner = Linkage(g)
+        with_rack = self.model.existJointName(rack.JOINT)
+        index = self.model.joints[self.model.getJointId(rack.JOINT)].idx_q if with_rack else None
+        targets = [PointTarget(corner.points["wheel_center"], Z)]
+        if with_rack:
+            targets.append(JointTarget(corner.model, rack.JOINT))
+        solver = NewtonSolver(corner.kin, corner.closures, targets, corner.branches)
+        poses, q = [], corner.q_design
+        for i, at in enumerate(qs):
+            if at is None:
+                poses.append(None)
+                continue
+            goal = [plain[f"{label}_wheel_center"][i, 2]] + ([at[index]] if with_rack else [])
+            corner.kin.update_positions(q)
+            start = np.array([t.residual(corner.kin)[0] + t.value for t in targets])
+            solution = solver.solve(q, start, np.array(goal))
+            q = solution.q if solution.converged else q
+            poses.append(solution.q if solution.converged else None)
+        return corner, poses
+
+    def sweep_results(self, sweep: Sweep, solutions: list, tangents=None, only=None):
+        """The results (every column, docs/results.md) of a sweep's solved steps: the
+        solver's columns, every metric column (``metric_columns``), each rated spring's
+        columns (rates.py, with its label's suffix), then every point's ``_x/_y/_z``.
+        ``tangents``: each step's dq per driver (default: each solution's own);
+        ``only``: the set of columns wanted (a study's summary), else every one."""
+        from .rates import RATE_COLUMNS, rate_columns  # a rated spring's columns
+
+        kind = self.results_class
+        columns, units = kind.solver_columns(solutions)
+        # A step that did not converge has no trustworthy pose: its cells stay empty.
+        qs = [s.q if s.converged else None for s in solutions]
+        if tangents is None:
+            tangents = [s.drive_tangent for s in solutions]
+        points = self.label_motion(qs, tangents)
+        for name, (values, column_unit) in self.metric_columns(points, only).items():
+            columns[name], units[name] = values, column_unit
+        first = self.labels[0]
+        plain = {name: p[first].val for name, p in points.items()}
+        for label, g in self.corners.items():
+            if not g.rated_spring or not (only is None or RATE_COLUMNS & set(only)):
+                continue
+            corner, poses = self.label_corner(label, plain, qs)
+            for name, (values, column_unit) in rate_columns(corner, poses).items():
+                columns[name + self.suffix(label)] = values
+                units[name + self.suffix(label)] = column_unit
+        for name, (values, column_unit) in point_columns(self.output_points, plain).items():
+            if only is None or name in only:
+                columns[name], units[name] = values, column_unit
+        meta = kind.solver_meta(solutions, (self.source, self.sha256), sweep, self)
+        meta["notes"] = self.sweep_notes(sweep.targets)
+        return kind(columns, units, meta)
 
     def run_sweep_chunks(self, sweep: Sweep | str | dict, rows: int = CHUNK, progress=None):
         """The sweep's Results ``rows`` steps at a time (each chunk's ``step_index``

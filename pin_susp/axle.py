@@ -36,7 +36,7 @@ from .constraints import (
     PointTarget,
 )
 from .corner import Results
-from .elements import elements_of, rack
+from .elements import elements_of
 from .elements.anti_roll_bar import AntiRollBar
 from .elements.wheel_pair import WheelPair
 from .errors import InputError
@@ -156,6 +156,10 @@ class AxleModel(AxleAssembly):
 
         return summary_repr(self, parts)
 
+    @property
+    def sha256(self) -> str | None:
+        return self.axle.sha256 if self.axle is not None else None
+
     def held_sweep(self, sweep):
         """The sweep as its steps hold it (``held_targets``): the sweep itself where
         nothing is held."""
@@ -231,9 +235,6 @@ class AxleModel(AxleAssembly):
             (u_bar if bar.anti_roll == "u_bar" else ("t_bar_pivot_b",), bar.anti_roll_stiffness),
         )
 
-    def sweep_results(self, sweep, solutions: list, tangents=None, only=None) -> AxleResults:
-        return axle_results(self, sweep, solutions)
-
     def with_corners(self, corners: dict[str, Geometry]) -> AxleModel:
         if self.axle is None:
             return AxleModel(corners["left"], corners["right"])
@@ -289,210 +290,17 @@ class AxleResults(Results):
 def axle_results(model: AxleModel, sweep, solutions: list) -> AxleResults:
     """Every corner column per side (suffix ``_left``/``_right``, derivatives along
     that side's wheel-centre z and the rack, the other wheel held), the axle's
-    columns, then the points (``left_…``, ``right_…``, the bar's).
+    columns, then the points (``left_…``, ``right_…``, the bar's):
+    ``model.sweep_results`` (assembly.py).
 
     >>> results = axle_results(model, sweep, solve_axle_sweep(model, sweep))
     >>> results.to_pandas()  # a DataFrame, a row per step (model.run_sweep does both)
     """
-    columns, units = AxleResults.solver_columns(solutions)
-    qs = [s.q if s.converged else None for s in solutions]
-    points = model.motion(qs, solutions)
-    for name, (values, column_unit) in axle_metric_columns(model, points).items():
-        columns[name], units[name] = values, column_unit
-    plain = {k: v["left"].val for k, v in points.items()}
-    for name, (values, column_unit) in _side_rates(model, plain, qs).items():
-        columns[name], units[name] = values, column_unit
-    for name in model.output_points:
-        for i, axis in enumerate("xyz"):
-            columns[f"{name}_{axis}"] = plain[name][:, i] * 1e3
-            units[f"{name}_{axis}"] = "mm"
-    source, sha = model.source, model.axle.sha256 if model.axle is not None else None
-    meta = AxleResults.solver_meta(solutions, (source, sha), sweep, model)
-    meta["notes"] = model.sweep_notes(sweep)
-    return AxleResults(columns, units, meta)
-
-
-def _side_rates(model: AxleModel, plain: dict, qs: list) -> dict:
-    """Each side's spring force and wheel and ride rates where its rate is given (the
-    corner's, rates.SpringRates, along its own hub z with the rack held: its corner
-    posed at the side's wheel-centre height and the rack's travel at each step)."""
-    from .rates import rate_columns
-
-    out = {}
-    rack = model.model.existJointName("rack_slide")
-    index = model.model.joints[model.model.getJointId("rack_slide")].idx_q if rack else None
-    for side, g in model.geometries.items():
-        if not g.rated_spring:
-            continue
-        corner = Linkage(g)
-        targets = [PointTarget(corner.points["wheel_center"], Z)]
-        if rack:
-            targets.append(JointTarget(corner.model, "rack_slide"))
-        solver = NewtonSolver(corner.kin, corner.closures, targets, corner.branches)
-        poses, q = [], corner.q_design
-        for i, at in enumerate(qs):
-            if at is None:
-                poses.append(None)
-                continue
-            goal = [plain[f"{side}_wheel_center"][i, 2]] + ([at[index]] if rack else [])
-            corner.kin.update_positions(q)
-            start = np.array([t.residual(corner.kin)[0] + t.value for t in targets])
-            solution = solver.solve(q, start, np.array(goal))
-            q = solution.q if solution.converged else q
-            poses.append(solution.q if solution.converged else None)
-        for name, (values, unit_) in rate_columns(corner, poses).items():
-            out[f"{name}_{side}"] = (values, unit_)
-    return out
+    return model.sweep_results(sweep, solutions)
 
 
 def axle_metric_columns(model: AxleModel, points: dict) -> dict:
     """name → (values, unit): each side's corner columns (suffixed), the axle's, and
     the roll derivatives, from the points of ``AxleModel.motion`` (or any engine's
-    points with their rates in that form)."""
-    from .metrics import metric_columns
-
-    sides = {}
-    for side, g in model.geometries.items():
-        design = {k: model.design_positions[f"{side}_{k}"][None] for k in model.point_names[side]}
-        own = {k: points[f"{side}_{k}"][side] for k in model.point_names[side]}
-        sides[side] = metric_columns(g, own, design, model.spring_sense[side])
-    out = {f"{name}_{side}": c for side, cols in sides.items() for name, c in cols.items()}
-    plain = {k: v["left"].val for k, v in points.items()}
-    return out | _axle_metrics(model, plain, sides) | _roll_rates(model, points, sides)
-
-
-def _roll_rates(model: AxleModel, points: dict, sides: dict) -> dict:
-    """Exact derivatives along roll: the left wheel centre up and the right one down
-    equally, the rack held (docs/axle.md): camber and toe per side (deg/deg), the
-    U-bar's twist per side's hub z, and the roll centre's migration (mm/deg).
-
-    With h the antisymmetric wheel-centre move, roll = atan2(a, b), a = Δz_L − Δz_R,
-    b = CP_y,L − CP_y,R, so dθ/dh = (2b − a·(ḃ_L + ḃ_R)) / (a² + b²), where ḃ_side
-    is that side's contact patch y rate along its own hub z (the sides meet only at
-    the rack). A side's metric then moves at ±(d metric/d hub z) / (dθ/dh).
-    """
-    from .jet import Dual
-    from .metrics import PointSet, fvic_y, fvic_z
-
-    cp = {s: points[f"{s}_contact_patch_center"][s] for s in SIDES}
-    wc = {s: points[f"{s}_wheel_center"][s].val[:, 2] for s in SIDES}
-    d = model.design_positions
-    a = (wc["left"] - d["left_wheel_center"][2]) - (wc["right"] - d["right_wheel_center"][2])
-    b = cp["left"].val[:, 1] - cp["right"].val[:, 1]
-    rate = {s: cp[s].der[0][:, 1] for s in SIDES}  # d CP_y / d own hub z
-    dtheta = (2.0 * b - a * (rate["left"] - rate["right"] * -1.0)) / (a * a + b * b)
-    # per side: m of its own hub z per radian of roll (+ left, − right)
-    per_rad = {"left": 1.0 / dtheta, "right": -1.0 / dtheta}
-    deg = np.pi / 180.0
-    out = {}
-    for side in SIDES:
-        for name in ("camber", "roadwheel_angle"):
-            gain = sides[side][f"deriv_{name}_wrt_hub_z"][0] * 1e3  # deg per m
-            out[f"deriv_{name}_wrt_roll_{side}"] = (gain * per_rad[side] * deg, "deg/deg")
-    # the roll centre as a function of both sides' CP and FVIC, pushed along roll
-    parts = []
-    for s in SIDES:
-        g = model.geometries[s]
-        own = {k: points[f"{s}_{k}"][s] for k in model.point_names[s]}
-        design = {k: d[f"{s}_{k}"][None] for k in model.point_names[s]}
-        ps = PointSet(own, design, g)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            values = (cp[s][..., 1], cp[s][..., 2], fvic_y(ps), fvic_z(ps))
-        # Dual over one direction, roll (rad): d/dθ = d/d(own hub z) · per_rad
-        parts.append(tuple(Dual(v.val * 1e3, v.der[0] * per_rad[s] * 1e3) for v in values))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        rc = roll_centre(parts)
-    out["deriv_roll_center_y_wrt_roll"] = (rc[0].der * deg, "mm/deg")
-    out["deriv_roll_center_z_wrt_roll"] = (rc[1].der * deg, "mm/deg")
-    out |= model.bar.rate_columns(model, points)
-    return out | _roll_stiffness(model, sides, out, per_rad)
-
-
-def _roll_stiffness(model: AxleModel, sides: dict, rates: dict, per_rad: dict) -> dict:
-    """Where the springs' rates (and a bar's stiffness) are given: ``roll_stiffness``
-    (N·m/deg) = Σ springs' k·(dℓ/dφ)² + the bar's k·(dθ/dφ)², and ``arb_wheel_rate``
-    (N/mm), the bar's rate at each wheel in roll (one up, the other down): ½·k·(dθ/dh)²."""
-    axle = model.axle
-    if any(model.geometries[s].spring_rate is None for s in SIDES):
-        return {}
-    if axle is not None and axle.anti_roll != "none":
-        if axle.anti_roll_rigid or axle.anti_roll_stiffness is None:
-            return {}  # a locked bar does not roll; without its stiffness: unknown
-    total, out = 0.0, {}
-    for side in SIDES:
-        g = model.geometries[side]
-        if g.spring == "torsion_bar":  # wind-up rate deg/mm → rad/m, k N·m/deg → N·m/rad
-            turn = np.radians(sides[side]["deriv_torsion_bar_twist_wrt_hub_z"][0]) * 1e3
-            k = g.spring_rate * 180.0 / np.pi
-        else:  # length rate mm/mm, k N/mm → N/m
-            turn, k = sides[side]["deriv_damper_length_wrt_hub_z"][0], g.spring_rate * 1e3
-        total = total + k * (turn * per_rad[side]) ** 2
-    bar = model.bar.roll_term(rates, per_rad)
-    if bar is not None:
-        total = total + bar[0]
-        out["arb_wheel_rate"] = bar[1]
-    out["roll_stiffness"] = (total * np.pi / 180.0, "N·m/deg")
-    return out
-
-
-def _axle_metrics(model: AxleModel, p: dict, sides: dict) -> dict:
-    """heave, roll, body_roll, camber to ground, ride height, track, roll centre, rack,
-    steer angles and Ackermann, the U-bar's arm angles and twist, the heave link."""
-    d = {k: v[None] for k, v in model.design_positions.items()}
-    dz = {s: p[f"{s}_wheel_center"][:, 2] - d[f"{s}_wheel_center"][:, 2] for s in SIDES}
-    cp = {s: p[f"{s}_contact_patch_center"] for s in SIDES}
-    track = cp["left"][:, 1] - cp["right"][:, 1]
-    out = {
-        "heave": (0.5 * (dz["left"] + dz["right"]) * 1e3, "mm"),
-        "roll": (np.degrees(np.arctan2(dz["left"] - dz["right"], track)), "deg"),
-    }
-    body_roll = np.degrees(np.arctan2(cp["right"][:, 2] - cp["left"][:, 2], track))
-    out["body_roll"] = (body_roll, "deg")
-    for side, s in (("left", 1.0), ("right", -1.0)):
-        camber = sides[side]["camber"][0]
-        out[f"camber_to_ground_{side}"] = (camber - s * body_roll, "deg")
-    cp0 = {s: d[f"{s}_contact_patch_center"][:, 2] for s in SIDES}
-    change = -0.5 * ((cp["left"][:, 2] - cp0["left"]) + (cp["right"][:, 2] - cp0["right"]))
-    out["ride_height_change"] = (change * 1e3, "mm")
-    out["track"] = (np.abs(track) * 1e3, "mm")
-    rc = roll_centre(
-        [
-            (cp[s][:, 1] * 1e3, cp[s][:, 2] * 1e3, sides[s]["fvic_y"][0], sides[s]["fvic_z"][0])
-            for s in SIDES
-        ]
-    )
-    out["roll_center_y"], out["roll_center_z"] = (rc[0], "mm"), (rc[1], "mm")
-    travel = rack.travel(p, d)
-    out |= rack.columns(travel)
-    steer = {}
-    for side, s in (("left", 1.0), ("right", -1.0)):
-        steer[side] = -s * sides[side]["roadwheel_angle"][0]
-        out[f"steer_angle_{side}"] = (steer[side], "deg")
-    ackermann = _ackermann(model, steer, track)
-    if travel is None:  # no rack: no steering input
-        ackermann[:] = np.nan
-    else:  # bump or roll steer alone is not steering: blank with the rack at centre
-        ackermann[np.abs(travel) < 1e-6] = np.nan
-    out["ackermann"] = (ackermann, "%")
-    for element in model.elements:
-        out |= element.columns(model, p, d)
-    return out
-
-
-def _ackermann(model: AxleModel, steer: dict, track: np.ndarray) -> np.ndarray:
-    """100·(δ_i − δ_o)/(δ_i* − δ_o) from the steer angles' change from design; blank for
-    |δ_o| < 0.5° or without a wheelbase."""
-    wheelbase = model.geometries["left"].wheelbase
-    n = len(track)
-    if wheelbase is None:
-        return np.full(n, np.nan)
-    design = model.design_steer
-    delta = {s: np.abs(steer[s] - design[s]) for s in SIDES}
-    left_inner = (steer["left"] + steer["right"]) > 0.0
-    inner = np.where(left_inner, delta["left"], delta["right"])
-    outer = np.where(left_inner, delta["right"], delta["left"])
-    with np.errstate(invalid="ignore", divide="ignore"):
-        o = np.radians(outer)
-        ideal = np.degrees(np.arctan2(wheelbase, wheelbase / np.tan(o) - np.abs(track)))
-        out = 100.0 * (inner - outer) / (ideal - outer)
-    return np.where(outer >= 0.5, out, np.nan)
+    points with their rates in that form): ``model.metric_columns``."""
+    return model.metric_columns(points)

@@ -14,7 +14,7 @@ from .assembly import CHUNK, Assembly  # noqa: F401 (CHUNK: as it was)
 from .errors import InputError
 from .geometry import Geometry, load_geometry, summary_repr, warn_outside
 from .linkage import Linkage
-from .metrics import METRICS, Pose, metric_columns, point_columns
+from .metrics import METRICS, Pose, metric_columns
 from .solver import Solution
 from .sweep import Sweep, Target
 
@@ -78,6 +78,10 @@ class Corner(Assembly, Linkage):
     @property
     def name(self) -> str:
         return self.geometry.name
+
+    @property
+    def sha256(self) -> str:
+        return self.geometry.sha256
 
     def __repr__(self) -> str:
         def parts():
@@ -145,9 +149,6 @@ class Corner(Assembly, Linkage):
     def spring_senses(self) -> dict[str, float]:
         return {"": self.spring_sense}
 
-    def sweep_results(self, sweep: Sweep, solutions: list[Solution], tangents=None, only=None):
-        return Results.from_solutions(self, solutions, sweep, tangents, only)
-
     def with_corners(self, corners: dict[str, Geometry]) -> Corner:
         return Corner(corners[""], warn=False)
 
@@ -207,29 +208,9 @@ class Results:
     def from_solutions(
         cls, corner: Corner, solutions: list[Solution], sweep: Sweep, tangents=None, only=None
     ) -> Results:
-        """``only``: the set of columns wanted (a study's summary), else every column."""
-        columns, units = cls.solver_columns(solutions)
-        # A step that did not converge has no trustworthy pose: its cells stay empty.
-        points = corner.motion([s.q if s.converged else None for s in solutions], tangents)
-        design = {k: v[None] for k, v in corner.design_positions.items()}
-        metrics = metric_columns(corner.geometry, points, design, corner.spring_sense, only)
-        for name, (values, column_unit) in metrics.items():
-            columns[name], units[name] = values, column_unit
-        qs = [s.q if s.converged else None for s in solutions]
-        if corner.geometry.rated_spring:
-            from .rates import RATE_COLUMNS, rate_columns  # a rated spring's columns
-
-            if only is None or RATE_COLUMNS & set(only):
-                for name, (values, column_unit) in rate_columns(corner, qs).items():
-                    columns[name], units[name] = values, column_unit
-        positions = {name: p.val for name, p in points.items()}
-        for name, (values, column_unit) in point_columns(corner.point_names, positions).items():
-            if only is None or name in only:
-                columns[name], units[name] = values, column_unit
-        geometry = (corner.geometry.source, corner.geometry.sha256)
-        meta = cls.solver_meta(solutions, geometry, sweep, corner)
-        meta["notes"] = corner.sweep_notes(sweep.targets)
-        return cls(columns, units, meta)
+        """``only``: the set of columns wanted (a study's summary), else every column
+        (``corner.sweep_results``, assembly.py)."""
+        return corner.sweep_results(sweep, solutions, tangents, only)
 
     @staticmethod
     def solver_columns(solutions: list[Solution]) -> tuple[dict, dict]:
