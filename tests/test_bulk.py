@@ -45,7 +45,9 @@ def long_sweep(corner, steps: int = 401, bump=(-40.0, 60.0), rack=(-10.0, 10.0),
 def step_by_step(monkeypatch):
     """Make a subject's solve_steps (assembly.py) march every step (the reference)."""
     march = marching.march
-    monkeypatch.setattr(pin_susp.assembly, "march", lambda *a, **k: march(*a, **{**k, "bulk": False}))
+    monkeypatch.setattr(
+        pin_susp.assembly, "march", lambda *a, **k: march(*a, **{**k, "bulk": False})
+    )
 
 
 @pytest.mark.parametrize("name", CORNERS)
@@ -348,7 +350,9 @@ def axle_step_by_step(monkeypatch):
     import pin_susp.axle
 
     march = marching.march
-    monkeypatch.setattr(pin_susp.assembly, "march", lambda *a, **k: march(*a, **{**k, "bulk": False}))
+    monkeypatch.setattr(
+        pin_susp.assembly, "march", lambda *a, **k: march(*a, **{**k, "bulk": False})
+    )
     monkeypatch.setattr(pin_susp.axle, "MIN_STEPS", 10**9)
 
 
