@@ -170,9 +170,7 @@ class AxleModel(AxleAssembly):
         """Both wheel heights and the rack must fix the pose at design (the closures
         with them of full rank): else a part turns freely — a droplink square to its
         bar arm's motion (dead centre), a bar axis along a droplink."""
-        solver = NewtonSolver(self.kin, self.closures, _drive_rows(self), self.branches)
-        solver.evaluate(self.q_design)
-        s = np.linalg.svd(solver.jacobian, compute_uv=False)
+        s = np.linalg.svd(self.drive_rows_at_design(), compute_uv=False)
         if s[-1] <= 1e-9 * s[0]:
             raise InputError(
                 source,
@@ -268,14 +266,6 @@ def solve_axle_sweep(model: AxleModel, sweep, source: str | None = None, progres
     if source is not None and source != sweep.source:
         sweep = replace(sweep, source=source)
     return model.solve_steps(sweep, progress)
-
-
-def _drive_rows(model: AxleModel) -> list:
-    """The drivers of the columns' rates: each wheel centre's z, and the rack."""
-    drive = [PointTarget(model.points[f"{s}_wheel_center"], Z) for s in SIDES]
-    if model.model.existJointName("rack_slide"):
-        drive.append(JointTarget(model.model, "rack_slide"))
-    return drive
 
 
 # ---------------------------------------------------------------- columns

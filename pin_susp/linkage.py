@@ -335,6 +335,13 @@ class Composed:
         targets = list(getattr(targets, "targets", targets))
         return [RACK_HELD] if len(self.held_targets(targets)) > len(targets) else []
 
+    def drive_rows_at_design(self) -> np.ndarray:
+        """The closures' rows and the drivers' (each corner's wheel-centre z, the rack)
+        at design, stacked: of full rank when the drivers fix the pose (the closures'
+        first, as many as ``mobility`` fewer than the joints' freedoms)."""
+        self._drive.evaluate(self.q_design)
+        return self._drive.jacobian
+
     def label_motion(self, qs: list, tangents: list | None = None) -> dict:
         """Every point (prefixed) at each configuration, as a jet.Dual per corner's label:
         its rates along that corner's drivers (``driver_columns``: its hub z, the others
@@ -425,8 +432,7 @@ class Linkage(Composed):
         """The closures must be independent at design, and the wheel must move in bump:
         otherwise the file describes no suspension (one clear error naming the points of
         the closures or joints concerned, not a singular solve)."""
-        self._drive.evaluate(self.q_design)
-        rows = self._drive.jacobian
+        rows = self.drive_rows_at_design()
         n = len(rows) - len(self._drive.targets)
         if n:
             u, s, _ = np.linalg.svd(rows[:n])
