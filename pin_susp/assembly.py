@@ -48,7 +48,16 @@ class Assembly(Composed):
     stiffness in N·m/deg or None) — an axle's anti-roll bar, unless rigid;
     ``markers``: what the 3D view marks from its results' columns (an axle's
     ``roll_centre``); ``static_columns``: the columns of its corners together a setup
-    sheet adds to each row (an axle's track and roll centre).
+    sheet adds to each row (an axle's track and roll centre); ``elements``: the elements
+    its corners share (pin_susp/elements/: an axle's anti-roll bar and heave link; none
+    for a corner), the point-based formulation's too (pointwise.ELEMENTS); ``noun``:
+    what a message calls it (``corner``, ``axle``).
+
+    Both are a :class:`~pin_susp.linkage.Composed` too: ``tree``, ``urdf``,
+    ``output_points`` (every point written, each prefixed by its label),
+    ``design_positions``, ``corner_points`` (label → its corner's point names,
+    unprefixed), ``driver_columns`` (label → the columns of its drivers: its hub z, the
+    rack, its toe link).
 
     One model (linkage.Composed) and one sweep path for every subject: its targets
     read per label (a point target names its corner by ``side``, none for a corner's
@@ -57,7 +66,7 @@ class Assembly(Composed):
     (``held_targets``), the counts and the determinacy checked (``solver_for``), the
     steps marched or solved at once (``solve_steps``, march.py), streamed a chunk at a
     time (``run_sweep_chunks``). What a subject says of its targets is its constructor's
-    (``kind``, ``needs``, ``undetermined``); ``refuses``: what its targets' reading has
+    (``noun``, ``needs``, ``undetermined``); ``refuses``: what its targets' reading has
     always refused besides (``"repeats"``: a target given twice, the rack on both
     sides; ``"fixed points"``: a target on the chassis; ``"one rack target"``: a rack
     corner's sweep without its one rack target); ``checks_counts_first``: whether
@@ -79,7 +88,6 @@ class Assembly(Composed):
     spring_senses: dict
     shared_springs: tuple = ()
     markers: tuple[str, ...] = ()
-    kind: str = "assembly"
     shared: tuple = ()
     refuses: tuple[str, ...] = ()
     checks_counts_first: bool = True
@@ -88,6 +96,14 @@ class Assembly(Composed):
     # setup and sensitivity: the subject's own static columns of its corners set
     # together, (column, heading) in mm (an axle's track and roll centre; a corner: none)
     static_columns: tuple[tuple[str, str], ...] = ()
+    elements: tuple = ()
+    noun: str = "assembly"
+    tree: object
+    urdf: str
+    output_points: list[str]
+    design_positions: dict
+    corner_points: dict
+    driver_columns: dict
 
     @staticmethod
     def suffix(label: str) -> str:
@@ -105,6 +121,24 @@ class Assembly(Composed):
         ``right:``): one per labelled corner; none for a corner's one, unlabelled (its
         inputs at the top)."""
         return tuple(label for label in self.labels if label)
+
+    def held_sweep(self, sweep: Sweep) -> Sweep:
+        """The sweep as its steps hold it (``held_targets``): its targets, and the rack's
+        at design where it gives every other (``sweep_notes`` says so); the sweep
+        itself where nothing is held."""
+        targets = self.held_targets(sweep.targets)
+        return sweep if len(targets) == len(sweep.targets) else replace(sweep, targets=targets)
+
+    def metric_columns_of(self, points: dict) -> dict:
+        """Every metric column (name → (values, unit)) from its points with their rates
+        along the drivers (name → {label: jet.Dual}, as ``label_motion`` gives them, or
+        an engine's): ``metric_columns``."""
+        return self.metric_columns(points)
+
+    def motion_points(self, by_label: dict) -> dict:
+        """Points with a Dual per label (name → {label: Dual}, ``label_motion``'s) in the
+        form its ``motion`` gives them: as they are (a corner's: its one Dual each)."""
+        return by_label
 
     def with_corners(self, corners: dict):
         """The same subject on other corners' Geometries, by label (its shared elements
@@ -179,7 +213,7 @@ class Assembly(Composed):
             raise InputError(
                 source,
                 "targets",
-                f"{len(targets)} target(s) given, this {self.kind} needs exactly "
+                f"{len(targets)} target(s) given, this {self.noun} needs exactly "
                 f"{self.mobility} ({self.needs})",
             )
         if "one rack target" in self.refuses and self.model.existJointName(rack.JOINT):

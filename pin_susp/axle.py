@@ -77,7 +77,6 @@ class AxleModel(AxleAssembly):
 
     labels = SIDES
     motion_at_once_from = MIN_STEPS  # linkage.Composed.label_motion
-    kind = "axle"
     refuses = ("repeats",)
     checks_counts_first = False  # its counts checked when solved (after loads' own)
     tangents_by_drivers = True  # the numbers it always had
@@ -159,12 +158,6 @@ class AxleModel(AxleAssembly):
     @property
     def sha256(self) -> str | None:
         return self.axle.sha256 if self.axle is not None else None
-
-    def held_sweep(self, sweep):
-        """The sweep as its steps hold it (``held_targets``): the sweep itself where
-        nothing is held."""
-        targets = self.held_targets(sweep.targets)
-        return sweep if len(targets) == len(sweep.targets) else replace(sweep, targets=targets)
 
     def _check_determined(self, source: str) -> None:
         """Both wheel heights and the rack must fix the pose at design (the closures

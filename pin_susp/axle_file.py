@@ -375,6 +375,7 @@ class AxleAssembly(Assembly):
 
     axle: AxleGeometry | None
     static_columns = (("track", "track"), ("roll_center_y", "RC y"), ("roll_center_z", "RC z"))
+    noun = "axle"  # validate's messages
 
     def setup_labels(self, label: str | None = None) -> tuple[str, ...]:
         chosen = super().setup_labels(label)

@@ -39,7 +39,6 @@ class Corner(Assembly, Linkage):
     labels = ("",)
     streams = True  # run_sweep_chunks
     poses_at_steps = True  # urdf --at SWEEP:STEP
-    kind = "corner"
     refuses = ("fixed points", "one rack target")
 
     @property
@@ -163,6 +162,12 @@ class Corner(Assembly, Linkage):
         from .as_set import geometry_data
 
         return geometry_data(geometries[""])
+
+    # Assembly surface for validate
+    noun = "corner"
+
+    def motion_points(self, by_label: dict) -> dict:
+        return {name: p[""] for name, p in by_label.items()}
 
 
 class Results:

@@ -6,27 +6,30 @@ constraints are rigid-body distances between hardpoints of one part, the
 derived points are written again from docs/geometry.md. ``pin-susp
 validate`` and the tests solve every step with it and compare.
 
-An axle (docs/axle.md) is both corners' formulations with their names
-prefixed by side, one rack unknown that moves both trackrods' inboard ends,
-and the anti-roll bar's parts, droplinks and plane rows (:data:`ANTI_ROLL`).
+A subject's labelled corners and the elements they share are one formulation
+(:func:`labelled`): each corner's with its names prefixed by its label (an
+axle's ``left_``, ``right_``; a corner's ``""`` leaves them as they are), one
+rack unknown that moves every trackrod's inboard end, and each shared element's
+rows (:data:`ELEMENTS`): the anti-roll bar's parts, droplinks and plane rows
+(:data:`ANTI_ROLL`), the heave link's ends on the rockers (docs/axle.md).
 """
 
 from __future__ import annotations
 
 import itertools
 from dataclasses import dataclass
-from types import SimpleNamespace
 
 import numpy as np
 from scipy.optimize import least_squares
 
+from .assembly import Assembly
+from .elements import AntiRollBar, HeaveLink, elements_of
 from .errors import PinSuspError
 from .geometry import Geometry, Wheel
 from .mechanisms import Pointwise
 
 Y = np.array([0.0, 1.0, 0.0])
 Z = np.array([0.0, 0.0, 1.0])
-SIDES = ("left", "right")
 WHEEL_POINTS = ("axle_midpoint", "wheel_center", "wheel_inboard", "wheel_outboard")
 # Residual evaluations a solve may take. A reachable step from the design state takes
 # at most 8 on every example (a closed pose is a root: Levenberg-Marquardt converges
@@ -177,6 +180,7 @@ class PointwiseLinkage:
         self.x0 = np.zeros(n)
         for name, c in self.column.items():
             self.x0[c : c + 3] = hp[name]
+        self.design = self.points(self.x0)
 
     def points(self, x: np.ndarray) -> dict[str, np.ndarray]:
         """Every hardpoint and derived point for the unknowns x."""
@@ -312,81 +316,134 @@ class PointwiseLinkage:
 
 
 class PointwiseCorner(PointwiseLinkage):
-    """A corner: its mechanism's parts, links and lines (``Mechanism.pointwise``)."""
+    """A lone corner (labelled ``""``: its names as they are): its mechanism's parts,
+    links and lines (``Mechanism.pointwise``); ``hardpoints``: its points to use instead
+    of its Geometry's."""
 
     def __init__(self, geometry: Geometry, hardpoints: dict[str, np.ndarray] | None = None):
-        spec = geometry.mechanism.pointwise(geometry)
-        racks = () if spec.rack is None else (spec.rack,)
-        super().__init__(spec, hardpoints or geometry.hardpoints, {"": geometry.wheel}, racks)
+        super().__init__(*labelled({"": geometry}, (), {"": hardpoints} if hardpoints else None))
         self.geometry = geometry
-        self.inner = spec.rack
+        self.inner = self.racks[0] if self.racks else None
 
 
 class PointwiseAxle(PointwiseLinkage):
-    """An axle: each corner's formulation with its names prefixed ``left_``/``right_``,
-    one rack unknown for both trackrods' inboard ends, the anti-roll bar
-    (:data:`ANTI_ROLL`), and the heave link's ends riding on the rockers.
-
-    ``axle``: a :class:`pin_susp.axle.AxleGeometry` (None: two bare corners);
-    ``corners``: side → the corner Geometry to use instead of the axle's (the
-    as-set corners; required without an axle).
-    """
+    """An axle file's: both corners (``corners``: side → the Geometry to use instead of
+    the file's, the as-set ones) and its shared elements (:func:`labelled`)."""
 
     def __init__(self, axle, corners: dict[str, Geometry] | None = None):
         corners = corners or {"left": axle.left, "right": axle.right}
-        if axle is None:
-            axle = SimpleNamespace(
-                center={}, side_points=dict.fromkeys(SIDES, {}), anti_roll="none", heave_link="none"
-            )
-        spec = Pointwise({}, [], [], set())
-        hp, racks = dict(axle.center), []
-        for side, g in corners.items():
-            own = g.mechanism.pointwise(g)
-
-            def name(n, side=side):
-                return f"{side}_{n}"
-
-            spec.parts.update({name(k): [name(n) for n in v] for k, v in own.parts.items()})
-            spec.links.extend((name(a), name(b)) for a, b in own.links)
-            spec.lines.extend(tuple(map(name, line)) for line in own.lines)
-            spec.fixed.update(map(name, own.fixed))
-            if own.rack is not None:
-                racks.append(name(own.rack))
-            hp.update({name(n): v for n, v in g.hardpoints.items()})
-            hp.update({name(n): v for n, v in axle.side_points[side].items()})
-        if axle.anti_roll not in ANTI_ROLL:
-            raise PinSuspError(
-                f"the point-based formulation has no {axle.anti_roll} anti-roll bar yet "
-                f"(it has: {', '.join(ANTI_ROLL)})"
-            )
-        planes = ANTI_ROLL[axle.anti_roll](axle, corners, spec, hp)
-        if axle.heave_link != "none":  # measured only: a point on each rocker
-            for side in SIDES:
-                spec.parts[f"{side}_rocker"].append(f"{side}_heave_link_rocker")
-        wheels = {f"{side}_": g.wheel for side, g in corners.items()}
-        super().__init__(spec, hp, wheels, racks, planes)
+        super().__init__(*labelled(corners, elements_of(axle)))
         self.axle = axle
-        self.design = self.points(self.x0)
 
     def targets(self, sweep_targets, values) -> list:
         """One step of a sweep's targets (its own design state for heave and roll)."""
-        return axle_targets(sweep_targets, values, self.design)
+        return targets_at(sweep_targets, values, self.design)
 
 
-def axle_targets(sweep_targets, values, design: dict) -> list:
-    """One step of an axle sweep's targets as point-based targets: ``values`` in SI as
-    axle.target_values gives them (heave m, roll rad, a point's coordinate m,
-    absolute); ``design``: the design points (m), for heave's and roll's zero."""
-    left, right = design["left_wheel_center"][2], design["right_wheel_center"][2]
+def labelled(corners: dict[str, Geometry], elements=(), hardpoints: dict | None = None):
+    """Labelled corners and the elements they share as :class:`PointwiseLinkage`'s
+    arguments (spec, hardpoints, wheels, racks, planes): each corner's formulation with
+    its names prefixed by its label (``left_``; a corner's ``""`` leaves them as they
+    are), one rack unknown for every trackrod's inboard end, then each element's parts,
+    links and plane rows (:data:`ELEMENTS`); ``hardpoints``: label → a corner's points
+    to use instead of its Geometry's.
+
+    >>> PointwiseLinkage(*labelled(subject.corners, subject.elements))  # any Assembly
+    """
+    spec = Pointwise({}, [], [], set())
+    hp, racks = {}, []
+    for label, g in corners.items():
+        own, p = g.mechanism.pointwise(g), Assembly.prefix(label)
+
+        def name(n, p=p):
+            return f"{p}{n}"
+
+        spec.parts.update({name(k): [name(n) for n in v] for k, v in own.parts.items()})
+        spec.links.extend((name(a), name(b)) for a, b in own.links)
+        spec.lines.extend(tuple(map(name, line)) for line in own.lines)
+        spec.fixed.update(map(name, own.fixed))
+        if own.rack is not None:
+            racks.append(name(own.rack))
+        points = (hardpoints or {}).get(label) or g.hardpoints
+        hp.update({name(n): v for n, v in points.items()})
+    planes = []
+    for element in elements:
+        planes += ELEMENTS[type(element)](element, corners, spec, hp)
+    wheels = {Assembly.prefix(label): g.wheel for label, g in corners.items()}
+    return spec, hp, wheels, racks, planes
+
+
+def sweep_values(sweep_targets, design: dict) -> np.ndarray:
+    """A sweep's target values in SI, a row per step: heave m, roll rad, a point's
+    coordinate m (absolute: a relative one from ``design``, the design points, m, by
+    their labelled names)."""
+    columns = []
+    for t in sweep_targets:
+        v = np.asarray(t.values, dtype=float)
+        if t.quantity == "roll":
+            columns.append(np.radians(v))
+        elif t.quantity == "heave":
+            columns.append(v * 1e-3)
+        else:
+            v = v * 1e-3
+            if t.mode == "relative":
+                v = v + design[_named(t)] @ t.unit_direction
+            columns.append(v)
+    return np.column_stack(columns)
+
+
+def targets_at(sweep_targets, values, design: dict) -> list:
+    """One step of a sweep's targets as point-based targets: ``values`` in SI as
+    :func:`sweep_values` gives them; ``design``: the design points (m), for heave's and
+    roll's zero (an axle's). A point's target names it by its corner's label (``side``:
+    ``left_wheel_center``; none: ``wheel_center``)."""
     out = []
     for t, value in zip(sweep_targets, values, strict=True):
-        if t.quantity == "heave":
-            out.append(Heave(0.5 * (left + right), float(value)))
-        elif t.quantity == "roll":
-            out.append(Roll(left - right, float(value)))
+        if t.quantity in ("heave", "roll"):
+            left, right = design["left_wheel_center"][2], design["right_wheel_center"][2]
+            if t.quantity == "heave":
+                out.append(Heave(0.5 * (left + right), float(value)))
+            else:
+                out.append(Roll(left - right, float(value)))
         else:
-            out.append(Along(f"{t.side}_{t.point}", t.unit_direction, float(value)))
+            out.append(Along(_named(t), t.unit_direction, float(value)))
     return out
+
+
+def _named(target) -> str:
+    """A sweep target's point by its labelled name (its corner's ``side``, if any)."""
+    return Assembly.prefix(target.side or "") + target.point
+
+
+def _anti_roll_bar(bar: AntiRollBar, corners: dict[str, Geometry], spec, hp) -> list:
+    """The anti-roll bar's rows (:data:`ANTI_ROLL`, by its type) and its points: its
+    axis or pivot, each corner's droplink ends."""
+    axle = bar.axle
+    if axle.anti_roll not in ANTI_ROLL:
+        raise PinSuspError(
+            f"the point-based formulation has no {axle.anti_roll} anti-roll bar yet "
+            f"(it has: {', '.join(ANTI_ROLL)})"
+        )
+    hp.update(bar.center)
+    _side_points(axle.side_points, corners, "droplink_", hp)
+    return ANTI_ROLL[axle.anti_roll](axle, corners, spec, hp)
+
+
+def _heave_link(link: HeaveLink, corners: dict[str, Geometry], spec, hp) -> list:
+    """The heave link, measured only: its end on each corner's rocker (no rows)."""
+    _side_points(link.side_points, corners, "heave_link_", hp)
+    if link.kind != "none":
+        for label in corners:
+            p = Assembly.prefix(label)
+            spec.parts[f"{p}rocker"].append(f"{p}heave_link_rocker")
+    return []
+
+
+def _side_points(side_points: dict, corners, start: str, hp) -> None:
+    """An element's points on each corner (names beginning ``start``), prefixed."""
+    for label in corners:
+        p = Assembly.prefix(label)
+        hp.update({p + n: v for n, v in side_points[label].items() if n.startswith(start)})
 
 
 def _no_bar(axle, corners, spec, hp) -> list:
@@ -403,13 +460,14 @@ def _u_bar(axle, corners, spec, hp) -> list:
 
     A rigid bar (``stiffness: rigid``) is one part on the axis (:func:`_rigid_bar`)."""
     axis = ("arb_u_bar_axis_a", "arb_u_bar_axis_b")
-    ends = [f"{side}_droplink_u_bar" for side in SIDES]
+    sides = [Assembly.prefix(label) for label in corners]
+    ends = [f"{p}droplink_u_bar" for p in sides]
     spec.fixed.update(axis)
-    if getattr(axle, "anti_roll_rigid", False):
+    if axle.anti_roll_rigid:
         _rigid_bar(axis, ends, spec, hp)
     else:
-        for side in SIDES:
-            spec.parts[f"{side}_arb_arm"] = [*axis, f"{side}_droplink_u_bar"]
+        for p in sides:
+            spec.parts[f"{p}arb_arm"] = [*axis, f"{p}droplink_u_bar"]
     _droplinks(axle, corners, "droplink_u_bar", spec)
     return []
 
@@ -425,10 +483,10 @@ def _t_bar(axle, corners, spec, hp) -> list:
     second point ``arb_t_bar_axis`` (the pivot moved along y as far as the left end
     is from it). Its midpoint then stays in its plane by itself."""
     pivot = "arb_t_bar_pivot"
-    ends = [f"{side}_droplink_t_bar" for side in SIDES]
+    ends = [f"{Assembly.prefix(label)}droplink_t_bar" for label in corners]
     spec.fixed.add(pivot)
     planes = []
-    if getattr(axle, "anti_roll_rigid", False):
+    if axle.anti_roll_rigid:
         hp["arb_t_bar_axis"] = hp[pivot] + np.linalg.norm(hp[ends[0]] - hp[pivot]) * Y
         spec.fixed.add("arb_t_bar_axis")
         _rigid_bar((pivot, "arb_t_bar_axis"), ends, spec, hp)
@@ -454,25 +512,28 @@ def _rigid_bar(axis, ends, spec, hp) -> None:
 
 
 def _droplinks(axle, corners: dict[str, Geometry], end: str, spec) -> None:
-    """Per side a rigid link from the rocker's ``droplink_rocker`` (or
+    """Per corner a rigid link from the rocker's ``droplink_rocker`` (or
     ``droplink_lower`` on the body ``anti_roll.mount`` names) to the bar's point
-    ``<side>_<end>``."""
-    for side, g in corners.items():
-        if "droplink_rocker" in axle.side_points[side]:
+    ``<label>_<end>``."""
+    for label, g in corners.items():
+        side = Assembly.prefix(label)
+        if "droplink_rocker" in axle.side_points[label]:
             upper, body = "droplink_rocker", "rocker"
         else:
             mount = axle.anti_roll_mount
             upper, body = "droplink_lower", g.mechanism.WHEEL_BODY if mount == "arm" else mount
-        if f"{side}_{body}" not in spec.parts:
-            own = [p.removeprefix(f"{side}_") for p in spec.parts if p.startswith(f"{side}_")]
+        if f"{side}{body}" not in spec.parts:
+            own = [p.removeprefix(side) for p in spec.parts if p.startswith(side)]
             raise PinSuspError(
                 f"the point-based formulation has no rigid part {body!r} to carry the "
                 f"droplink (its parts: {', '.join(own)})"
             )
-        spec.parts[f"{side}_{body}"].append(f"{side}_{upper}")
-        spec.links.append((f"{side}_{upper}", f"{side}_{end}"))
+        spec.parts[f"{side}{body}"].append(f"{side}{upper}")
+        spec.links.append((f"{side}{upper}", f"{side}{end}"))
 
 
 # anti_roll.type → what it adds to the axle's parts, links, lines and fixed points;
 # it returns its plane rows (conditions always held, as targets).
 ANTI_ROLL = {"none": _no_bar, "u_bar": _u_bar, "t_bar": _t_bar}
+# a shared element (pin_susp/elements/) → its point-based parts, links and plane rows
+ELEMENTS = {AntiRollBar: _anti_roll_bar, HeaveLink: _heave_link}

@@ -41,9 +41,7 @@ KIND_WORDS = {"axle", "corner"}
 KIND_TESTS = {
     "cli/commands/draw.py": 1,  # the axle's front view, a twin
     "cli/commands/sensitivity.py": 1,  # the axle's sensitivities, a twin
-    "pointwise.py": 1,
     "study/spec.py": 1,  # is_axle_data: the study's axle flag (its variants' data, sensitivities)
-    "validate/scopes.py": 1,  # the corner's or the axle's scope: two views, one per kind
 }
 
 
@@ -206,6 +204,32 @@ def test_both_subjects_answer_what_the_consumers_ask():
     assert corner.summary_columns is None  # every metric column
     sided = [c for c in axle.summary_columns if c.endswith(tuple(map(axle.suffix, axle.labels)))]
     assert sided and len(sided) == len(set(sided))
+
+
+def test_validate_sees_one_scope_of_either_subject():
+    """What validate asks instead of the kind: one Scope over the labelled corners (the
+    drivers: each hub z, the rack), each corner's columns from points a Dual per label
+    (an axle's own added), and the engines' points in the form the subject's motion has."""
+    import numpy as np
+
+    from pin_susp.subject import load_subject
+    from pin_susp.validate import Scope, scope_of
+
+    examples = PACKAGE.parent / "examples"
+    corner = load_subject(examples / "double_wishbone.yaml")
+    axle = load_subject(examples / "axle_front.yaml")
+    for subject, drivers in ((corner, 2), (axle, 3)):
+        scope = scope_of(subject)
+        assert type(scope) is Scope and scope.drivers == drivers
+        by_label = subject.label_motion([subject.q_design])
+        columns = subject.metric_columns_of(by_label)
+        assert {f"camber{subject.suffix(label)}" for label in subject.labels} <= set(columns)
+    assert "roll_center_z" in axle.metric_columns_of(axle.label_motion([axle.q_design]))
+    own = corner.motion([corner.q_design])
+    as_motion = corner.motion_points(corner.label_motion([corner.q_design]))
+    assert own.keys() == as_motion.keys()
+    assert all(np.array_equal(own[n].val, as_motion[n].val) for n in own)
+    assert corner.noun == "corner" and axle.noun == "axle"
 
 
 if __name__ == "__main__":

@@ -17,11 +17,11 @@ bump twist are checked too.
 The metrics are then computed from each engine's points and compared with
 pin_susp's, metric by metric and point by point.
 
-A corner or an axle (docs/axle.md) alike: what differs between them — their
-points, drivers, targets and columns — is a scope (:class:`CornerScope`,
-:class:`AxleScope`); the engines only see points and targets.
+A corner or an axle (docs/axle.md) alike: the engines' view of a subject — its
+points, drivers, targets and columns — is one :class:`Scope` over the Assembly's
+labelled corners; the engines only see points and targets.
 
-The package: ``scopes`` (a corner's and an axle's view for the engines), ``engines``
+The package: ``scopes`` (the subject's view for the engines), ``engines``
 (their shared pieces and the point-based engine), ``mujoco_engine``, ``drake_engine``
 (its URDF check too), ``report`` (the comparison); :func:`validate` runs them.
 """
@@ -40,10 +40,18 @@ from .drake_engine import (
     drake_run,
     quiet_drake,
 )
-from .engines import STEP, pointwise_points
+from .engines import STEP, pointwise_points, pointwise_run
 from .mujoco_engine import MujocoCorner, mujoco_points, mujoco_run, quiet_mujoco
 from .report import RELATIVE, TOLERANCE, Branches, EngineReport, compare
-from .scopes import RATE_METRICS, AxleScope, CornerScope, held_drivers, scope_of, step_targets
+from .scopes import (
+    RATE_METRICS,
+    AxleScope,
+    CornerScope,
+    Scope,
+    held_drivers,
+    scope_of,
+    step_targets,
+)
 
 ENGINES = ("pointwise", "mujoco", "drake")
 INSTALL = {"mujoco": "MuJoCo", "drake": "Drake"}
@@ -63,7 +71,7 @@ def validate(
     """Solve the sweep with pin_susp, then with each of ``engines`` (of :data:`ENGINES`)
     that is installed; compare.
 
-    ``subject``: a Corner or an AxleModel. Returns (results, reports), the reports
+    ``subject``: an Assembly (a Corner, an AxleModel). Returns (results, reports), the reports
     in the order of ENGINES. ``mjcf_text`` (MuJoCo's) and ``urdf_text`` (Drake's)
     default to the subject's own export; given, each must be that export
     (:func:`pin_susp.mjcf.check_mjcf`, :func:`check_urdf`, checked before any
@@ -88,7 +96,7 @@ def validate(
     reports = []
     if "pointwise" in engines:
         try:
-            points = pointwise_points(scope, sweep)
+            points = pointwise_run(scope, sweep)
         except PinSuspError as exc:
             reports.append(EngineReport("pointwise", note=str(exc)))
         else:

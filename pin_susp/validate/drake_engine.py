@@ -296,15 +296,16 @@ def quiet_drake():
 
 
 def drake_points(subject, sweep, urdf_text: str | None = None, source: str = "the URDF") -> list:
-    """Drake's points at every step (None where it did not converge), quietly;
-    ``urdf_text`` defaults to the subject's own export."""
+    """Drake's points at every step (None where it did not converge), quietly, as the
+    subject's motion gives them; ``urdf_text`` defaults to the subject's own export."""
     scope = scope_of(subject)
     text = scope.subject.urdf if urdf_text is None else urdf_text
-    return drake_run(scope, sweep, text, source)[0]
+    return scope.as_motion(drake_run(scope, sweep, text, source)[0])
 
 
 def drake_run(scope, sweep, urdf_text: str, source: str):
-    """(points, warnings counter); Drake's errors as PinSuspError naming ``source``."""
+    """(points, a Dual per label; warnings counter); Drake's errors as PinSuspError
+    naming ``source``."""
     with quiet_drake() as counter:
         engine = DrakeCorner(urdf_text, scope, source)
         points = []

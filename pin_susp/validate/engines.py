@@ -16,7 +16,15 @@ STEP = 1e-3  # m: the drivers' step for the engines' rates (±STEP, ±2·STEP)
 
 def pointwise_points(subject, sweep) -> list[dict | None]:
     """The point-based formulation's points at every step, with their rates along the
-    drivers; None where it did not converge.
+    drivers, as the subject's motion gives them (a corner's a Dual each, an axle's a
+    Dual per side); None where it did not converge (:func:`pointwise_run`)."""
+    scope = scope_of(subject)
+    return scope.as_motion(pointwise_run(scope, sweep))
+
+
+def pointwise_run(scope, sweep) -> list[dict | None]:
+    """The point-based formulation's points at every step, a Dual per label (the
+    scope's form); None where it did not converge.
 
     The rates: the tangent of its own equations, J·dx = e for the driver's row
     (the held target's, or the toe link's distance), solved in the least-squares
@@ -24,7 +32,6 @@ def pointwise_points(subject, sweep) -> list[dict | None]:
     the points then move along dx (Richardson differences of the explicit point
     formulas, error ~1e-12).
     """
-    scope = scope_of(subject)
     model = scope.pointwise()
     out = []
     for targets in scope.step_targets(sweep):

@@ -132,12 +132,15 @@ class _Site:
 
 
 def mujoco_points(subject, sweep, mjcf_text: str, source: str = "the MJCF") -> list:
-    """MuJoCo's points at every step (None where it did not converge), quietly."""
-    return mujoco_run(scope_of(subject), sweep, mjcf_text, source)[0]
+    """MuJoCo's points at every step (None where it did not converge), quietly, as the
+    subject's motion gives them."""
+    scope = scope_of(subject)
+    return scope.as_motion(mujoco_run(scope, sweep, mjcf_text, source)[0])
 
 
 def mujoco_run(scope, sweep, mjcf_text: str, source: str):
-    """(points, warnings counter); MuJoCo's errors as PinSuspError naming ``source``."""
+    """(points, a Dual per label; warnings counter); MuJoCo's errors as PinSuspError
+    naming ``source``."""
     import mujoco
 
     with quiet_mujoco(mujoco) as counter:

@@ -51,8 +51,8 @@ class EngineReport:
 def compare(
     subject, results, points_per_step: list | None, engine: str, tolerance: float = TOLERANCE
 ) -> EngineReport:
-    """Metric columns of an engine's points against pin_susp's results (a corner's or
-    an axle's: ``subject`` is a Corner or an AxleModel)."""
+    """Metric columns of an engine's points against pin_susp's results (``subject``: an
+    Assembly — a Corner, an AxleModel — or its Scope)."""
     scope = scope_of(subject)
     report = EngineReport(engine, tolerance)
     branches = Branches(scope.tree)
