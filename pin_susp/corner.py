@@ -8,24 +8,18 @@ The model itself — URDF, Pinocchio model, points, closures — is the
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 import numpy as np
 
-from .assembly import Assembly
-from .constraints import PointTarget
+from .assembly import CHUNK, Assembly  # noqa: F401 (CHUNK: as it was)
 from .errors import InputError
 from .geometry import Geometry, load_geometry, summary_repr, warn_outside
 from .linkage import Linkage
-from .march import march
-from .metrics import METRICS, TOE_LINK, Pose, metric_columns, point_columns
-from .solver import NewtonSolver, Solution
-from .sweep import Sweep, Target, check_held, load_sweep
-
-CHUNK = 10_000  # steps solved and written at a time by a streamed sweep
+from .metrics import METRICS, Pose, metric_columns
+from .solver import Solution
+from .sweep import Sweep, Target
 
 
-class Corner(Linkage, Assembly):
+class Corner(Assembly, Linkage):
     """One suspension corner: geometry (as set), URDF, Pinocchio model, sweeps.
 
     >>> corner = Corner("examples/double_wishbone.yaml")  # a path, a dict or a Geometry
@@ -45,6 +39,32 @@ class Corner(Linkage, Assembly):
     labels = ("",)
     streams = True  # run_sweep_chunks
     poses_at_steps = True  # urdf --at SWEEP:STEP
+    refuses = ("fixed points", "one rack target")
+
+    @property
+    def results_class(self) -> type:
+        return Results
+
+    @property
+    def needs(self) -> str:
+        """What its sweep's targets must be, as its count's error says."""
+        if self.actuators:
+            return (
+                "bump and steer: a wheel target and one trackrod_inboard target along y; "
+                "a wheel target alone holds the rack at design"
+            )
+        if self.geometry.steering_points:
+            return "bump: one wheel target (the fixed toe link leaves no steer)"
+        return "bump: one wheel target (no steering)"
+
+    def undetermined(self, targets: list[Target]) -> str:
+        """The error of targets that do not fix its pose at design."""
+        held = ", ".join(f"{t.point} along {_along(t)}" for t in targets)
+        return (
+            f"{held} do not fix the pose of this mechanism at its design state (the "
+            "targets' rows are dependent: a target along a direction its point cannot "
+            "move in, e.g. the rack along x, or a design sitting at a lock-up)"
+        )
 
     @property
     def corners(self) -> dict[str, Geometry]:
@@ -57,6 +77,10 @@ class Corner(Linkage, Assembly):
     @property
     def name(self) -> str:
         return self.geometry.name
+
+    @property
+    def sha256(self) -> str:
+        return self.geometry.sha256
 
     def __repr__(self) -> str:
         def parts():
@@ -94,51 +118,6 @@ class Corner(Linkage, Assembly):
             value = columns[m.name][0][0]
             warn_outside(f"{self.geometry.source}: design {m.name}", value, *m.plausible, m.unit)
 
-    def drive_order(self, targets: list[Target]) -> list[int] | None:
-        """Which target is which driver, when the targets are exactly the drivers
-        (wheel-centre z, then the rack along y, in any order); None otherwise."""
-        if TOE_LINK in self.drivers:  # a driver no sweep target is: motion() solves it
-            return None
-        targets = self.held_targets(targets)
-        wanted = [Target("wheel_center", "z").key]
-        if self.geometry.steering == "rack":
-            wanted.append(Target(self.geometry.steering_points[0], "y").key)
-        have = [t.key for t in targets]
-        if len(have) != len(wanted) or set(have) != set(wanted):
-            return None
-        return [have.index(w) for w in wanted]
-
-    def solver_for(self, targets: list[Target], source: str = "<targets>") -> NewtonSolver:
-        """Check targets against this mechanism and build the Newton solver (the rack
-        held at design where a rack corner's sweep gives no rack target)."""
-        targets = self.held_targets(targets)
-        self._check_targets(targets, source)
-        rows = [PointTarget(self.points[t.point], t.unit_direction) for t in targets]
-        solver = NewtonSolver(self.kin, self.closures, rows, self.branches)
-        # The targets must fix the pose: with the closures, a square Jacobian of full rank.
-        solver.evaluate(self.q_design)
-        if np.linalg.cond(solver.jacobian) > 1e10:
-            held = ", ".join(f"{t.point} along {_along(t)}" for t in targets)
-            raise InputError(
-                source,
-                "targets",
-                f"{held} do not fix the pose of this mechanism at its design state (the "
-                "targets' rows are dependent: a target along a direction its point cannot "
-                "move in, e.g. the rack along x, or a design sitting at a lock-up)",
-            )
-        return solver
-
-    def target_values(self, targets: list[Target]) -> np.ndarray:
-        """Absolute target values (m), one row per step, one column per held target
-        (``held_targets``)."""
-        cols = []
-        for t in self.held_targets(targets):
-            values = np.asarray(t.values, dtype=float) * 1e-3
-            if t.mode == "relative":
-                values = values + self.design_positions[t.point] @ t.unit_direction
-            cols.append(values)
-        return np.column_stack(cols)
-
     def solve_pose(self, targets: list[Target], q_start: np.ndarray | None = None) -> Pose:
         """Solve one pose: each target holds a single value (mm)."""
         solver = self.solver_for(targets)
@@ -149,107 +128,6 @@ class Corner(Linkage, Assembly):
         start = self.target_values([t.at_design() for t in targets])[0]
         solution = solver.solve(q0, start, values[0])
         return self._pose(solution)
-
-    def run_sweep(self, sweep: Sweep | str | dict, progress=None) -> Results:
-        """Solve every step of a sweep and compute every column (metrics, derivatives).
-
-        >>> results = corner.run_sweep("examples/bump_steer.yaml")  # a path, dict or Sweep
-        >>> results["camber"]  # deg, a numpy array, one value per step
-        >>> results.to_pandas()  # the same columns as a DataFrame, as the CSV has them
-        >>> results.to_csv("results.csv"); results.plot("report.png")
-
-        ``progress(i, n)``: called after each step."""
-        if not isinstance(sweep, Sweep):
-            sweep = load_sweep(sweep)
-        return self.solve_sweep(sweep, progress)[1]
-
-    def solve_sweep(self, sweep: Sweep, progress=None) -> tuple[list[Solution], Results]:
-        """Every step solved: the solutions and their results (run_sweep's)."""
-        tangents = []
-        solutions = self.solve_steps(sweep, progress, tangents=tangents)
-        return solutions, Results.from_solutions(self, solutions, sweep, tangents or None)
-
-    def check_sweep(self, sweep: Sweep) -> None:
-        """The sweep's target errors, before any work (solver_for's)."""
-        self.solver_for(sweep.targets, sweep.source)
-
-    def run_sweep_chunks(self, sweep: Sweep | str | dict, rows: int = CHUNK, progress=None):
-        """The sweep's Results ``rows`` steps at a time (each chunk's ``step_index``
-        counts from the sweep's first step): the same values as run_sweep, in memory
-        that does not grow with the sweep's length — for writing as it goes.
-
-        Each chunk starts from the last converged pose before it (the design state for
-        the first), as the sweep's march does.
-
-        >>> for part in corner.run_sweep_chunks("examples/bump_steer.yaml", rows=20):
-        ...     part.to_pandas()  # a DataFrame of these 20 rows (the last may be shorter)
-        """
-        if not isinstance(sweep, Sweep):
-            sweep = load_sweep(sweep)
-        self.solver_for(sweep.targets, sweep.source)  # the targets' errors before any work
-        q = None
-        for start in range(0, sweep.steps, rows):
-            part = Sweep(
-                [replace(t, values=t.values[start : start + rows]) for t in sweep.targets],
-                sweep.source,
-                sweep.sha256,
-                sweep.data,
-            )
-            done = None
-            if progress is not None:
-                done = lambda i, n, start=start: progress(start + i, sweep.steps)  # noqa: E731
-            tangents = []
-            solutions = self.solve_steps(part, done, q_start=q, tangents=tangents)
-            results = Results.from_solutions(self, solutions, part, tangents or None)
-            results.columns["step_index"] = results.columns["step_index"] + start
-            converged = [s for s in solutions if s.converged]
-            if converged:
-                q = converged[-1].q
-            del solutions, tangents, converged
-            yield results
-            del results  # before the next chunk is solved: one chunk held at a time
-
-    def solve_steps(
-        self,
-        sweep: Sweep,
-        progress=None,
-        q_start: np.ndarray | None = None,
-        step_times=None,
-        tangents: list | None = None,
-    ) -> list[Solution]:
-        """Solve the sweep's steps in order, each from a prediction off the last ones.
-
-        ``q_start``: a solved configuration of the sweep's first step's predecessor
-        (default: the design state); ``step_times``: a list that receives each
-        step's solve time in seconds (for benchmarks); ``tangents``: a list that
-        receives the exact drivers' tangent of each step, when the sweep's
-        targets are the drivers (wheel-centre z, rack) — it stays empty otherwise.
-        """
-        check_held(sweep)
-        solver = self.solver_for(sweep.targets, sweep.source)
-        order = self.drive_order(sweep.targets) if tangents is not None else None
-        solver.keep_jacobian = order is not None
-        values = self.target_values(sweep.targets)
-        q = self.q_design if q_start is None else q_start
-        previous = self.target_values([t.at_design() for t in sweep.targets])[0]
-        if q_start is not None:
-            previous = self._values_at(solver, q_start)
-        return march(
-            solver,
-            values,
-            q,
-            previous,
-            progress=progress,
-            step_times=step_times,
-            tangents=tangents if order is not None else None,
-            keep=None if order is None else lambda tangent: tangent[..., order],
-            bulk=True,
-        )
-
-    def _values_at(self, solver: NewtonSolver, q: np.ndarray) -> np.ndarray:
-        """The target values that q satisfies."""
-        self.kin.update_positions(q)
-        return np.array([t.point.position(self.kin) @ t.direction for t in solver.targets])
 
     def _pose(self, solution: Solution) -> Pose:
         points = self.motion([solution.q])
@@ -265,60 +143,10 @@ class Corner(Linkage, Assembly):
             derivatives={k: float(v[0]) for k, (v, _) in columns.items() if "deriv_" in k},
         )
 
-    def _check_targets(self, targets: list[Target], source: str) -> None:
-        known = ", ".join(self.point_names)
-        for i, t in enumerate(targets):
-            if t.quantity is not None:
-                raise InputError(
-                    source,
-                    f"targets[{i}].quantity",
-                    f"{t.quantity} is an axle's quantity: this geometry is one corner",
-                )
-            if t.side is not None:
-                raise InputError(
-                    source,
-                    f"targets[{i}].side",
-                    "a side is for an axle's targets: this geometry is one corner",
-                )
-            key = f"targets[{i}].point"
-            if t.point not in self.points:
-                raise InputError(source, key, f"unknown point {t.point!r} (points: {known})")
-            if self.body_of(t.point) == "chassis":
-                raise InputError(
-                    source, key, f"{t.point} is fixed to the chassis: a target on it cannot move"
-                )
-        moving_rack = [i for i, t in enumerate(targets) if self.body_of(t.point) == "rack"]
-        if len(targets) != self.mobility:
-            if self.actuators:
-                what = (
-                    "bump and steer: a wheel target and one trackrod_inboard target along y; "
-                    "a wheel target alone holds the rack at design"
-                )
-            elif self.geometry.steering_points:
-                what = "bump: one wheel target (the fixed toe link leaves no steer)"
-            else:
-                what = "bump: one wheel target (no steering)"
-            raise InputError(
-                source,
-                "targets",
-                f"{len(targets)} target(s) given, this corner needs exactly "
-                f"{self.mobility} ({what})",
-            )
-        if self.actuators and len(moving_rack) != 1:
-            raise InputError(
-                source,
-                "targets",
-                "a rack-steered corner needs exactly one target on the rack "
-                f"(trackrod_inboard along y), got {len(moving_rack)}",
-            )
-
     # Assembly surface for loads, viz and drawing
     @property
     def spring_senses(self) -> dict[str, float]:
         return {"": self.spring_sense}
-
-    def sweep_results(self, sweep: Sweep, solutions: list[Solution]) -> Results:
-        return Results.from_solutions(self, solutions, sweep)
 
     def with_corners(self, corners: dict[str, Geometry]) -> Corner:
         return Corner(corners[""], warn=False)
@@ -351,9 +179,6 @@ class Corner(Linkage, Assembly):
 
     # Assembly surface for validate
     noun = "corner"
-
-    def held_sweep(self, sweep: Sweep) -> Sweep:
-        return replace(sweep, targets=self.held_targets(sweep.targets))
 
     def motion_points(self, by_label: dict) -> dict:
         return {name: p[""] for name, p in by_label.items()}
@@ -402,29 +227,9 @@ class Results:
     def from_solutions(
         cls, corner: Corner, solutions: list[Solution], sweep: Sweep, tangents=None, only=None
     ) -> Results:
-        """``only``: the set of columns wanted (a study's summary), else every column."""
-        columns, units = cls.solver_columns(solutions)
-        # A step that did not converge has no trustworthy pose: its cells stay empty.
-        points = corner.motion([s.q if s.converged else None for s in solutions], tangents)
-        design = {k: v[None] for k, v in corner.design_positions.items()}
-        metrics = metric_columns(corner.geometry, points, design, corner.spring_sense, only)
-        for name, (values, column_unit) in metrics.items():
-            columns[name], units[name] = values, column_unit
-        qs = [s.q if s.converged else None for s in solutions]
-        if corner.geometry.rated_spring:
-            from .rates import RATE_COLUMNS, rate_columns  # a rated spring's columns
-
-            if only is None or RATE_COLUMNS & set(only):
-                for name, (values, column_unit) in rate_columns(corner, qs).items():
-                    columns[name], units[name] = values, column_unit
-        positions = {name: p.val for name, p in points.items()}
-        for name, (values, column_unit) in point_columns(corner.point_names, positions).items():
-            if only is None or name in only:
-                columns[name], units[name] = values, column_unit
-        geometry = (corner.geometry.source, corner.geometry.sha256)
-        meta = cls.solver_meta(solutions, geometry, sweep, corner)
-        meta["notes"] = corner.sweep_notes(sweep.targets)
-        return cls(columns, units, meta)
+        """``only``: the set of columns wanted (a study's summary), else every column
+        (``corner.sweep_results``, assembly.py)."""
+        return corner.sweep_results(sweep, solutions, tangents, only)
 
     @staticmethod
     def solver_columns(solutions: list[Solution]) -> tuple[dict, dict]:

@@ -293,6 +293,55 @@ class Composed:
         frames = [n for n in self.output_points if "contact_patch_center" not in n]
         self._frame_motion = FrameMotion(self.kin, frames, self.points, self.design_positions)
 
+    @property
+    def quantities(self) -> dict:
+        """quantity → what reads a quantity target (Assembly's shared elements): none."""
+        return {}
+
+    def readable(self, t) -> bool:
+        """Whether a target names a quantity this model has, or one of its corners."""
+        if t.quantity is not None:
+            return t.quantity in self.quantities
+        return (t.side or "") in self._corners
+
+    def point_of(self, t) -> str:
+        """A point target's point in the model: its corner's label as a prefix."""
+        return (f"{t.side}_" if t.side else "") + t.point
+
+    def held_targets(self, targets: list) -> list:
+        """The targets a sweep's steps hold: its own, and where a rack-steered model's
+        sweep gives every target but the rack's (a bump-only sweep; heave and roll, or a
+        wheel height per side) the rack held at design (rack_displacement 0;
+        ``sweep_notes`` says so). Every other set of targets as given (checked by the
+        subject's ``solver_for``, assembly.py)."""
+        targets = list(targets)
+        if not self.model.existJointName("rack_slide") or len(targets) != self.mobility - 1:
+            return targets
+        for t in targets:
+            if not self.readable(t):
+                return targets  # refused when the targets are read
+            point = None if t.quantity is not None else self.points.get(self.point_of(t))
+            if point is not None and point.body == "rack":
+                return targets
+        from .sweep import Target
+
+        steps = len(targets[0].values) if targets else 1
+        first = next(iter(self._corners))
+        inboard = self._corners[first].steering_points[0]
+        return [*targets, Target(inboard, "y", np.zeros(steps), side=first or None)]
+
+    def sweep_notes(self, targets) -> list[str]:
+        """What the summary says of how the sweep's targets (or a Sweep's) were read."""
+        targets = list(getattr(targets, "targets", targets))
+        return [RACK_HELD] if len(self.held_targets(targets)) > len(targets) else []
+
+    def drive_rows_at_design(self) -> np.ndarray:
+        """The closures' rows and the drivers' (each corner's wheel-centre z, the rack)
+        at design, stacked: of full rank when the drivers fix the pose (the closures'
+        first, as many as ``mobility`` fewer than the joints' freedoms)."""
+        self._drive.evaluate(self.q_design)
+        return self._drive.jacobian
+
     def label_motion(self, qs: list, tangents: list | None = None) -> dict:
         """Every point (prefixed) at each configuration, as a jet.Dual per corner's label:
         its rates along that corner's drivers (``driver_columns``: its hub z, the others
@@ -383,8 +432,7 @@ class Linkage(Composed):
         """The closures must be independent at design, and the wheel must move in bump:
         otherwise the file describes no suspension (one clear error naming the points of
         the closures or joints concerned, not a singular solve)."""
-        self._drive.evaluate(self.q_design)
-        rows = self._drive.jacobian
+        rows = self.drive_rows_at_design()
         n = len(rows) - len(self._drive.targets)
         if n:
             u, s, _ = np.linalg.svd(rows[:n])
@@ -454,27 +502,6 @@ class Linkage(Composed):
         configuration (a step that did not converge) gives NaN.
         """
         return {name: by_label[""] for name, by_label in self.label_motion(qs, tangents).items()}
-
-    def held_targets(self, targets: list) -> list:
-        """The targets a sweep's steps hold: its own, and on a rack-steered corner whose
-        sweep gives every target but the rack's (a bump-only sweep) the rack held at
-        design (rack_displacement 0; ``sweep_notes`` says so). Every other set of targets
-        as given (checked by ``solver_for``)."""
-        targets = list(targets)
-        if not self.actuators or len(targets) != self.mobility - 1:
-            return targets
-        if any(t.point in self.points and self.body_of(t.point) == "rack" for t in targets):
-            return targets
-        if any(t.quantity is not None or t.side is not None for t in targets):
-            return targets  # an axle's targets: refused by _check_targets
-        steps = len(targets[0].values) if targets else 1
-        from .sweep import Target
-
-        return [*targets, Target(self.geometry.steering_points[0], "y", np.zeros(steps))]
-
-    def sweep_notes(self, targets: list) -> list[str]:
-        """What the summary says of how the sweep's targets were read."""
-        return [RACK_HELD] if len(self.held_targets(targets)) > len(targets) else []
 
     def body_of(self, point: str) -> str:
         return self.points[point].body

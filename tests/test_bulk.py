@@ -8,6 +8,7 @@ from conftest import EXAMPLES, example, torsion_bar
 from pointwise import PointwiseCorner
 
 import pin_susp
+import pin_susp.assembly
 import pin_susp.corner
 from pin_susp import bulk
 from pin_susp import march as marching
@@ -42,9 +43,11 @@ def long_sweep(corner, steps: int = 401, bump=(-40.0, 60.0), rack=(-10.0, 10.0),
 
 
 def step_by_step(monkeypatch):
-    """Make Corner.solve_steps march every step (the reference)."""
+    """Make a subject's solve_steps (assembly.py) march every step (the reference)."""
     march = marching.march
-    monkeypatch.setattr(pin_susp.corner, "march", lambda *a, **k: march(*a, **{**k, "bulk": False}))
+    monkeypatch.setattr(
+        pin_susp.assembly, "march", lambda *a, **k: march(*a, **{**k, "bulk": False})
+    )
 
 
 @pytest.mark.parametrize("name", CORNERS)
@@ -120,7 +123,7 @@ def test_solved_at_once_rather_than_step_by_step(monkeypatch):
         return march(solver_, values, *args, **kwargs)
 
     monkeypatch.setattr(marching, "march", counting)
-    monkeypatch.setattr(pin_susp.corner, "march", counting)
+    monkeypatch.setattr(pin_susp.assembly, "march", counting)
     solutions = corner.solve_steps(sweep)
     assert all(s.converged for s in solutions)
     assert seen[0] == 1001 and max(seen[1:]) <= 2 * bulk.COARSE_STEPS
@@ -347,7 +350,9 @@ def axle_step_by_step(monkeypatch):
     import pin_susp.axle
 
     march = marching.march
-    monkeypatch.setattr(pin_susp.axle, "march", lambda *a, **k: march(*a, **{**k, "bulk": False}))
+    monkeypatch.setattr(
+        pin_susp.assembly, "march", lambda *a, **k: march(*a, **{**k, "bulk": False})
+    )
     monkeypatch.setattr(pin_susp.axle, "MIN_STEPS", 10**9)
 
 
@@ -372,7 +377,7 @@ def test_an_axle_long_sweep_solved_at_once_equals_the_step_by_step_march(kind, m
         return march(solver_, values, *args, **kwargs)
 
     monkeypatch.setattr(marching, "march", counting)
-    monkeypatch.setattr(pin_susp.axle, "march", counting)
+    monkeypatch.setattr(pin_susp.assembly, "march", counting)
     solutions = solve_axle_sweep(model, sweep)
     assert seen[0] == 401 and len(seen) == 2 and seen[1] <= 2 * bulk.COARSE_STEPS
     assert all(s.converged for s in solutions)

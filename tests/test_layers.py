@@ -430,7 +430,6 @@ def test_the_readme_module_table_lists_every_module():
 LONG = {
     "metrics.py": 689,  # the corner metrics, their registry, instant centres, anti geometry
     "geometry.py": 707,  # the Geometry data, the geometry file's reader, wheel formulas
-    "axle.py": 669,  # the axle's model, its sweep and its columns
 }
 MAX_LINES = 600
 
@@ -453,7 +452,10 @@ LAYERS = (
     ("metrics", ("metrics",)),  # the metric functions of points, their registry
     ("solve", ("solver", "bulk", "march", "urdf", "linkage", "shim", "as_set")),
     ("columns", ("rates",)),  # a rated spring's columns, from the solve's rates
-    ("subjects", ("elements", "assembly", "corner", "axle_file", "axle", "subject")),
+    (
+        "subjects",
+        ("elements", "analyses_surface", "assembly", "corner", "axle_file", "axle", "subject"),
+    ),
     (
         "analyses",
         ("setup", "loads", "load_case", "statics", "sensitivity_model", "sensitivity", "pointwise"),

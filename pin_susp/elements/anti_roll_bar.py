@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import InputError
 from ..mechanisms import BALL, ROD, axis_foot, pivot
 from ..tree import Body, Closure, Joint, Visual
 from ..vectors import unit
@@ -31,6 +32,18 @@ class AntiRollBar:
         self.kind = spec.anti_roll if spec else "none"
         self.rigid = bool(spec) and spec.anti_roll_rigid
         self.center = spec.center if spec else {}
+
+    def check_targets(self, targets, source: str) -> None:
+        """A rigid bar locks the corners together: a roll target refused."""
+        for i, t in enumerate(targets):
+            if self.rigid and t.quantity == "roll":
+                raise InputError(
+                    source,
+                    f"targets[{i}]",
+                    "roll is fixed by the rigid anti-roll bar (axle_config.anti_roll.stiffness: "
+                    "rigid): the axle only heaves, so a roll target is unreachable or redundant; "
+                    "give heave (or one wheel height) and the rack",
+                )
 
     def add_to(self, bodies, points, closures, visuals, materials) -> None:
         """The bar's material and centre points (its axis or pivot), its bodies and

@@ -15,6 +15,9 @@ class HeaveLink:
         self.kind = axle.heave_link
         self.side_points = axle.side_points
 
+    def check_targets(self, targets, source: str) -> None:
+        """Nothing: the link only measures."""
+
     def add_to(self, bodies, points, closures, visuals, materials) -> None:
         """Each end on its side's rocker (no body, no closure: it only measures)."""
         if self.kind == "none":

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 JOINT = "rack_slide"
+INBOARD = "trackrod_inboard"  # each rack-steered corner's point the rack carries
 POINT = "left_trackrod_inboard"  # where the composed rack is read: the first corner's end
 
 
