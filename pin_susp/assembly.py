@@ -126,6 +126,16 @@ class Assembly:
         """The results (every column) of a sweep's solved steps."""
         raise NotImplementedError
 
+    def sweep_and_design(self, sweep, only=None) -> tuple[object, dict]:
+        """A sweep's results and its design state's columns (name → a one-value array),
+        each solved as ``pin-susp sweep`` solves it (the design: every target at its
+        design value); ``only``: the columns wanted (a subject may give every one): a
+        study's variant."""
+        from .sweep import Sweep
+
+        design = Sweep([t.at_design() for t in sweep.targets], sweep.source, sweep.sha256)
+        return self.solve_sweep(sweep)[1], self.solve_sweep(design)[1].columns
+
     def with_corners(self, corners: dict):
         """The same subject on other corners' Geometries, by label (its shared elements
         kept; each corner set up as its Geometry says): the drawings' and the 3D view's

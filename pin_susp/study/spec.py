@@ -226,7 +226,7 @@ class _Design:
 
     def __init__(self, geometry: dict, geometry_path: str, sweep_path: str, axle: bool):
         # errors name the files, as `pin-susp sweep` would
-        subject = build(geometry, geometry_path, axle)
+        subject = build(geometry, geometry_path)
         from ..sweep import load_sweep
 
         self.sweep = load_sweep(sweep_path)
