@@ -136,6 +136,12 @@ class Assembly:
         design = Sweep([t.at_design() for t in sweep.targets], sweep.source, sweep.sha256)
         return self.solve_sweep(sweep)[1], self.solve_sweep(design)[1].columns
 
+    def sensitivities_hold(self, sweep) -> bool:
+        """Whether its hardpoint sensitivities at a sweep's steps hold what the sweep
+        holds: a corner's hold the sweep's own targets (an axle's, each wheel centre's
+        height and the rack alone)."""
+        return True
+
     def with_corners(self, corners: dict):
         """The same subject on other corners' Geometries, by label (its shared elements
         kept; each corner set up as its Geometry says): the drawings' and the 3D view's

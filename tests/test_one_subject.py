@@ -41,7 +41,6 @@ KIND_WORDS = {"axle", "corner"}
 KIND_TESTS = {
     "cli/commands/draw.py": 1,  # the axle's front view, a twin
     "cli/commands/sensitivity.py": 1,  # the axle's sensitivities, a twin
-    "study/spec.py": 1,  # is_axle_data: the study's axle flag (its variants' data, sensitivities)
 }
 
 
