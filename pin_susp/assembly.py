@@ -136,12 +136,6 @@ class Assembly:
         design = Sweep([t.at_design() for t in sweep.targets], sweep.source, sweep.sha256)
         return self.solve_sweep(sweep)[1], self.solve_sweep(design)[1].columns
 
-    def sensitivities_hold(self, sweep) -> bool:
-        """Whether its hardpoint sensitivities at a sweep's steps hold what the sweep
-        holds: a corner's hold the sweep's own targets (an axle's, each wheel centre's
-        height and the rack alone)."""
-        return True
-
     def with_corners(self, corners: dict):
         """The same subject on other corners' Geometries, by label (its shared elements
         kept; each corner set up as its Geometry says): the drawings' and the 3D view's
@@ -149,6 +143,15 @@ class Assembly:
         raise NotImplementedError
 
     # -- setup and sensitivity (setup.py, sensitivity.py, their commands) ----------
+
+    @classmethod
+    def as_drawn(cls, path, label: str | None = None) -> Assembly:
+        """The subject of a geometry file as the file draws it, for the setup analyses:
+        its labels, its corners as drawn, its source, name and setup answers, but no
+        model built and no setup applied (a setup that cannot be applied is the setup
+        analysis's to report). ``label``: a setup option's (``--side``), refused here
+        where the kind has no such label, before the file is read further."""
+        raise NotImplementedError
 
     @property
     def drawn_corners(self) -> dict:
@@ -188,3 +191,64 @@ class Assembly:
         """The subject's file data with each given corner's setup (label → Geometry)
         written in."""
         raise NotImplementedError
+
+    # -- drawings (drawing.py, pin-susp draw) ----------------------------------------
+
+    # the views its drawing shows: a corner's front and side; the front alone where its
+    # corners stand side by side on one road (an axle's: the roll centre where each
+    # contact patch's line through its instant centre crosses the other)
+    drawing_views: tuple[str, ...] = ("front", "side")
+    # whether it is drawn at a step of its sweep results too (draw --from-results), not
+    # only at its design state
+    drawn_at_steps: bool = False
+
+    # -- hardpoint sensitivities (sensitivity.py, its command) ---------------------
+
+    # the points its shared elements add (an axle's bar and heave link), no corner's
+    # hardpoints: their sensitivities are not computed
+    element_points: frozenset[str] = frozenset()
+    # its own columns of its corners together that its sensitivities give, after each
+    # corner's (an axle's track, roll centre, ...; a corner: none)
+    sensitivity_columns: tuple[str, ...] = ()
+
+    def corner_linkage(self, label: str):
+        """The Linkage of a labelled corner alone, as set: its sensitivities' model."""
+        from .linkage import Linkage
+
+        return Linkage(self.corners[label])
+
+    def sensitivity_sweep(self, sweep) -> tuple[list, object]:
+        """A sweep solved for its sensitivities: its steps' solutions, and the results the
+        failure report reads (the steps without sensitivities): here every column."""
+        return self.solve_sweep(sweep)
+
+    def held_at(self, sweep, step: int) -> list | None:
+        """What its sensitivities hold at a sweep's step: the sweep's targets there (None:
+        each corner's wheel-centre height and rack as solved there)."""
+        from dataclasses import replace
+
+        return [replace(t, values=t.values[step]) for t in sweep.targets]
+
+    def sensitivities_hold(self, sweep) -> bool:
+        """Whether its hardpoint sensitivities at a sweep's steps hold what the sweep
+        holds: a corner's hold the sweep's own targets (``held_at``) (an axle's, each wheel centre's
+        height and the rack alone)."""
+        return True
+
+    def sensitivity_held(self) -> str | None:
+        """What its sensitivities hold, as its table and CSV say it (None: the sweep's
+        targets, or the design's, unsaid)."""
+        return None
+
+    def sensitivity_groups(self, columns: list[str]) -> list[tuple[str, list]]:
+        """The printed table's groups, (heading, columns): each labelled corner's own
+        (a corner's one: every column, no heading); a corner that takes another's setup
+        (a mirrored axle's right side) mirrors it, and is left out."""
+        groups = []
+        for label in self.labels:
+            if self.setup_owner(label) == label:
+                suffix = self.suffix(label)
+                names = [n for n in columns if n.endswith(suffix)]
+                heading = f"the {label} corner (columns suffixed {suffix}):" if label else ""
+                groups.append((heading, names))
+        return groups

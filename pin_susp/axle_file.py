@@ -31,6 +31,21 @@ SIDE_EXTRAS = {
     "rocker_to_rocker": ("heave_link_rocker",),
 }
 CENTER = {"u_bar": ("arb_u_bar_axis_a", "arb_u_bar_axis_b"), "t_bar": ("arb_t_bar_pivot",)}
+# the axle's own sensitivity columns, after each side's (docs/axle.md's names)
+AXLE_COLUMNS = (
+    "body_roll",
+    "camber_to_ground_left",
+    "camber_to_ground_right",
+    "track",
+    "roll_center_y",
+    "roll_center_z",
+    "deriv_camber_wrt_roll_left",
+    "deriv_camber_wrt_roll_right",
+    "deriv_roadwheel_angle_wrt_roll_left",
+    "deriv_roadwheel_angle_wrt_roll_right",
+    "deriv_roll_center_y_wrt_roll",
+    "deriv_roll_center_z_wrt_roll",
+)
 VEHICLE_KEYS = ("cg_position", "wheelbase", "front_brake_bias", "driven_axle")
 AXLE_KEYS = (
     "axle_position",
@@ -391,6 +406,18 @@ class AxleAssembly(Assembly):
     axle: AxleGeometry | None
     static_columns = (("track", "track"), ("roll_center_y", "RC y"), ("roll_center_z", "RC z"))
     noun = "axle"  # validate's messages
+    element_points = frozenset(n for ns in (*SIDE_EXTRAS.values(), *CENTER.values()) for n in ns)
+    sensitivity_columns = AXLE_COLUMNS
+    drawing_views = ("front",)
+    drawn_at_steps = True
+
+    @classmethod
+    def as_drawn(cls, path, label: str | None = None) -> AxleAssembly:
+        drawn = cls.__new__(cls)  # no model built: the setup surface alone
+        drawn.axle = axle = load_axle(path)
+        drawn.source, drawn.name = axle.source, axle.name
+        drawn.corners = {"left": axle.left, "right": axle.right}
+        return drawn
 
     def setup_labels(self, label: str | None = None) -> tuple[str, ...]:
         chosen = super().setup_labels(label)
@@ -419,5 +446,28 @@ class AxleAssembly(Assembly):
 
         return axle_data(self.axle, geometries)
 
+    def sensitivity_sweep(self, sweep) -> tuple[list, object]:
+        from .corner import Results  # the solver's columns alone: what the report reads
+
+        solutions = self.solve_steps(sweep)
+        columns, units = Results.solver_columns(solutions)
+        source = (self.axle.source, self.axle.sha256) if self.axle else ("<geometries>", None)
+        meta = Results.solver_meta(solutions, source, sweep, self)
+        return solutions, Results(columns, units, meta)
+
+    def held_at(self, sweep, step: int) -> None:
+        return None  # each wheel centre's height and the rack: the sides share nothing else
+
     def sensitivities_hold(self, sweep) -> bool:
         return holds_wheels(sweep)
+
+    def sensitivity_held(self) -> str:
+        rack = " and the rack" if self.model.existJointName("rack_slide") else ""
+        return f"each wheel centre's height{rack} held"
+
+    def sensitivity_groups(self, columns: list[str]) -> list[tuple[str, list]]:
+        own = [n for n in columns if n not in self.sensitivity_columns]
+        groups = [("the axle:", self.sensitivity_columns), *super().sensitivity_groups(own)]
+        if self.setup_owner("right") != "right":
+            groups.append(("the right corner's columns mirror the left's (a mirrored axle)", ()))
+        return groups

@@ -340,11 +340,25 @@ class Corner(Linkage, Assembly):
         return Results(columns, both.units, meta), static
 
     # Assembly surface for setup and sensitivity
+    @classmethod
+    def as_drawn(cls, path, label: str | None = None) -> Corner:
+        if label is not None:  # before the file is read: named as typed
+            raise cls._no_sides(path)
+        drawn = cls.__new__(cls)  # no model built: the setup surface alone
+        drawn.geometry = load_geometry(path)
+        return drawn
+
     def setup_labels(self, label: str | None = None) -> tuple[str, ...]:
         if label is not None:
-            problem = f"{self.source} is a corner (--side sets one side of an axle)"
-            raise InputError("--side", "", problem)
+            raise self._no_sides(self.source)
         return self.labels
+
+    def corner_linkage(self, label: str) -> Corner:
+        return self  # its one corner's Linkage: itself
+
+    @staticmethod
+    def _no_sides(source) -> InputError:
+        return InputError("--side", "", f"{source} is a corner (--side sets one side of an axle)")
 
     def setup_data(self, geometries: dict[str, Geometry]) -> dict:
         from .as_set import geometry_data

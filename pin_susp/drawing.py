@@ -1,5 +1,8 @@
 """2D drawings of a corner and an axle, with matplotlib (Agg, no display).
 
+``subject_figure`` draws a subject as its views say: a corner's by
+``drawing_figure``, an axle's by ``axle_drawing_figure``.
+
 ``drawing_figure`` draws the corner in front and side view at its design
 state, with the instant-centre construction of the as-set corner: front view,
 each ball joint to the FVIC (the instant axis ∩ plane x = WC_x) and the line
@@ -45,6 +48,19 @@ from .drawing_labels import label_points  # noqa: E402
 from .errors import InputError  # noqa: E402
 from .geometry import unit, wheel_down  # noqa: E402
 from .plots import ResultsFile  # noqa: E402
+
+
+def subject_figure(subject, labels: bool = False, at=None, caption: str = "design state"):
+    """The drawing of a subject (an Assembly) in its views (``Assembly.drawing_views``):
+    a corner's front and side view at its design state (``drawing_figure``); an axle's
+    front view (``axle_drawing_figure``) at design or, ``at`` = (ResultsFile, step), at
+    a step of its results (``axle_pose``: for a subject ``drawn_at_steps``)."""
+    if "side" in subject.drawing_views:
+        return drawing_figure(subject, labels=labels)
+    q = None
+    if at is not None:
+        q, caption = axle_pose(subject, *at)
+    return axle_drawing_figure(subject, q, labels=labels, caption=caption)
 
 
 def drawing_figure(corner, labels: bool = False):

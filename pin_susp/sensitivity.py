@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .axle_file import AXLE_COLUMNS as AXLE_COLUMNS  # the axle's own, by its old address
 from .errors import InputError
 from .jet import Dual
 from .metrics import METRIC_BY_NAME, PointSet
@@ -22,27 +23,14 @@ def hardpoint_sensitivities(corner, sweep=None, progress=None, with_results: boo
 
     A list of Sensitivity; with ``with_results``, (that list, the sweep's
     Results or None) so that a caller can name the steps that have none.
+    (:func:`subject_sensitivities` of the corner.)
     """
-    from dataclasses import replace
-
     from .sweep import load_sweep
 
-    model = HardpointSensitivity(corner)
-    if sweep is None:
-        states = [model.at(corner.q_design)]
-        return (states, None) if with_results else states
-    if not hasattr(sweep, "targets"):
+    if sweep is not None and not hasattr(sweep, "targets"):
         sweep = load_sweep(sweep)
-    results = corner.run_sweep(sweep)
-    out = []
-    n = len(results)
-    for i in range(n):
-        if results["solver_converged"][i]:
-            targets = [replace(t, values=t.values[i]) for t in sweep.targets]
-            out.append(model.at(results.meta["q"][i], targets, step=i))
-        if progress is not None:
-            progress(i + 1, n)
-    return (out, results) if with_results else out
+    states, results = subject_sensitivities(SubjectSensitivity(corner), sweep, progress)
+    return (states, results) if with_results else states
 
 
 # How much of a change is worth talking about, per unit, for the terminal table.
@@ -109,7 +97,7 @@ def select_points(corner, spec: str = "designer") -> list[str]:
     return wanted
 
 
-# ---------------------------------------------------------------- an axle
+# ---------------------------------------------------------------- a subject
 
 SYMMETRIC_MOVE = (
     "a symmetric move: hardpoint P moves the left P by (dx, dy, dz) and the right P by "
@@ -120,36 +108,21 @@ ONE_SIDED_MOVE = "a one-sided move: left_P and right_P each move alone"
 
 def axle_held(model) -> str:
     """What an axle's sensitivities hold (the note on its table and CSV)."""
-    rack = " and the rack" if model.model.existJointName("rack_slide") else ""
-    return f"each wheel centre's height{rack} held"
+    return model.sensitivity_held()
 
 
-# the axle's own columns, after each side's (docs/axle.md's names)
-AXLE_COLUMNS = (
-    "body_roll",
-    "camber_to_ground_left",
-    "camber_to_ground_right",
-    "track",
-    "roll_center_y",
-    "roll_center_z",
-    "deriv_camber_wrt_roll_left",
-    "deriv_camber_wrt_roll_right",
-    "deriv_roadwheel_angle_wrt_roll_left",
-    "deriv_roadwheel_angle_wrt_roll_right",
-    "deriv_roll_center_y_wrt_roll",
-    "deriv_roll_center_z_wrt_roll",
-)
+class SubjectSensitivity:
+    """d(column)/d(hardpoint coordinate) of a subject (an Assembly), exact.
 
-
-class AxleSensitivity:
-    """d(column)/d(hardpoint coordinate) of an axle (docs/axle.md), exact.
-
-    Each side is its corner's HardpointSensitivity (the as-set corner): with each
-    wheel centre's height and the rack held, the sides share nothing else, so a
-    side's columns move with its own points only. The axle's columns (track, roll
-    centre, body roll, the roll rates) are plain functions of both sides' contact
-    patches, instant centres, wheel heights and rates, run on the sides' nested
-    Duals lifted onto the axle's directions:
+    Each labelled corner is its HardpointSensitivity (the as-set corner's Linkage,
+    ``Assembly.corner_linkage``); a corner's one, unlabelled, gives its columns as they
+    are. An axle's (docs/axle.md): with each wheel centre's height and the rack held,
+    the sides share nothing else, so a side's columns (suffixed ``_left``) move with
+    its own points only. The subject's own columns of its corners together
+    (``Assembly.sensitivity_columns``: an axle's track, roll centre, body roll, the
+    roll rates) are plain functions of both sides' contact patches, instant centres,
+    wheel heights and rates, run on the sides' nested Duals lifted onto the axle's
+    directions:
 
     - symmetric (default): one direction per corner point and axis, the left
       point moved by (dx, dy, dz) and the right one by (dx, −dy, dz);
@@ -162,64 +135,67 @@ class AxleSensitivity:
     """
 
     def __init__(self, model, one_sided: bool = False):
-        from .axle import SIDES
-        from .linkage import Linkage
-
         self.model, self.one_sided = model, one_sided
-        self.sides = {s: HardpointSensitivity(Linkage(model.geometries[s])) for s in SIDES}
+        labels = model.labels
+        self.sides = {s: HardpointSensitivity(model.corner_linkage(s)) for s in labels}
         names = {s: h.hardpoints for s, h in self.sides.items()}
         if one_sided:
-            self.hardpoints = [f"{s}_{n}" for s in SIDES for n in names[s]]
+            self.hardpoints = [model.prefix(s) + n for s in labels for n in names[s]]
         else:
-            self.hardpoints = list(dict.fromkeys(names["left"] + names["right"]))
-        # lift[side] (3 axle points, 3 side points): d/d(axle coordinate) from d/d(side's)
+            self.hardpoints = list(dict.fromkeys(n for s in labels for n in names[s]))
+        # lift[side] (3 subject points, 3 side points): d/d(subject coordinate) from
+        # d/d(side's); None for a corner's one (its coordinates as they are)
         self.lift = {}
-        for s in SIDES:
+        for s in labels:
+            if not s:
+                self.lift[s] = None
+                continue
             flip = np.diag([1.0, -1.0 if s == "right" and not one_sided else 1.0, 1.0])
             lift = np.zeros((3 * len(self.hardpoints), 3 * len(names[s])))
             for j, n in enumerate(names[s]):
-                i = self.hardpoints.index(f"{s}_{n}" if one_sided else n)
+                i = self.hardpoints.index(model.prefix(s) + n if one_sided else n)
                 lift[3 * i : 3 * i + 3, 3 * j : 3 * j + 3] = flip
             self.lift[s] = lift
-        # each side's corner joints in the axle's configuration
-        axle = model.model
+        # each side's corner joints in the subject's configuration
+        whole = model.model
         self.joints = {}
         for s, h in self.sides.items():
             c = h.corner.model
             pairs = [
-                (c.joints[j].idx_q, axle.joints[axle.getJointId(_axle_joint(c.names[j], s))].idx_q)
+                (c.joints[j].idx_q, whole.joints[whole.getJointId(_joint(c.names[j], s))].idx_q)
                 for j in range(1, c.njoints)
             ]
             self.joints[s] = tuple(np.array(x) for x in zip(*pairs, strict=True))
 
     def side_q(self, q: np.ndarray, side: str) -> np.ndarray:
-        """The side's corner configuration within the axle's q."""
-        corner, axle = self.joints[side]
+        """The side's corner configuration within the subject's q."""
+        corner, whole = self.joints[side]
         out = np.empty(self.sides[side].corner.model.nq)
-        out[corner] = q[axle]
+        out[corner] = q[whole]
         return out
 
-    def at(self, q: np.ndarray | None = None, step: int = 0) -> Sensitivity:
-        """At the axle's solved configuration q (default: its design state), each wheel
-        centre's height and the rack held where q has them."""
-        from .axle import SIDES
-
+    def at(self, q: np.ndarray | None = None, step: int = 0, targets=None) -> Sensitivity:
+        """At the subject's solved configuration q (default: its design state), holding
+        ``targets`` (``Assembly.held_at``; default: each wheel centre's height and the
+        rack where q has them)."""
         jets, per_side = {}, {}
         for s, h in self.sides.items():
             qs = h.corner.q_design if q is None else self.side_q(q, s)
-            jets[s] = h.jets(qs)
+            jets[s] = h.jets(qs, targets)
             per_side[s] = h._collect(*jets[s], step)
         n = len(self.hardpoints)
         values, units, metrics = {}, {}, {}
-        for s in SIDES:
-            side = per_side[s]
+        for s, side in per_side.items():
+            lift = self.lift[s]
             for name, v in side.values.items():
-                key = f"{name}_{s}"
-                values[key] = (self.lift[s] @ v.ravel()).reshape(n, 3)
+                key = name + self.model.suffix(s)
+                values[key] = v if lift is None else (lift @ v.ravel()).reshape(n, 3)
                 units[key], metrics[key] = side.units[name], side.metrics[name]
-        with np.errstate(invalid="ignore", divide="ignore"):
-            columns = self._axle_columns(jets)
-        for name in AXLE_COLUMNS:
+        own = self.model.sensitivity_columns
+        if own:
+            with np.errstate(invalid="ignore", divide="ignore"):
+                columns = self._axle_columns(jets)
+        for name in own:
             x, unit_ = columns[name]
             metrics[name] = float(x.val[0])
             values[name] = x.der[:, 0].reshape(n, 3) * 1e-3  # per mm
@@ -284,9 +260,9 @@ class AxleSensitivity:
         return out
 
 
-def _axle_joint(name: str, side: str) -> str:
-    """A corner joint's name in the axle's model (the rack is shared)."""
-    return name if name == "rack_slide" else f"{side}_{name}"
+def _joint(name: str, label: str) -> str:
+    """A corner joint's name in the subject's model (an axle's rack is shared)."""
+    return name if name == "rack_slide" else f"{label}_{name}" if label else name
 
 
 def _value(x) -> Dual:
@@ -299,25 +275,25 @@ def _rate(x) -> Dual:
     return Dual(x.val.der[0], x.der.der[:, 0])
 
 
-def axle_sensitivities(sens: AxleSensitivity, sweep=None, progress=None):
-    """An axle's sensitivities (``AxleSensitivity(model)``) at its design state, or at
-    every converged step of ``sweep`` — each wheel centre's height and the rack held as
-    solved there (a roll or heave target too: the roll angle then moves with the track).
-    (A list of Sensitivity, the sweep's solver columns as AxleResults or None.)"""
-    from .axle import AxleResults, solve_axle_sweep
-
-    model = sens.model
+def subject_sensitivities(sens: SubjectSensitivity, sweep=None, progress=None):
+    """A subject's sensitivities (``SubjectSensitivity(subject)``) at its design state,
+    or at every converged step of ``sweep``, holding there what the subject holds
+    (``Assembly.held_at``: a corner's, the sweep's targets; an axle's, each wheel
+    centre's height and the rack as solved — a roll or heave target too: the roll angle
+    then moves with the track). (A list of Sensitivity, the results the failure report
+    reads, ``Assembly.sensitivity_sweep``, or None.)"""
+    subject = sens.model
     if sweep is None:
         return [sens.at()], None
-    solutions = solve_axle_sweep(model, sweep)
-    columns, units = AxleResults.solver_columns(solutions)
-    source = (model.axle.source, model.axle.sha256) if model.axle else ("<geometries>", None)
-    meta = AxleResults.solver_meta(solutions, source, sweep, model)
-    results = AxleResults(columns, units, meta)
+    solutions, results = subject.sensitivity_sweep(sweep)
     out = []
     for i, solution in enumerate(solutions):
         if solution.converged:
-            out.append(sens.at(solution.q, step=i))
+            out.append(sens.at(solution.q, step=i, targets=subject.held_at(sweep, i)))
         if progress is not None:
             progress(i + 1, len(solutions))
     return out, results
+
+
+AxleSensitivity = SubjectSensitivity  # an axle's, by its old name
+axle_sensitivities = subject_sensitivities  # (sens, sweep, progress), by its old name

@@ -53,6 +53,13 @@ def load_subject(path, warn: bool = True) -> Assembly:
     return Corner(load_geometry(path), warn=warn)
 
 
+def load_drawn(path, label: str | None = None) -> Assembly:
+    """The subject of a geometry file as the file draws it, for the setup analyses
+    (``Assembly.as_drawn``): no model built, no setup applied; ``label``: a setup
+    option's (``--side``), refused first where the kind has no such label."""
+    return subject_class(path).as_drawn(path, label)
+
+
 class SubjectKind:
     """How one kind of subject is built from its geometry file's data, as a study builds
     its design and its variants (docs/studies.md): ``build``, and ``variant_data`` (the

@@ -361,3 +361,41 @@ def test_bad_axle_setup_and_sensitivity_input_gets_one_line(tmp_path, capsys):
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and message in err[0], (argv, err)
         assert not out.exists()
+
+
+def test_a_setup_that_cannot_be_applied_is_reported_by_the_sheet(tmp_path, capsys, monkeypatch):
+    """A file whose own setup cannot be applied (a 900 mm shim stack) gets the sheet's
+    error — its own solve's residual, an axle's side and file key — not the one of a
+    model built first; ``--side`` on a corner names the file as typed, before reading
+    it; on a mirrored axle, the side is refused before the setup is tried."""
+    monkeypatch.chdir(tmp_path)
+    corner = example("camber_shim.yaml")
+    corner["config"]["camber_shim"]["setup_thickness"] = 900.0
+    write(tmp_path, corner, "corner.yaml")
+    write(tmp_path, axle_data({"camber_shim": {**SHIM, "setup_thickness": 900.0}}))
+    (tmp_path / "broken.yaml").write_text("type: double_wishbone\nhardpoints: {}\n")
+    reach = "the shimmed upright does not assemble (residual 29.5 mm): beyond the linkage's reach"
+    mirrored_side = (
+        "--side: axle.yaml is a mirrored axle (no hardpoints.right): its right side takes "
+        "the left's setup, so one setup sets both sides; give the right corner's own points "
+        "(hardpoints.right, with axle_config.right_setup) to set one side alone"
+    )
+    cases = [
+        (["corner.yaml"], f"corner.yaml: config.camber_shim.setup_thickness: {reach}"),
+        (["corner.yaml", "--camber", "-2", "-o", "out.yaml"],
+         f"corner.yaml: config.camber_shim.setup_thickness: {reach}"),
+        (["axle.yaml"],
+         f"axle.yaml: axle_config.left_setup.camber_shim.setup_thickness: left corner: {reach}"),
+        (["axle.yaml", "--camber", "-2", "-o", "out.yaml"],
+         f"axle.yaml: axle_config.left_setup.camber_shim.setup_thickness: left corner: {reach}"),
+        (["axle.yaml", "--side", "right"], mirrored_side),
+        (["./corner.yaml", "--side", "left"],
+         "--side: ./corner.yaml is a corner (--side sets one side of an axle)"),
+        (["./broken.yaml", "--side", "left"],
+         "--side: ./broken.yaml is a corner (--side sets one side of an axle)"),
+    ]  # fmt: skip
+    for argv, message in cases:
+        assert main(["setup", *argv]) == 2, argv
+        captured = capsys.readouterr()
+        assert captured.out == "" and captured.err == f"pin-susp: error: {message}\n", argv
+        assert not (tmp_path / "out.yaml").exists()

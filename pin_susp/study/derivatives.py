@@ -57,27 +57,20 @@ def _pick(s, name: str, columns) -> np.ndarray:
 
 
 def sensitivities(subject, sweep, results) -> tuple:
-    """The exact hardpoint sensitivities at design and at each converged step:
-    (Sensitivity, {step: Sensitivity}), one-sided names (``left_…``) on labelled
-    corners; no steps where the sweep holds other than they hold
-    (``Assembly.sensitivities_hold``)."""
-    from dataclasses import replace
+    """The exact hardpoint sensitivities at design and at each converged step, holding
+    there what the subject holds (``Assembly.held_at``): (Sensitivity, {step:
+    Sensitivity}), one-sided names (``left_…``) on labelled corners; no steps where the
+    sweep holds other than they hold (``Assembly.sensitivities_hold``: an axle's roll or
+    heave sweep)."""
+    from ..sensitivity import SubjectSensitivity
 
-    converged = [i for i in range(len(results)) if results["solver_converged"][i]]
-    if not subject.sensitivities_hold(sweep):  # the steps' would hold other quantities
-        converged = []
-    if subject.blocks:  # labelled corners: each lifted onto the subject's moves
-        from ..sensitivity import AxleSensitivity
-
-        model = AxleSensitivity(subject, one_sided=True)
-        return model.at(), {i: model.at(results.meta["q"][i], step=i) for i in converged}
-    from ..sensitivity import HardpointSensitivity
-
-    model = HardpointSensitivity(subject)
-    at_design, steps = model.at(subject.q_design), {}
-    for i in converged:
-        targets = [replace(t, values=t.values[i]) for t in sweep.targets]
-        steps[i] = model.at(results.meta["q"][i], targets, step=i)
+    model = SubjectSensitivity(subject, one_sided=True)
+    at_design, steps = model.at(), {}
+    if subject.sensitivities_hold(sweep):  # else the steps' would hold other quantities
+        for i in range(len(results)):
+            if results["solver_converged"][i]:
+                held = subject.held_at(sweep, i)
+                steps[i] = model.at(results.meta["q"][i], step=i, targets=held)
     return at_design, steps
 
 

@@ -65,11 +65,9 @@ def _step(args) -> tuple[str, str | None]:
 
 
 def run(args) -> int:
-    from ...corner import Corner
-    from ...drawing import axle_drawing_figure, axle_pose, drawing_figure
-    from ...geometry import load_geometry
+    from ...drawing import subject_figure
     from ...plots import ResultsFile, save_figure
-    from ...subject import is_axle_file, load_subject
+    from ...subject import load_subject, subject_class
 
     check_outputs(args, args.output)
     check_image(args.output)
@@ -78,16 +76,13 @@ def run(args) -> int:
         path, _, step = at.rpartition(":")
         if not path or not re.fullmatch(r"[0-9]{1,9}", step):
             raise PinSuspError(f"{option} {at}: expected RESULTS.csv:STEP, e.g. axle.csv:15")
-    if is_axle_file(args.geometry):
-        model = load_subject(args.geometry)
-        q, caption = None, "design state"
-        if at is not None:
-            q, caption = axle_pose(model, ResultsFile(path), int(step))
-        figure = axle_drawing_figure(model, q, labels=args.labels, caption=caption)
-    elif at is not None:
-        raise PinSuspError(f"{option}: {args.geometry} is a corner, drawn at its design state only")
-    else:
-        figure = drawing_figure(Corner(load_geometry(args.geometry)), labels=args.labels)
+        if not subject_class(args.geometry).drawn_at_steps:  # before the file is read
+            raise PinSuspError(
+                f"{option}: {args.geometry} is a corner, drawn at its design state only"
+            )
+    subject = load_subject(args.geometry)
+    pose = None if at is None else (ResultsFile(path), int(step))
+    figure = subject_figure(subject, labels=args.labels, at=pose)
     save_figure(figure, args.output)
     print(f"wrote {args.output}")
     if option == "--at":

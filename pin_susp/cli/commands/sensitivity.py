@@ -48,90 +48,59 @@ def arguments(parser) -> None:
 
 
 def run(args) -> int:
-    from ...corner import Corner
-    from ...geometry import load_geometry
-    from ...sensitivity import hardpoint_sensitivities, select_points
-    from ...subject import is_axle_file
+    """Each labelled corner's columns (an axle's suffixed _left, _right) and the subject's
+    own of its corners together (an axle's track, roll centre, roll rates); an axle's
+    points moved symmetrically on both sides, or one side alone (--one-sided)."""
+    from ...sensitivity import (
+        ONE_SIDED_MOVE,
+        SYMMETRIC_MOVE,
+        SubjectSensitivity,
+        select_points,
+        subject_sensitivities,
+    )
+    from ...subject import load_subject, subject_class
     from ...sweep import load_sweep
 
     check_outputs(args, args.output)
-    if is_axle_file(args.geometry):
-        return _sensitivity_axle(args)
-    if args.one_sided:
+    # a labelled corner's points move alone; a corner's one, unlabelled, has no other
+    if args.one_sided and not any(subject_class(args.geometry).labels):
         raise PinSuspError("--one-sided: a corner has one side (it moves one side of an axle)")
-    corner = Corner(load_geometry(args.geometry))
-    points = select_points(corner, args.points)
-    sweep = None
-    if args.sweep is not None:
-        sweep = load_sweep(args.sweep)
-        corner.solver_for(sweep.targets, sweep.source)
-    progress = progress_bar(sweep.steps if sweep else 1, args.quiet)
-    states, results = hardpoint_sensitivities(corner, sweep, progress, with_results=True)
-    notes = []
-    if corner.geometry.drawn is not None:
-        notes.append("(with respect to the as-set hardpoints: shim and adjusters applied)")
-    groups = [("", list(states[0].values) if states else [])]
-    return _sensitivity_report(args, corner.geometry, sweep, states, results, points, groups, notes)
-
-
-def _sensitivity_axle(args) -> int:
-    """An axle's: each side's corner columns (_left, _right) and the axle's (track, roll
-    centre, roll rates), for a symmetric move of both sides' points or a one-sided one."""
-    from ...axle import CENTER, SIDE_EXTRAS, SIDES
-
-    side_points = {n for names in SIDE_EXTRAS.values() for n in names}
-    center_points = {n for names in CENTER.values() for n in names}
-    from ...sensitivity import (
-        AXLE_COLUMNS,
-        ONE_SIDED_MOVE,
-        SYMMETRIC_MOVE,
-        AxleSensitivity,
-        axle_held,
-        axle_sensitivities,
-        select_points,
-    )
-    from ...subject import load_subject
-    from ...sweep import load_sweep
-
     model = load_subject(args.geometry)
     if model.anti_roll_rigid:
         raise PinSuspError(
             f"{args.geometry}: sensitivity: not for an axle with a rigid anti-roll bar yet "
             "(each wheel's height is held, which a rigid bar does not allow)"
         )
-    bar = [
+    own = [
         n
         for n in (args.points or "").split(",")
-        if n.strip() in {*side_points, *center_points} or n.strip().startswith(SIDES)
+        if n.strip() in model.element_points or n.strip().startswith(model.blocks)
     ]
-    if bar:
+    if own:
         raise PinSuspError(
-            f"--points: {bar[0].strip()} — the sensitivities of the anti-roll bar's and heave "
+            f"--points: {own[0].strip()} — the sensitivities of the anti-roll bar's and heave "
             "link's points (and of side-prefixed names) are not computed yet: give the "
             "corners' hardpoints (both sides move together; --one-sided for one side)"
         )
-    sens = AxleSensitivity(model, args.one_sided)
-    points = select_points(sens.sides["left"].corner, args.points)
+    sens = SubjectSensitivity(model, args.one_sided)
+    points = select_points(sens.sides[model.labels[0]].corner, args.points)
     if args.one_sided:
-        points = [f"{side}_{p}" for side in SIDES for p in points]
-    sweep = None if args.sweep is None else load_sweep(args.sweep)
+        points = [model.prefix(s) + p for s in model.labels for p in points]
+    sweep = None
+    if args.sweep is not None:
+        sweep = load_sweep(args.sweep)
+        model.check_sweep(sweep)
     progress = progress_bar(sweep.steps if sweep else 1, args.quiet)
-    states, results = axle_sensitivities(sens, sweep, progress)
+    states, results = subject_sensitivities(sens, sweep, progress)
+    held = model.sensitivity_held()
     move = ONE_SIDED_MOVE if args.one_sided else SYMMETRIC_MOVE
-    notes = [f"exact; {axle_held(model)}; {move}"]
-    if any(g.drawn is not None for g in model.geometries.values()):
-        notes.append("(with respect to the as-set hardpoints: shims and adjusters applied)")
-    columns = list(states[0].values) if states else []
-    groups = [("the axle:", AXLE_COLUMNS)]
-    for side in ("left",) if model.axle.mirrored else SIDES:
-        names = [n for n in columns if n.endswith(f"_{side}") and n not in AXLE_COLUMNS]
-        groups.append((f"the {side} corner (columns suffixed _{side}):", names))
-    if model.axle.mirrored:
-        groups.append(("the right corner's columns mirror the left's (a mirrored axle)", ()))
-    head = (f"hardpoint: {move}", axle_held(model))
-    return _sensitivity_report(
-        args, model.axle, sweep, states, results, points, groups, notes, head
-    )
+    notes = [f"exact; {held}; {move}"] if held else []
+    if any(g.drawn is not None for g in model.corners.values()):
+        adjusted = "shims and adjusters" if model.blocks else "shim and adjusters"
+        notes.append(f"(with respect to the as-set hardpoints: {adjusted} applied)")
+    groups = model.sensitivity_groups(list(states[0].values) if states else [])
+    head = (f"hardpoint: {move}", held) if held else ()
+    return _sensitivity_report(args, model, sweep, states, results, points, groups, notes, head)
 
 
 def _sensitivity_report(

@@ -107,7 +107,7 @@ def run(args) -> int:
 
     from ... import setup
     from ...io.atomic import all_or_none
-    from ...subject import load_subject
+    from ...subject import load_drawn
 
     check_outputs(args, args.output, args.csv)
     targets = {
@@ -122,8 +122,9 @@ def run(args) -> int:
     if args.output is not None and not targets:
         raise PinSuspError("-o writes a solved setup: give --camber, --toe or --ride-height-change")
     # each corner's sheet as a corner's (its own shim and adjusters), the subject's own
-    # static columns of its corners together (an axle's), or the inverse solve per corner
-    subject = load_subject(args.geometry, warn=False)
+    # static columns of its corners together (an axle's), or the inverse solve per corner;
+    # the subject as drawn: its setup is the sheet's to apply and to report
+    subject = load_drawn(args.geometry, args.side)
     chosen = subject.setup_labels(args.side)
     drawn = subject.drawn_corners
     link = _link(drawn[subject.labels[0]])
