@@ -101,6 +101,12 @@ class AnalysesSurface:
         each corner's wheel-centre height and rack as solved there)."""
         return [replace(t, values=t.values[step]) for t in sweep.targets]
 
+    def sensitivities_hold(self, sweep) -> bool:
+        """Whether its hardpoint sensitivities at a sweep's steps hold what the sweep
+        holds: a corner's hold the sweep's own targets (``held_at``) (an axle's, each
+        wheel centre's height and the rack alone)."""
+        return True
+
     def sensitivity_held(self) -> str | None:
         """What its sensitivities hold, as its table and CSV say it (None: the sweep's
         targets, or the design's, unsaid)."""
@@ -118,3 +124,15 @@ class AnalysesSurface:
                 heading = f"the {label} corner (columns suffixed {suffix}):" if label else ""
                 groups.append((heading, names))
         return groups
+
+    # -- studies (study/) -----------------------------------------------------------
+
+    def sweep_and_design(self, sweep, only=None) -> tuple[object, dict]:
+        """A sweep's results and its design state's columns (name → a one-value array),
+        each solved as ``pin-susp sweep`` solves it (the design: every target at its
+        design value); ``only``: the columns wanted (a subject may give every one): a
+        study's variant."""
+        from .sweep import Sweep
+
+        design = Sweep([t.at_design() for t in sweep.targets], sweep.source, sweep.sha256)
+        return self.solve_sweep(sweep)[1], self.solve_sweep(design)[1].columns

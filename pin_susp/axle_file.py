@@ -382,6 +382,21 @@ def mirror_corner(corner: dict) -> dict:
 
 
 # Assembly surface for setup and sensitivity (AxleModel's; kept out of axle.py, at its cap)
+def holds_wheels(sweep) -> bool:
+    """Whether an axle's sweep holds what its sensitivities hold: each wheel centre's
+    height and the rack (its roll and heave targets hold other quantities)."""
+    keys = set()
+    for t in sweep.targets:
+        if t.quantity is not None:
+            return False
+        d = tuple(t.unit_direction.tolist())
+        if (t.point, d) == ("wheel_center", (0.0, 0.0, 1.0)):
+            keys.add(t.side)
+        elif t.point != "trackrod_inboard":
+            return False
+    return keys == set(SIDES)
+
+
 class AxleAssembly(Assembly):
     """An axle's answers to what takes an Assembly (AxleModel's, from its file
     ``self.axle``, an AxleGeometry): its own static columns of both sides together, the
@@ -442,6 +457,9 @@ class AxleAssembly(Assembly):
 
     def held_at(self, sweep, step: int) -> None:
         return None  # each wheel centre's height and the rack: the sides share nothing else
+
+    def sensitivities_hold(self, sweep) -> bool:
+        return holds_wheels(sweep)
 
     def sensitivity_held(self) -> str:
         rack = " and the rack" if self.model.existJointName("rack_slide") else ""

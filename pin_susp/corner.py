@@ -151,6 +151,22 @@ class Corner(Assembly, Linkage):
     def with_corners(self, corners: dict[str, Geometry]) -> Corner:
         return Corner(corners[""], warn=False)
 
+    # Assembly surface for study
+    def sweep_and_design(self, sweep: Sweep, only=None) -> tuple[Results, dict]:
+        # one pass of the columns over the design state and the steps: the steps solved
+        # as run_sweep solves them, the design row column-wise the same
+        tangents = []
+        solutions = self.solve_steps(sweep, tangents=tangents)
+        design = Solution(self.q_design.copy(), True, 0, 0.0)
+        both = Results.from_solutions(
+            self, [design, *solutions], sweep, [None, *tangents] if tangents else None, only
+        )
+        columns = {k: v[1:] for k, v in both.columns.items()}
+        columns["step_index"] = np.arange(len(solutions))
+        meta = dict(both.meta, q=both.meta["q"][1:], why=both.meta["why"][1:])
+        static = {k: v[:1] for k, v in both.columns.items()}
+        return Results(columns, both.units, meta), static
+
     # Assembly surface for setup and sensitivity
     @classmethod
     def as_drawn(cls, path, label: str | None = None) -> Corner:

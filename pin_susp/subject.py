@@ -3,10 +3,13 @@ file, or an axle's (``scope: axle``, docs/axle.md), and builds it.
 
 :func:`load_subject` returns a :class:`~pin_susp.corner.Corner` or an
 :class:`~pin_susp.axle.AxleModel`, both an :class:`~pin_susp.assembly.Assembly`:
-what takes one asks the Assembly's surface, not its kind.
+what takes one asks the Assembly's surface, not its kind. :func:`kind_of` gives how a
+subject is built from its file's data, as a study builds its design and its variants.
 """
 
 from __future__ import annotations
+
+import copy
 
 from .assembly import Assembly
 
@@ -55,3 +58,54 @@ def load_drawn(path, label: str | None = None) -> Assembly:
     (``Assembly.as_drawn``): no model built, no setup applied; ``label``: a setup
     option's (``--side``), refused first where the kind has no such label."""
     return subject_class(path).as_drawn(path, label)
+
+
+class SubjectKind:
+    """How one kind of subject is built from its geometry file's data, as a study builds
+    its design and its variants (docs/studies.md): ``build``, and ``variant_data`` (the
+    data a variant's hardpoints are moved in)."""
+
+    def build(self, data: dict, source: str, variant: bool = False) -> Assembly:
+        """The subject of a geometry file's data (errors name ``source``). A
+        ``variant``'s goes without the plausibility warnings (the design's were shown)
+        and, a corner's, without the URDF's shapes (never drawn)."""
+        raise NotImplementedError
+
+    def variant_data(self, data: dict) -> dict:
+        """A copy of the data in which each labelled corner's hardpoints are its own to
+        move (``data["hardpoints"][label]``; a corner's one, unlabelled, at
+        ``data["hardpoints"]``)."""
+        return copy.deepcopy(data)
+
+
+class _CornerKind(SubjectKind):
+    def build(self, data: dict, source: str, variant: bool = False) -> Assembly:
+        from .corner import Corner
+        from .geometry import parse_geometry, warn_dead_centres
+        from .yamlio import Reader
+
+        geometry = parse_geometry(data, Reader("<dict>"), None)
+        if not variant:  # a link near dead centre, as every command says
+            warn_dead_centres(geometry, source)
+        return Corner(geometry, warn=not variant, visuals=not variant)
+
+
+class _AxleKind(SubjectKind):
+    def build(self, data: dict, source: str, variant: bool = False) -> Assembly:
+        from .axle import AxleModel, load_axle
+
+        return AxleModel(load_axle(data, None if variant else source))
+
+    def variant_data(self, data: dict) -> dict:
+        out = super().variant_data(data)
+        points = out["hardpoints"]
+        if "right" not in points or points["right"] is None:  # mirrored: made explicit
+            from .axle_file import mirror_corner
+
+            points["right"] = mirror_corner({"hardpoints": points["left"]})["hardpoints"]
+        return out
+
+
+def kind_of(data: dict) -> SubjectKind:
+    """The kind of subject a geometry file's data, as read, holds (its ``scope``)."""
+    return _AxleKind() if is_axle_data(data) else _CornerKind()

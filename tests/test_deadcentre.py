@@ -126,7 +126,7 @@ def test_study_warns_of_the_dead_centre_of_its_design(tmp_path):
         for variant in (False,) if axle else (False, True):
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always", PlausibilityWarning)
-                build(data, "study.yaml", axle, variant=variant)
+                build(data, "study.yaml", variant=variant)
             said = [str(w.message) for w in caught if "from dead centre" in str(w.message)]
             if variant:
                 assert not said

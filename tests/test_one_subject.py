@@ -38,9 +38,7 @@ ONE_KIND_ATTRIBUTES = {"geometries", "geometry", "axle"}
 KIND_WORDS = {"axle", "corner"}
 
 # Today's places, by file (below pin_susp/): a ratchet that only goes down.
-KIND_TESTS = {
-    "study/spec.py": 1,  # is_axle_data: the study's axle flag (its variants' data, sensitivities)
-}
+KIND_TESTS: dict[str, int] = {}
 
 
 def _names(node: ast.AST) -> set[str]:
@@ -228,6 +226,35 @@ def test_validate_sees_one_scope_of_either_subject():
     assert own.keys() == as_motion.keys()
     assert all(np.array_equal(own[n].val, as_motion[n].val) for n in own)
     assert corner.noun == "corner" and axle.noun == "axle"
+
+
+def test_a_study_asks_the_subject_not_its_kind():
+    """What a study asks instead of the kind: the subject of the file's data built
+    (subject.kind_of), the data a variant's points move in (an axle's mirrored right side
+    written out), whether its sensitivities hold a sweep, each step's held targets."""
+    import yaml
+
+    from pin_susp.subject import kind_of
+    from pin_susp.sweep import load_sweep
+
+    examples = PACKAGE.parent / "examples"
+    bump = load_sweep(examples / "bump_steer.yaml")
+    for name, labels in (("double_wishbone.yaml", ("",)), ("axle_front.yaml", ("left", "right"))):
+        data = yaml.safe_load((examples / name).read_text())
+        kind = kind_of(data)
+        subject = kind.build(data, name, variant=True)
+        assert subject.labels == labels
+        moved = kind.variant_data(data)
+        assert moved is not data and moved["hardpoints"] is not data["hardpoints"]
+        if subject.blocks:  # a mirrored axle: its right side's points written out
+            assert "right" not in data["hardpoints"]
+            assert all(moved["hardpoints"][label] for label in subject.blocks)
+        else:
+            assert moved == data
+        if not subject.blocks:
+            assert subject.sensitivities_hold(bump) and subject.held_at(bump, 0)
+        else:
+            assert not subject.sensitivities_hold(bump) and subject.held_at(bump, 0) is None
 
 
 if __name__ == "__main__":

@@ -25,10 +25,11 @@ directory: manifest, part files, resume), ``cluster`` (Dask), ``run`` (a run).
 # ruff: noqa: F401 (the package's names, importable from pin_susp.study as before)
 from __future__ import annotations
 
+from ..axle_file import holds_wheels
 from ..errors import InputError
 from ..study_summary import summary_lines
 from .data import AXES, MISS, Job, Term, Variable, objective_residuals
-from .derivatives import holds_wheels, linear_prediction, objective_jacobian, sensitivities
+from .derivatives import linear_prediction, objective_jacobian, sensitivities
 from .folder import INFORMATION, finished_batches, read_steps, write_geometry
 from .run import Outcome, best_row, curves_of, run_study
 from .spec import (

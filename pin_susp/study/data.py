@@ -72,7 +72,6 @@ class Job:
     geometry_path: str
     sweep: dict
     sweep_path: str
-    axle: bool
     variables: list[Variable]
     summary: list[str]
     terms: list[Term]

@@ -24,7 +24,7 @@ def objective_jacobian(v: Variant, sweep) -> np.ndarray:
     n = sweep.steps
     if v.results is None:
         return np.zeros((len(job.terms) * n, k))
-    at_design, steps = sensitivities(v.subject, sweep, v.results, job.axle)
+    at_design, steps = sensitivities(v.subject, sweep, v.results)
     columns = _columns(at_design.hardpoints, job.variables)
     blocks = []
     for t, w in zip(job.terms, shares(job.terms, n), strict=True):
@@ -56,56 +56,30 @@ def _pick(s, name: str, columns) -> np.ndarray:
     return np.nan_to_num(s.values[name][columns])
 
 
-def sensitivities(subject, sweep, results, axle: bool) -> tuple:
-    """The exact hardpoint sensitivities at design and at each converged step:
-    (Sensitivity, {step: Sensitivity}), one-sided names on an axle."""
-    from dataclasses import replace
+def sensitivities(subject, sweep, results) -> tuple:
+    """The exact hardpoint sensitivities at design and at each converged step, holding
+    there what the subject holds (``Assembly.held_at``): (Sensitivity, {step:
+    Sensitivity}), one-sided names (``left_…``) on labelled corners; no steps where the
+    sweep holds other than they hold (``Assembly.sensitivities_hold``: an axle's roll or
+    heave sweep)."""
+    from ..sensitivity import SubjectSensitivity
 
-    if axle:
-        from ..sensitivity import AxleSensitivity
-
-        model = AxleSensitivity(subject, one_sided=True)
-        at_design = model.at()
-        steps = {}
-        if holds_wheels(sweep):  # else the steps' sensitivities hold other quantities
-            steps = {
-                i: model.at(results.meta["q"][i], step=i)
-                for i in range(len(results))
-                if results["solver_converged"][i]
-            }
-        return at_design, steps
-    from ..sensitivity import HardpointSensitivity
-
-    model = HardpointSensitivity(subject)
-    at_design = model.at(subject.q_design)
-    steps = {}
-    for i in range(len(results)):
-        if results["solver_converged"][i]:
-            targets = [replace(t, values=t.values[i]) for t in sweep.targets]
-            steps[i] = model.at(results.meta["q"][i], targets, step=i)
+    model = SubjectSensitivity(subject, one_sided=True)
+    at_design, steps = model.at(), {}
+    if subject.sensitivities_hold(sweep):  # else the steps' would hold other quantities
+        for i in range(len(results)):
+            if results["solver_converged"][i]:
+                held = subject.held_at(sweep, i)
+                steps[i] = model.at(results.meta["q"][i], step=i, targets=held)
     return at_design, steps
-
-
-def holds_wheels(sweep) -> bool:
-    """Whether an axle's sweep holds what its sensitivities hold: each wheel centre's
-    height and the rack (its roll and heave targets hold other quantities)."""
-    keys = set()
-    for t in sweep.targets:
-        if t.quantity is not None:
-            return False
-        d = tuple(t.unit_direction.tolist())
-        if (t.point, d) == ("wheel_center", (0.0, 0.0, 1.0)):
-            keys.add(t.side)
-        elif t.point != "trackrod_inboard":
-            return False
-    return keys == {"left", "right"}
 
 
 def linear_prediction(study: Study, variants) -> dict[str, np.ndarray] | None:
     """The first-order prediction of each summary column from the exact hardpoint
     sensitivities at design and at every step (no re-solve): name → values per
-    variant, for ``<metric>_static``, ``_min`` and ``_max`` — on an axle the steps'
-    only where its sweep holds what the sensitivities hold (holds_wheels)."""
+    variant, for ``<metric>_static``, ``_min`` and ``_max`` — the steps' only where the
+    sweep holds what the sensitivities hold (``Assembly.sensitivities_hold``: an axle's
+    roll or heave sweep, the static column alone)."""
     from ..sweep import load_sweep
 
     job = study.job()
@@ -113,7 +87,7 @@ def linear_prediction(study: Study, variants) -> dict[str, np.ndarray] | None:
     design = Variant(job, np.zeros(len(study.variables)), sweep, every_column=True)
     if design.results is None or not design.converged:
         return None
-    at_design, steps = sensitivities(design.subject, sweep, design.results, study.axle)
+    at_design, steps = sensitivities(design.subject, sweep, design.results)
     columns = _columns(at_design.hardpoints, study.variables)
     d = variants[study.names].to_numpy(dtype=float)
     out = {}

@@ -233,6 +233,6 @@ def write_geometry(study: Study, deltas, path: str | Path, comment: str) -> None
     """The study's geometry file with the deltas applied (best.yaml), whole or not at all."""
     from ..io.atomic import write_text
 
-    data = variant_data(study.geometry_data, study.variables, deltas, study.axle)
+    data = variant_data(study.geometry_data, study.variables, deltas)
     lines = "".join(f"# {line}\n" for line in comment.splitlines())
     write_text(lines + yaml.safe_dump(data, sort_keys=False), path)

@@ -10,10 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..subject import is_axle_data
 from ..yamlio import Reader, load_yaml, read_once
 from .data import AXES, Job, Term, Variable
-from .derivatives import holds_wheels
 from .variants import at_design, build
 
 KINDS = ("doe", "monte_carlo", "optimise")
@@ -50,7 +48,6 @@ class Study:
     geometry_data: dict
     sweep_path: str
     sweep_data: dict
-    axle: bool
     variables: list[Variable]
     kind: str
     samples: int
@@ -85,7 +82,6 @@ class Study:
             geometry_path=self.geometry_path,
             sweep=self.sweep_data,
             sweep_path=self.sweep_path,
-            axle=self.axle,
             variables=self.variables,
             summary=self.summary,
             terms=self.terms,
@@ -113,8 +109,7 @@ def _load_study(source: str | Path) -> Study:
     sweep_path = str(here / r.text(data["sweep"], "sweep"))
     geometry_data, _, geometry_sha = load_yaml(geometry_path)
     sweep_data, _, sweep_sha = load_yaml(sweep_path)
-    axle = is_axle_data(geometry_data)  # the kind, read where subjects are (subject.py)
-    design = _Design(geometry_data, geometry_path, sweep_path, axle)
+    design = _Design(geometry_data, geometry_path, sweep_path)
     variables = _variables(data, design, r)
     study = Study(
         source=name,
@@ -123,7 +118,6 @@ def _load_study(source: str | Path) -> Study:
         geometry_data=geometry_data,
         sweep_path=sweep_path,
         sweep_data=sweep_data,
-        axle=axle,
         variables=variables,
         kind=kind,
         samples=0,
@@ -178,7 +172,7 @@ def _load_study(source: str | Path) -> Study:
         study.seed = _seed(b, "optimise", r)
         study.max_evaluations = _count(b.get("evaluations", 60), "optimise.evaluations", r)
         study.terms = _terms(b["objective"], design, r)
-        if axle and not holds_wheels(design.sweep):
+        if not design.subject.sensitivities_hold(design.sweep):
             r.fail(
                 "optimise",
                 "on an axle the optimiser's exact Jacobian holds each wheel centre's height "
@@ -224,9 +218,9 @@ def _seed(block: dict, key: str, r: Reader) -> int:
 class _Design:
     """The study's geometry and sweep solved at design: names to check the file against."""
 
-    def __init__(self, geometry: dict, geometry_path: str, sweep_path: str, axle: bool):
+    def __init__(self, geometry: dict, geometry_path: str, sweep_path: str):
         # errors name the files, as `pin-susp sweep` would
-        subject = build(geometry, geometry_path, axle)
+        self.subject = subject = build(geometry, geometry_path)
         from ..sweep import load_sweep
 
         self.sweep = load_sweep(sweep_path)

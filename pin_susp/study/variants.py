@@ -5,7 +5,6 @@ solved through the sweep.
 
 from __future__ import annotations
 
-import copy
 import math
 import warnings
 from typing import TYPE_CHECKING
@@ -13,7 +12,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import InputError, PinSuspError
-from ..yamlio import Reader
+from ..subject import kind_of
 from .data import AXES, Job, Variable, missed, objective_residuals
 
 if TYPE_CHECKING:
@@ -59,15 +58,11 @@ def _sobol(k: int, n: int, seed: int) -> np.ndarray:
         return qmc.Sobol(d=k, scramble=True, seed=seed).random(n)
 
 
-def variant_data(base: dict, variables: list[Variable], deltas, axle: bool) -> dict:
-    """The geometry file's data with each variable's delta (mm) added to its point."""
-    data = copy.deepcopy(base)
-    if axle:
-        points = data["hardpoints"]
-        if "right" not in points or points["right"] is None:  # mirrored: made explicit
-            from ..axle import mirror_corner
-
-            points["right"] = mirror_corner({"hardpoints": points["left"]})["hardpoints"]
+def variant_data(base: dict, variables: list[Variable], deltas, axle=None) -> dict:
+    """The geometry file's data with each variable's delta (mm) added to its point (its
+    corner's by the variable's side: every corner's points its own, an axle's mirrored
+    right side written out; subject.kind_of). ``axle``: unused, the kind is the data's."""
+    data = kind_of(base).variant_data(base)
     for v, d in zip(variables, deltas, strict=True):
         if d == 0.0:
             continue
@@ -81,22 +76,12 @@ def variant_data(base: dict, variables: list[Variable], deltas, axle: bool) -> d
     return data
 
 
-def build(data: dict, source: str, axle: bool, variant: bool = False):
-    """A corner or an axle from a geometry file's data (errors name ``source``). A
-    ``variant``'s corner goes without the plausibility warnings (the design's were
-    shown) and the URDF's shapes (never drawn)."""
+def build(data: dict, source: str, variant: bool = False):
+    """The subject of a geometry file's data, a corner or an axle (subject.kind_of;
+    errors name ``source``). A ``variant``'s goes without the plausibility warnings (the
+    design's were shown) and the URDF's shapes (never drawn)."""
     try:
-        if axle:
-            from ..axle import AxleModel, load_axle
-
-            return AxleModel(load_axle(data, None if variant else source))
-        from ..corner import Corner
-        from ..geometry import parse_geometry, warn_dead_centres
-
-        geometry = parse_geometry(data, Reader("<dict>"), None)
-        if not variant:  # a link near dead centre, as every command says
-            warn_dead_centres(geometry, source)
-        return Corner(geometry, warn=not variant, visuals=not variant)
+        return kind_of(data).build(data, source, variant)
     except InputError as exc:
         if exc.source == "<dict>":
             raise InputError(source, exc.key, exc.problem) from None
@@ -121,13 +106,13 @@ class Variant:
         self.sweep = sweep if sweep is not None else load_sweep(job.sweep)
         self.error = ""
         self.results = self.static = None
-        data = variant_data(job.geometry, job.variables, self.deltas, job.axle)
+        data = variant_data(job.geometry, job.variables, self.deltas)
         try:
             with warnings.catch_warnings():  # a variant's plausibility: the design's was shown
                 warnings.simplefilter("ignore")
-                self.subject = build(data, "variant", job.axle, variant=True)
+                self.subject = build(data, "variant", variant=True)
                 only = None if every_column else job.needs
-                self.results, self.static = _solve(self.subject, self.sweep, job.axle, only)
+                self.results, self.static = self.subject.sweep_and_design(self.sweep, only)
         except PinSuspError as exc:
             self.subject = None
             self.error = str(exc)
@@ -162,31 +147,3 @@ class Variant:
         if self.results is None:
             return missed(self.job.terms, len(self.sweep.targets[0].values))
         return objective_residuals(self.job.terms, self.results, self.static)
-
-
-def _solve(subject, sweep, axle: bool, only=None):
-    """The sweep's results and the design state's columns (a one-step row); ``only``:
-    the columns wanted (a corner's; an axle's has all)."""
-    if axle:
-        from ..axle import axle_results, solve_axle_sweep
-
-        results = axle_results(subject, sweep, solve_axle_sweep(subject, sweep))
-        design = at_design(sweep)
-        static = axle_results(subject, design, solve_axle_sweep(subject, design))
-        return results, static.columns
-    # one pass of the columns over the design state and the steps: the steps are solved
-    # exactly as `pin-susp sweep` solves them, the design row is column-wise the same
-    from ..corner import Results
-    from ..solver import Solution
-
-    tangents = []
-    solutions = subject.solve_steps(sweep, tangents=tangents)
-    design = Solution(subject.q_design.copy(), True, 0, 0.0)
-    both = Results.from_solutions(
-        subject, [design, *solutions], sweep, [None, *tangents] if tangents else None, only
-    )
-    columns = {k: v[1:] for k, v in both.columns.items()}
-    columns["step_index"] = np.arange(len(solutions))
-    meta = dict(both.meta, q=both.meta["q"][1:], why=both.meta["why"][1:])
-    static = {k: v[:1] for k, v in both.columns.items()}
-    return Results(columns, both.units, meta), static
