@@ -44,9 +44,9 @@ import pinocchio as pin
 import yaml
 
 import pin_susp
-from pin_susp.axle import AxleModel, axle_results, load_axle, solve_axle_sweep
-from pin_susp.pointwise import PointwiseCorner
-from pin_susp.sweep import Sweep, Target, load_sweep
+from pin_susp.analyses.pointwise import PointwiseCorner
+from pin_susp.model.sweep import Sweep, Target, load_sweep
+from pin_susp.subjects.axle import AxleModel, axle_results, load_axle, solve_axle_sweep
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 CORNERS = ("double_wishbone.yaml", "camber_shim.yaml", "pushrod_rocker.yaml")
@@ -237,20 +237,20 @@ def long_sweep(rounds: int, steps: int, baseline_steps: int) -> dict:
     issue 17); and the point-based baselines on the first ``baseline_steps`` steps."""
     import tempfile
 
-    import pin_susp.corner
-    from pin_susp import march as marching
+    import pin_susp.subjects.corner
     from pin_susp.io.tables import csv_text, write_parquet
+    from pin_susp.solve import march as marching
 
     corner = pin_susp.Corner(EXAMPLES / "double_wishbone.yaml")
     sweep = issue_sweep(steps)
     march = marching.march
 
     def step_by_step():
-        pin_susp.corner.march = lambda *a, **k: march(*a, **{**k, "bulk": False})
+        pin_susp.subjects.corner.march = lambda *a, **k: march(*a, **{**k, "bulk": False})
         try:
             return corner.run_sweep(sweep)
         finally:
-            pin_susp.corner.march = march
+            pin_susp.subjects.corner.march = march
 
     folder = tempfile.TemporaryDirectory()
     parquet = Path(folder.name) / "out.parquet"
@@ -336,7 +336,7 @@ def cli_marginal(steps: tuple[int, int], rounds: int) -> dict:
 def loads_overhead(rounds: int, steps: int = 101) -> dict:
     """The sweep with every column, and the same with the forces of 3 load cases added
     (pin-susp loads), per step, in alternation."""
-    from pin_susp.loads import load_cases, member_forces
+    from pin_susp.analyses.loads import load_cases, member_forces
 
     corner = pin_susp.Corner(EXAMPLES / "pushrod_rocker.yaml")
     cases = load_cases(EXAMPLES / "loads.yaml")

@@ -34,9 +34,9 @@ from pathlib import Path
 import numpy as np
 
 import pin_susp
-from pin_susp.corner import Results
 from pin_susp.io import tables
-from pin_susp.sweep import Sweep, Target
+from pin_susp.model.sweep import Sweep, Target
+from pin_susp.subjects.corner import Results
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 NEVER = 10**18  # FAST_CELLS that no table reaches: the repr style

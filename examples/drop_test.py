@@ -23,9 +23,9 @@ import numpy as np
 from scipy.optimize import brentq
 
 import pin_susp
-from pin_susp.loads import LoadCase, Statics
-from pin_susp.mjcf import tree_to_mjcf
-from pin_susp.rates import SpringRates
+from pin_susp.analyses.loads import LoadCase, Statics
+from pin_susp.model.mjcf import tree_to_mjcf
+from pin_susp.solve.rates import SpringRates
 
 HERE = Path(__file__).resolve().parent
 SETTLED = 1e-7  # m/s and rad/s: every joint's speed below this is at rest

@@ -35,42 +35,42 @@ from typing import TYPE_CHECKING
 # (PEP 562), so that `import pin_susp` or a CLI command that needs only the
 # sweep does not pay for loads, sensitivities, studies and their libraries.
 _EXPORTS = {
-    "Axle": "axle",
-    "AxleModel": "axle",
-    "AxleResults": "axle",
-    "load_axle": "axle",
-    "Corner": "corner",
-    "Results": "corner",
+    "Axle": "subjects.axle",
+    "AxleModel": "subjects.axle",
+    "AxleResults": "subjects.axle",
+    "load_axle": "subjects.axle",
+    "Corner": "subjects.corner",
+    "Results": "subjects.corner",
     "InputError": "errors",
     "PinSuspError": "errors",
-    "Geometry": "geometry",
-    "load_geometry": "geometry",
-    "LoadCase": "loads",
-    "load_cases": "loads",
-    "member_forces": "loads",
-    "METRICS": "metrics",
-    "Pose": "metrics",
-    "hardpoint_sensitivities": "sensitivity",
-    "SetupModel": "setup",
-    "apply_setup": "as_set",
-    "setup_sheet": "setup",
-    "solve_setup": "setup",
-    "Sweep": "sweep",
-    "Target": "sweep",
-    "load_sweep": "sweep",
+    "Geometry": "model.geometry",
+    "load_geometry": "model.geometry",
+    "LoadCase": "analyses.loads",
+    "load_cases": "analyses.loads",
+    "member_forces": "analyses.loads",
+    "METRICS": "columns.metrics",
+    "Pose": "columns.metrics",
+    "hardpoint_sensitivities": "analyses.sensitivity",
+    "SetupModel": "analyses.setup",
+    "apply_setup": "solve.as_set",
+    "setup_sheet": "analyses.setup",
+    "solve_setup": "analyses.setup",
+    "Sweep": "model.sweep",
+    "Target": "model.sweep",
+    "load_sweep": "model.sweep",
 }
 
 if TYPE_CHECKING:  # for type checkers and IDEs; at run time __getattr__ below
-    from .as_set import apply_setup
-    from .axle import Axle, AxleModel, AxleResults, load_axle
-    from .corner import Corner, Results
+    from .analyses.loads import LoadCase, load_cases, member_forces
+    from .analyses.sensitivity import hardpoint_sensitivities
+    from .analyses.setup import SetupModel, setup_sheet, solve_setup
+    from .columns.metrics import METRICS, Pose
     from .errors import InputError, PinSuspError
-    from .geometry import Geometry, load_geometry
-    from .loads import LoadCase, load_cases, member_forces
-    from .metrics import METRICS, Pose
-    from .sensitivity import hardpoint_sensitivities
-    from .setup import SetupModel, setup_sheet, solve_setup
-    from .sweep import Sweep, Target, load_sweep
+    from .model.geometry import Geometry, load_geometry
+    from .model.sweep import Sweep, Target, load_sweep
+    from .solve.as_set import apply_setup
+    from .subjects.axle import Axle, AxleModel, AxleResults, load_axle
+    from .subjects.corner import Corner, Results
 
 
 def __getattr__(name: str):

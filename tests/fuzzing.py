@@ -1600,7 +1600,7 @@ def _check_setup(case: Case, o: Outcome, context) -> None:
             assert not bad, f"setup sheet cells {bad[:5]}" + context
         else:
             from pin_susp import load_geometry
-            from pin_susp.axle import load_axle
+            from pin_susp.subjects.axle import load_axle
 
             load = load_axle if b"scope: axle" in text else load_geometry
             with warnings.catch_warnings():
@@ -1666,7 +1666,7 @@ WHEEL_MOUNTED += ("wheel_inboard", "wheel_outboard")
 def bodies(g) -> tuple[list[str], list[list[str]], list[Loop], list[Line]]:
     """(chassis points, rigid groups incl. rods, branch loops, point-on-line conditions)
     of an as-set Geometry, per mechanism as docs/geometry.md describes it (written
-    here, not read from pin_susp.mechanisms: an independent check). A loop's four
+    here, not read from pin_susp.model.mechanisms: an independent check). A loop's four
     points keep the sign of their chirality; a line (p, a, b) keeps p on the line
     through a and b, on a's design side."""
     kind = getattr(g, "type", "double_wishbone")
@@ -1829,14 +1829,14 @@ def _check_axle_rows(case: Case, o: Outcome, header, rows, context) -> None:
     converged = [r for r in rows if r[header.index("solver_converged")] == "True"]
     if not converged:
         return
-    from pin_susp.axle import load_axle
+    from pin_susp.subjects.axle import load_axle
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         axle = load_axle(str(Path(o.directory) / "g.yaml"))
     ROWS_CHECKED[f"{axle.left.type} axle"] += len(converged)
     design = {}
-    from pin_susp.setup import apply_setup
+    from pin_susp.analyses.setup import apply_setup
 
     for side in ("left", "right"):
         g = apply_setup(axle.corner(side))  # as set, as AxleModel solves it

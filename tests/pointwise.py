@@ -1,6 +1,6 @@
 """Independent computations for cross-checks.
 
-``PointwiseCorner`` wraps pin_susp.pointwise — hardpoint coordinates as
+``PointwiseCorner`` wraps pin_susp.analyses.pointwise — hardpoint coordinates as
 unknowns, rigid distances, scipy least_squares — which shares no kinematics
 with the Pinocchio path. The shim assembly and the metrics are written again
 here from the reference article and docs/results.md.
@@ -17,11 +17,11 @@ def _vec(v) -> np.ndarray:
 
 
 class PointwiseCorner:
-    """pin_susp.pointwise (points as unknowns, scipy) with a mm interface for the tests."""
+    """pin_susp.analyses.pointwise (points as unknowns, scipy) with a mm interface for the tests."""
 
     def __init__(self, data: dict, hardpoints: dict | None = None):
-        from pin_susp.geometry import load_geometry
-        from pin_susp.pointwise import PointwiseCorner as Points
+        from pin_susp.analyses.pointwise import PointwiseCorner as Points
+        from pin_susp.model.geometry import load_geometry
 
         si = None if hardpoints is None else {k: v * 1e-3 for k, v in hardpoints.items()}
         self.points_model = Points(load_geometry(data), si)
@@ -127,12 +127,12 @@ def shim_assembly(data: dict) -> dict[str, np.ndarray]:
 
 
 class PointwiseAxle:
-    """pin_susp.pointwise's axle (both corners, the rack, the bar: points as unknowns,
+    """pin_susp.analyses.pointwise's axle (both corners, the rack, the bar: points as unknowns,
     scipy) with the sweep's own units: mm, deg, relative point targets from its own
     design state."""
 
     def __init__(self, axle):
-        from pin_susp.pointwise import PointwiseAxle as Points
+        from pin_susp.analyses.pointwise import PointwiseAxle as Points
 
         self.points_model = Points(axle)
 

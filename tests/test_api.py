@@ -174,7 +174,7 @@ def test_the_report_refuses_before_writing_anything(results, tmp_path):
 
 
 def test_the_axle_is_at_the_top_level_like_the_corner(tmp_path):
-    from pin_susp.axle import AxleModel, axle_results, load_axle, solve_axle_sweep
+    from pin_susp.subjects.axle import AxleModel, axle_results, load_axle, solve_axle_sweep
 
     assert pin_susp.Axle is pin_susp.AxleModel is AxleModel
     assert pin_susp.load_axle is load_axle

@@ -15,9 +15,9 @@ import yourdfpy
 from conftest import ROOT, example, mirrored
 
 import pin_susp
-from pin_susp.axle import AxleModel, axle_results, load_axle, solve_axle_sweep
-from pin_susp.geometry import load_geometry
-from pin_susp.sweep import load_sweep
+from pin_susp.model.geometry import load_geometry
+from pin_susp.model.sweep import load_sweep
+from pin_susp.subjects.axle import AxleModel, axle_results, load_axle, solve_axle_sweep
 
 EXAMPLES = ["double_wishbone.yaml", "macpherson.yaml", "multilink_front.yaml"]
 
@@ -831,8 +831,8 @@ def test_sensitivity_says_what_it_does_not_cover(tmp_path, capsys):
 def test_the_roll_rows_jacobian_is_its_residuals_derivative(tmp_path):
     """The roll target's row (closed form, from the wheel centres' frames) against
     central differences of its residual along random configuration directions."""
-    from pin_susp.axle import axle_rows
     from pin_susp.constraints import RollTarget
+    from pin_susp.subjects.axle import axle_rows
 
     model = AxleModel(load_axle(axle_file(tmp_path)))
     (roll,) = [r for r in axle_rows(model, roll_sweep().targets) if isinstance(r, RollTarget)]

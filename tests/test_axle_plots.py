@@ -15,11 +15,11 @@ import pytest
 import yaml
 from conftest import EXAMPLES, example, sweep_csv
 
-from pin_susp.axle import AxleModel, load_axle
 from pin_susp.cli import main
-from pin_susp.drawing import PARALLEL, axle_drawing_figure, axle_pose
 from pin_susp.errors import InputError
 from pin_susp.plots import AXLE_PANELS, ResultsFile, report_figure
+from pin_susp.subjects.axle import AxleModel, load_axle
+from pin_susp.viz.drawing import PARALLEL, axle_drawing_figure, axle_pose
 
 SIDES = ("left", "right")
 

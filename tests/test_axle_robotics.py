@@ -18,9 +18,9 @@ import yourdfpy
 from conftest import EXAMPLES, example
 
 import pin_susp
-from pin_susp.axle import SIDES, AxleModel, load_axle
 from pin_susp.cli import main
-from pin_susp.mjcf import tree_to_mjcf
+from pin_susp.model.mjcf import tree_to_mjcf
+from pin_susp.subjects.axle import SIDES, AxleModel, load_axle
 
 NS = {"pin_susp": "https://github.com/pin-susp/pin_susp/urdf"}
 CHECK_URDF = shutil.which("check_urdf")

@@ -14,13 +14,13 @@ import pytest
 import yaml
 from conftest import ROOT, example, mirrored
 
-from pin_susp.axle import AxleModel, axle_results, load_axle, solve_axle_sweep
+from pin_susp.analyses.sensitivity import AXLE_COLUMNS, AxleSensitivity, HardpointSensitivity
+from pin_susp.analyses.setup import axle_setup_sheet, setup_sheet, solve_axle_setup
 from pin_susp.cli import main
-from pin_susp.geometry import load_geometry
-from pin_susp.linkage import Linkage
-from pin_susp.sensitivity import AXLE_COLUMNS, AxleSensitivity, HardpointSensitivity
-from pin_susp.setup import axle_setup_sheet, setup_sheet, solve_axle_setup
-from pin_susp.sweep import load_sweep
+from pin_susp.model.geometry import load_geometry
+from pin_susp.model.sweep import load_sweep
+from pin_susp.solve.linkage import Linkage
+from pin_susp.subjects.axle import AxleModel, axle_results, load_axle, solve_axle_sweep
 
 AXLE = yaml.safe_load((ROOT / "examples/axle_front.yaml").read_text())
 SHIM = example("camber_shim.yaml")["config"]["camber_shim"]  # the same upright's shim

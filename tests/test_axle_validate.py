@@ -13,11 +13,11 @@ import yaml
 from conftest import EXAMPLES, example, mirrored
 from pointwise import PointwiseAxle
 
-from pin_susp import pointwise
-from pin_susp.axle import AxleModel, axle_results, load_axle, solve_axle_sweep
+from pin_susp.analyses import pointwise
 from pin_susp.cli import main
-from pin_susp.geometry import load_geometry
-from pin_susp.sweep import load_sweep
+from pin_susp.model.geometry import load_geometry
+from pin_susp.model.sweep import load_sweep
+from pin_susp.subjects.axle import AxleModel, axle_results, load_axle, solve_axle_sweep
 from pin_susp.validate import validate
 
 AXLE = EXAMPLES / "axle_front.yaml"

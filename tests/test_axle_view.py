@@ -240,9 +240,9 @@ def test_axle_replay_renders_both_corners_and_the_roll_centre(tmp_path):
 
     from PIL import Image
 
-    from pin_susp.axle import AxleModel, axle_results, load_axle, solve_axle_sweep
-    from pin_susp.sweep import load_sweep
-    from pin_susp.viz import Scene, roll_centres
+    from pin_susp.model.sweep import load_sweep
+    from pin_susp.subjects.axle import AxleModel, axle_results, load_axle, solve_axle_sweep
+    from pin_susp.viz.scene import Scene, roll_centres
 
     model = AxleModel(load_axle(low_roll_centre(yaml.safe_load(CASES["low_rc"][0].read_text()))))
     sweep = load_sweep(EXAMPLES / "roll.yaml")
@@ -285,8 +285,8 @@ def test_a_set_up_axle_shows_its_drawn_geometry_as_a_ghost():
 
     from conftest import example
 
-    from pin_susp.axle import AxleModel, load_axle
-    from pin_susp.viz import Scene
+    from pin_susp.subjects.axle import AxleModel, load_axle
+    from pin_susp.viz.scene import Scene
 
     data = yaml.safe_load((EXAMPLES / "axle_front.yaml").read_text())
     drawn = AxleModel(load_axle(data))

@@ -16,11 +16,11 @@ import yaml
 from conftest import EXAMPLES, example
 
 import pin_susp
-from pin_susp.bulk import on_branches
 from pin_susp.cli import main
-from pin_susp.march import march
-from pin_susp.solver import NewtonSolver
-from pin_susp.sweep import load_sweep
+from pin_susp.model.sweep import load_sweep
+from pin_susp.solve.bulk import on_branches
+from pin_susp.solve.march import march
+from pin_susp.solve.solver import NewtonSolver
 
 LBJ = {"x": 0, "y": 900, "z": 200}  # the example's lower ball joint
 PIVOTS = ("upper_wishbone_inboard_front", "upper_wishbone_inboard_rear")
@@ -183,7 +183,7 @@ def test_an_axle_with_the_pivot_on_the_lbj_guards_both_uprights(tmp_path, capsys
     """The axle's corners (prefixed by side) keep the fallback: both upper ball joints
     are guarded by the lower pivot's plane, and a heave sweep's converged steps keep
     the design's sign on both sides (from the CSV's points)."""
-    from pin_susp.axle import AxleModel, load_axle
+    from pin_susp.subjects.axle import AxleModel, load_axle
 
     data = yaml.safe_load((EXAMPLES / "axle_front.yaml").read_text())
     data["hardpoints"]["left"][PIVOTS[0]] = dict(LBJ)  # the right side mirrors the left

@@ -1,4 +1,4 @@
-"""A long sweep solved for every step at once (pin_susp.bulk) against Pinocchio itself,
+"""A long sweep solved for every step at once (pin_susp.solve.bulk) against Pinocchio itself,
 the step-by-step march, and the independent point-based formulation."""
 
 import numpy as np
@@ -8,13 +8,13 @@ from conftest import EXAMPLES, example, torsion_bar
 from pointwise import PointwiseCorner
 
 import pin_susp
-import pin_susp.assembly
-import pin_susp.corner
-from pin_susp import bulk
-from pin_susp import march as marching
-from pin_susp.bulk import Frames, Tree
-from pin_susp.corner import Results
-from pin_susp.sweep import Sweep, Target
+import pin_susp.subjects.assembly
+import pin_susp.subjects.corner
+from pin_susp.model.sweep import Sweep, Target
+from pin_susp.solve import bulk
+from pin_susp.solve import march as marching
+from pin_susp.solve.bulk import Frames, Tree
+from pin_susp.subjects.corner import Results
 
 CORNERS = [
     "double_wishbone.yaml",
@@ -46,7 +46,7 @@ def step_by_step(monkeypatch):
     """Make a subject's solve_steps (assembly.py) march every step (the reference)."""
     march = marching.march
     monkeypatch.setattr(
-        pin_susp.assembly, "march", lambda *a, **k: march(*a, **{**k, "bulk": False})
+        pin_susp.subjects.assembly, "march", lambda *a, **k: march(*a, **{**k, "bulk": False})
     )
 
 
@@ -123,7 +123,7 @@ def test_solved_at_once_rather_than_step_by_step(monkeypatch):
         return march(solver_, values, *args, **kwargs)
 
     monkeypatch.setattr(marching, "march", counting)
-    monkeypatch.setattr(pin_susp.assembly, "march", counting)
+    monkeypatch.setattr(pin_susp.subjects.assembly, "march", counting)
     solutions = corner.solve_steps(sweep)
     assert all(s.converged for s in solutions)
     assert seen[0] == 1001 and max(seen[1:]) <= 2 * bulk.COARSE_STEPS
@@ -245,7 +245,7 @@ def test_spring_length_and_its_rates_at_once_equal_each_pose_alone(geometry):
     """The spring's length (a torsion bar's wind-up), motion ratio and its rate — the
     second-order closure solve — for every step at once, against Pinocchio's
     forwardKinematics(q, v, a) one pose at a time (rates.SpringRates.derivatives)."""
-    from pin_susp.rates import SpringRates
+    from pin_susp.solve.rates import SpringRates
 
     corner = pin_susp.Corner(geometry, warn=False)
     solutions = corner.solve_steps(long_sweep(corner, steps=61))
@@ -314,7 +314,7 @@ def test_a_sweep_with_no_converged_step_gives_empty_cells():
 def axle_sweeps(steps: int = 401) -> dict:
     """The example axle's roll (−3…3° at 10 mm of heave, the rack held) and both wheels'
     bump with the rack moving (its Ackermann defined): point, roll and heave rows."""
-    from pin_susp.sweep import load_sweep
+    from pin_susp.model.sweep import load_sweep
 
     rack = {"point": "trackrod_inboard", "side": "left", "direction": {"axis": "y"}}
     wheel = lambda side, a, b: {  # noqa: E731
@@ -347,13 +347,13 @@ def axle_sweeps(steps: int = 401) -> dict:
 def axle_step_by_step(monkeypatch):
     """Make the axle march every step and evaluate its columns one Pinocchio call after
     another (the reference)."""
-    import pin_susp.axle
+    import pin_susp.subjects.axle
 
     march = marching.march
     monkeypatch.setattr(
-        pin_susp.assembly, "march", lambda *a, **k: march(*a, **{**k, "bulk": False})
+        pin_susp.subjects.assembly, "march", lambda *a, **k: march(*a, **{**k, "bulk": False})
     )
-    monkeypatch.setattr(pin_susp.axle, "MIN_STEPS", 10**9)
+    monkeypatch.setattr(pin_susp.subjects.axle, "MIN_STEPS", 10**9)
 
 
 @pytest.mark.parametrize("kind", ["roll", "bump+steer"])
@@ -363,7 +363,7 @@ def test_an_axle_long_sweep_solved_at_once_equals_the_step_by_step_march(kind, m
     same sweep marched and evaluated step by step (to 1e-9), every step converged and on
     every loop's design assembly (the scalar branch check, step by step), and the sweep
     took the at-once path: the march saw only the coarse steps."""
-    from pin_susp.axle import AxleModel, axle_results, solve_axle_sweep
+    from pin_susp.subjects.axle import AxleModel, axle_results, solve_axle_sweep
 
     model = AxleModel(EXAMPLES / "axle_front.yaml")
     sweep = axle_sweeps()[kind]
@@ -377,7 +377,7 @@ def test_an_axle_long_sweep_solved_at_once_equals_the_step_by_step_march(kind, m
         return march(solver_, values, *args, **kwargs)
 
     monkeypatch.setattr(marching, "march", counting)
-    monkeypatch.setattr(pin_susp.assembly, "march", counting)
+    monkeypatch.setattr(pin_susp.subjects.assembly, "march", counting)
     solutions = solve_axle_sweep(model, sweep)
     assert seen[0] == 401 and len(seen) == 2 and seen[1] <= 2 * bulk.COARSE_STEPS
     assert all(s.converged for s in solutions)

@@ -427,7 +427,8 @@ def test_a_damaged_part_file_is_named_and_its_batch_solved_again_on_resume(
 # animation being recorded, the page being made, the HTML being written.
 _AT = """
 import importlib.abc, signal, sys
-from pin_susp import cli, viz
+from pin_susp import cli
+from pin_susp.viz import scene as viz
 from pin_susp.io import atomic
 number = getattr(signal, sys.argv[2])
 

@@ -17,8 +17,6 @@ from conftest import EXAMPLES, ROOT, torsion_bar
 
 import pin_susp
 import pin_susp.constraints
-from pin_susp.axle import AxleModel, axle_rows, load_axle
-from pin_susp.bulk import Rows, tree_of
 from pin_susp.constraints import (
     BarTwist,
     FaceAlignment,
@@ -28,8 +26,10 @@ from pin_susp.constraints import (
     Row,
     ShimGap,
 )
-from pin_susp.solver import _Batch
-from pin_susp.sweep import load_sweep
+from pin_susp.model.sweep import load_sweep
+from pin_susp.solve.bulk import Rows, tree_of
+from pin_susp.solve.solver import _Batch
+from pin_susp.subjects.axle import AxleModel, axle_rows, load_axle
 
 ROWS_KNOWN = {"WORLD", "BranchGuard", "Kinematics", "StepFrames", "ManyFrames"}
 
@@ -45,7 +45,7 @@ def kinds_in_constraints() -> set[type]:
     return found
 
 
-@pytest.mark.parametrize("module", ["solver.py", "bulk.py"])
+@pytest.mark.parametrize("module", ["solve/solver.py", "solve/bulk.py"])
 def test_the_solver_and_the_batched_path_know_no_row_kind(module):
     """No isinstance at all in solver.py and bulk.py, and nothing imported from
     constraints/ but the frames' containers, the kinematics and the branch guard."""

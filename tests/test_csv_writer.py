@@ -12,9 +12,9 @@ import pyarrow.parquet as pq
 import pytest
 from conftest import EXAMPLES
 
-from pin_susp.corner import Results
 from pin_susp.io import atomic, tables
-from pin_susp.sweep import load_sweep
+from pin_susp.model.sweep import load_sweep
+from pin_susp.subjects.corner import Results
 
 EDGE = [
     0.0,

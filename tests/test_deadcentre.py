@@ -137,9 +137,9 @@ def test_study_warns_of_the_dead_centre_of_its_design(tmp_path):
 
 
 def test_no_committed_example_is_near_a_dead_centre():
-    from pin_susp.axle import axle_tree, load_axle
-    from pin_susp.deadcentre import DEAD_CENTRE, transmissions
-    from pin_susp.geometry import load_geometry
+    from pin_susp.model.deadcentre import DEAD_CENTRE, transmissions
+    from pin_susp.model.geometry import load_geometry
+    from pin_susp.subjects.axle import axle_tree, load_axle
 
     checked = 0
     for path in sorted(EXAMPLES.glob("*.yaml")):
@@ -284,7 +284,7 @@ def test_validate_reports_another_branch_and_marks_what_it_says(tmp_path, capsys
     checked here by the handedness of the rocker's four points against pin_susp's —
     and its closing line says 'marked !' only when a cell is marked."""
     from pin_susp import Corner
-    from pin_susp.sweep import load_sweep
+    from pin_susp.model.sweep import load_sweep
     from pin_susp.validate import pointwise_points
 
     g = near_dead_centre(0.6, 38.6)
@@ -327,8 +327,8 @@ def test_validate_reports_another_branch_and_marks_what_it_says(tmp_path, capsys
 def test_axle_droplink_near_the_bars_dead_centre_warns_once(tmp_path):
     """A U-bar's droplink all but through the bar's axis: the droplink drives the bar's
     arm (toward infinity), said for the left with the mirrored right."""
-    from pin_susp.axle import load_axle
     from pin_susp.errors import PlausibilityWarning
+    from pin_susp.subjects.axle import load_axle
 
     a = example("axle_front.yaml")
     a["hardpoints"]["left"]["droplink_u_bar"] = {"x": 0.5, "y": 300, "z": 220}
@@ -359,8 +359,8 @@ def test_mujoco_landing_on_the_other_rocker_branch_is_said_so(tmp_path):
     ends: signed volume) opposite to the design's; none of them is compared."""
     pytest.importorskip("mujoco")
     from pin_susp import Corner
-    from pin_susp.mjcf import tree_to_mjcf
-    from pin_susp.sweep import load_sweep
+    from pin_susp.model.mjcf import tree_to_mjcf
+    from pin_susp.model.sweep import load_sweep
     from pin_susp.validate import mujoco_points, validate
 
     g = near_dead_centre(0.6, 38.6)

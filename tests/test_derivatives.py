@@ -7,8 +7,8 @@ import pytest
 from conftest import EXAMPLES, example, mirrored, sweep_csv
 
 import pin_susp
+from pin_susp.analyses.sensitivity import HardpointSensitivity
 from pin_susp.cli import main
-from pin_susp.sensitivity import HardpointSensitivity
 
 
 def front_view_corner() -> dict:

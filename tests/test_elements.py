@@ -5,12 +5,12 @@ from pathlib import Path
 
 import numpy as np
 
-from pin_susp.axle import AxleModel, axle_tree, load_axle
-from pin_susp.compose import SHARED, compose_tree, prefixed
-from pin_susp.elements import elements_of, rack
-from pin_susp.elements.anti_roll_bar import AntiRollBar
-from pin_susp.elements.heave_link import HeaveLink
-from pin_susp.geometry import load_geometry
+from pin_susp.model.compose import SHARED, compose_tree, prefixed
+from pin_susp.model.geometry import load_geometry
+from pin_susp.subjects.axle import AxleModel, axle_tree, load_axle
+from pin_susp.subjects.elements import elements_of, rack
+from pin_susp.subjects.elements.anti_roll_bar import AntiRollBar
+from pin_susp.subjects.elements.heave_link import HeaveLink
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 

@@ -8,7 +8,7 @@ from conftest import EXAMPLES, example
 
 from pin_susp.cli import main
 from pin_susp.errors import InputError
-from pin_susp.geometry import load_geometry
+from pin_susp.model.geometry import load_geometry
 
 SIZE = {"aspect_ratio": 0.55, "section_width": 270, "rim_diameter": 13}
 
@@ -84,7 +84,7 @@ def test_a_plausibility_warning_names_the_key_as_written(tmp_path):
 
 
 def test_an_axle_reads_its_tyre_under_one_key(tmp_path):
-    from pin_susp.axle import load_axle
+    from pin_susp.subjects.axle import load_axle
 
     data = example("axle_front.yaml")
     w = data["axle_config"]["wheel"]
@@ -252,8 +252,8 @@ def test_the_summary_says_the_rack_was_held(tmp_path, capsys):
 def test_a_bump_only_sweep_validates_and_differentiates_with_the_rack_held(corner):
     """The pointwise re-solve (scipy on the points) holds the rack too and agrees; the
     hardpoint sensitivities are those with the rack's own target."""
-    from pin_susp.sensitivity import hardpoint_sensitivities
-    from pin_susp.sweep import load_sweep
+    from pin_susp.analyses.sensitivity import hardpoint_sensitivities
+    from pin_susp.model.sweep import load_sweep
     from pin_susp.validate import validate
 
     results, (report,) = validate(corner, load_sweep(bump_only(5)), engines=("pointwise",))

@@ -12,7 +12,7 @@ from conftest import EXAMPLES, ROOT, example
 
 import pin_susp
 from pin_susp.cli import main
-from pin_susp.mjcf import tree_to_mjcf
+from pin_susp.model.mjcf import tree_to_mjcf
 
 CASES = [
     ("double_wishbone.yaml", "bump_steer.yaml"),

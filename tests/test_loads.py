@@ -7,11 +7,11 @@ import pytest
 from conftest import EXAMPLES
 
 import pin_susp
+from pin_susp.analyses.loads import LoadCase, Statics, load_cases
 from pin_susp.constraints import DistanceClosure, JointTarget, Row
 from pin_susp.errors import InputError, PinSuspError
-from pin_susp.loads import LoadCase, Statics, load_cases
-from pin_susp.solver import NewtonSolver
-from pin_susp.sweep import Sweep, Target
+from pin_susp.model.sweep import Sweep, Target
+from pin_susp.solve.solver import NewtonSolver
 
 CASES = [
     LoadCase("braking", np.array([-3000.0, 200.0, 2500.0]), np.zeros(3), np.zeros(3)),
@@ -411,7 +411,7 @@ def test_rate_columns_appear_only_with_a_rate():
 def test_bad_rates_name_their_key(change, key):
     import yaml
 
-    from pin_susp.geometry import load_geometry
+    from pin_susp.model.geometry import load_geometry
 
     data = yaml.safe_load((EXAMPLES / "pushrod_rocker.yaml").read_text())
     change(data)
@@ -426,7 +426,7 @@ def test_bad_rates_name_their_key(change, key):
 def _axle(bar: str):
     import yaml
 
-    from pin_susp.axle import AxleModel, load_axle
+    from pin_susp.subjects.axle import AxleModel, load_axle
 
     data = yaml.safe_load((EXAMPLES / "axle_front.yaml").read_text())
     config = data["axle_config"]
@@ -442,7 +442,7 @@ def _axle(bar: str):
 
 
 def _axle_case(left, right):
-    from pin_susp.loads import AxleLoadCase
+    from pin_susp.analyses.loads import AxleLoadCase
 
     zero = np.zeros(3)
     return AxleLoadCase("case", LoadCase("case", np.asarray(left, float), zero, zero),
@@ -482,7 +482,7 @@ def test_an_axles_bar_and_springs_share_by_stiffness():
     """Statically indeterminate: the springs' and the bar's deflections (force/rate)
     must be those of one motion of the axle — written from the sweep's own rates
     (damper length and bar twist per wheel height), not from the solver."""
-    from pin_susp.axle import axle_results, solve_axle_sweep
+    from pin_susp.subjects.axle import axle_results, solve_axle_sweep
 
     model, _ = _axle("u_bar")
     sweep = _sweep_of(ROLL)
@@ -508,7 +508,7 @@ def test_an_axles_bar_and_springs_share_by_stiffness():
 def test_a_rigid_bar_compresses_both_springs_alike():
     """A locked bar on a mirrored axle in heave: the wheels move as one, so both
     springs deflect alike — the same force on each side, whichever wheel is loaded."""
-    from pin_susp.axle import solve_axle_sweep
+    from pin_susp.subjects.axle import solve_axle_sweep
 
     model, _ = _axle("rigid")
     solutions = solve_axle_sweep(model, _sweep_of(HEAVE))
@@ -525,7 +525,7 @@ HEAVE = [{"quantity": "heave", "start": -15, "stop": 15}]
 
 
 def _sweep_of(targets):
-    from pin_susp.sweep import load_sweep
+    from pin_susp.model.sweep import load_sweep
 
     return load_sweep({"steps": 7, "targets": [*targets, RACK_HELD]})
 
@@ -533,7 +533,7 @@ def _sweep_of(targets):
 def test_a_bar_without_rates_says_what_it_needs():
     import yaml
 
-    from pin_susp.axle import AxleModel, load_axle
+    from pin_susp.subjects.axle import AxleModel, load_axle
 
     data = yaml.safe_load((EXAMPLES / "axle_front.yaml").read_text())
     with pytest.raises(PinSuspError, match="share the load by their stiffnesses"):
@@ -546,8 +546,8 @@ def test_roll_stiffness_is_the_second_derivative_of_the_stored_energy():
     arb_wheel_rate is the bar's share at each wheel: ½·k_bar·(dθ/dh)²."""
     import yaml
 
-    from pin_susp.axle import AxleModel, axle_results, load_axle, solve_axle_sweep
-    from pin_susp.sweep import load_sweep
+    from pin_susp.model.sweep import load_sweep
+    from pin_susp.subjects.axle import AxleModel, axle_results, load_axle, solve_axle_sweep
 
     data = yaml.safe_load((EXAMPLES / "axle_front.yaml").read_text())
     data["axle_config"]["spring"] = {"type": "coilover", "rate": 175.0}
@@ -649,7 +649,7 @@ def test_each_side_of_an_axle_has_its_corners_rates():
     import yaml
     from conftest import mirrored
 
-    from pin_susp.axle import AxleModel, axle_results, load_axle, solve_axle_sweep
+    from pin_susp.subjects.axle import AxleModel, axle_results, load_axle, solve_axle_sweep
 
     data = yaml.safe_load((EXAMPLES / "axle_front.yaml").read_text())
     data["axle_config"]["spring"] = {"type": "coilover", "rate": 175.0, "preload": 2600.0}
@@ -692,7 +692,7 @@ def test_a_spring_below_zero_force_is_warned_of(tmp_path, capsys):
 def test_a_load_case_file_is_read_by_the_subjects_labels(tmp_path):
     """``load_cases(path, labels=subject.labels)``: a corner's loads at each case's top
     (labels ``""``), an axle's in a block per labelled corner — as ``axle=`` reads them."""
-    from pin_susp.loads import AxleLoadCase
+    from pin_susp.analyses.loads import AxleLoadCase
 
     corner = load_cases(EXAMPLES / "loads.yaml", labels=("",))
     flat = load_cases(EXAMPLES / "loads.yaml")

@@ -122,7 +122,7 @@ def test_the_replay_colours_a_bent_wishbone_as_no_two_force_member(tmp_path, cap
     the ramp (blue, compression), and the key and the page say what that colour is."""
     import matplotlib
 
-    from pin_susp.viz import NOT_TWO_FORCE
+    from pin_susp.viz.scene import NOT_TWO_FORCE
 
     path = tmp_path / "corner.yaml"
     path.write_text(yaml.safe_dump(pushrod_on_the_lower_wishbone()))
@@ -145,7 +145,7 @@ def test_the_replay_colours_a_bent_wishbone_as_no_two_force_member(tmp_path, cap
 @pytest.mark.parametrize("geometry", ["pushrod_rocker.yaml", "bent"])
 def test_the_statics_name_the_bent_arms(geometry):
     import pin_susp
-    from pin_susp.loads import Statics
+    from pin_susp.analyses.loads import Statics
 
     data = pushrod_on_the_lower_wishbone() if geometry == "bent" else example(geometry)
     bent = Statics(pin_susp.Corner(data)).not_two_force()

@@ -25,8 +25,8 @@ from scipy.optimize import brentq, least_squares
 import pin_susp
 from pin_susp import Target
 from pin_susp.cli import main
-from pin_susp.metrics import PointSet
-from pin_susp.sweep import load_sweep
+from pin_susp.columns.metrics import PointSet
+from pin_susp.model.sweep import load_sweep
 from pin_susp.validate import validate
 
 DATA = Path(__file__).parent / "data"

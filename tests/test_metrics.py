@@ -7,7 +7,7 @@ import pytest
 from conftest import example, mirrored, translated
 
 import pin_susp
-from pin_susp.metrics import METRICS
+from pin_susp.columns.metrics import METRICS
 
 SIDE_FREE = (
     "camber",
@@ -125,7 +125,7 @@ def test_damper_length_is_strut_distance_and_only_with_a_coilover():
 
 
 def test_flat_steering_axis_leaves_scrub_and_trail_empty():
-    from pin_susp.metrics import PointSet, mechanical_trail, scrub_radius
+    from pin_susp.columns.metrics import PointSet, mechanical_trail, scrub_radius
 
     corner = pin_susp.Corner(example("double_wishbone.yaml"))
     p = {k: v[None].copy() for k, v in corner.design_positions.items()}
@@ -143,8 +143,8 @@ def test_registry_gives_every_column_a_unit_and_label():
 @pytest.mark.parametrize("side", ["left", "right"])
 def test_every_metric_derivative_matches_central_differences(side):
     """d<metric> along arbitrary point velocities, against differences of the metric itself."""
-    from pin_susp.jet import Dual
-    from pin_susp.metrics import PointSet
+    from pin_susp.columns.metrics import PointSet
+    from pin_susp.maths.jet import Dual
 
     data = example("pushrod_rocker.yaml")
     data = mirrored(data) if side == "right" else data

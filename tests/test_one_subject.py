@@ -31,7 +31,12 @@ from pathlib import Path
 PACKAGE = Path(__file__).resolve().parents[1] / "pin_susp"
 
 # The subjects' own modules: where the kinds are told apart, once.
-SUBJECTS = ("corner.py", "axle.py", "axle_file.py", "subject.py")
+SUBJECTS = (
+    "subjects/corner.py",
+    "subjects/axle.py",
+    "subjects/axle_file.py",
+    "subjects/subject.py",
+)
 
 KINDS = {"Corner", "AxleModel", "Geometry", "AxleGeometry", "Results", "AxleResults"}
 ONE_KIND_ATTRIBUTES = {"geometries", "geometry", "axle"}
@@ -191,7 +196,7 @@ s = len(labels) > 1
 def test_both_subjects_answer_what_the_consumers_ask():
     """What a command asks instead of the kind: the blocks a per-corner input is in
     (loads' cases) and the columns a sweep's summary shows."""
-    from pin_susp.subject import load_subject
+    from pin_susp.subjects.subject import load_subject
 
     examples = PACKAGE.parent / "examples"
     corner = load_subject(examples / "double_wishbone.yaml")
@@ -208,7 +213,7 @@ def test_validate_sees_one_scope_of_either_subject():
     (an axle's own added), and the engines' points in the form the subject's motion has."""
     import numpy as np
 
-    from pin_susp.subject import load_subject
+    from pin_susp.subjects.subject import load_subject
     from pin_susp.validate import Scope, scope_of
 
     examples = PACKAGE.parent / "examples"
@@ -234,8 +239,8 @@ def test_a_study_asks_the_subject_not_its_kind():
     written out), whether its sensitivities hold a sweep, each step's held targets."""
     import yaml
 
-    from pin_susp.subject import kind_of
-    from pin_susp.sweep import load_sweep
+    from pin_susp.model.sweep import load_sweep
+    from pin_susp.subjects.subject import kind_of
 
     examples = PACKAGE.parent / "examples"
     bump = load_sweep(examples / "bump_steer.yaml")

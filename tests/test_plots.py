@@ -13,9 +13,9 @@ from conftest import EXAMPLES, example, mirrored
 
 import pin_susp
 from pin_susp.cli import main
-from pin_susp.drawing import PARALLEL, drawing_figure
 from pin_susp.errors import InputError
 from pin_susp.plots import ResultsFile, report_figure
+from pin_susp.viz.drawing import PARALLEL, drawing_figure
 
 ARMS = ("upper_wishbone", "lower_wishbone")
 

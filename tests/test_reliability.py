@@ -221,8 +221,8 @@ def test_five_steps_do_not_jump_the_toggle_that_many_steps_cannot_pass(tmp_path,
 
 
 def test_setup_refuses_an_as_set_corner_on_another_branch():
-    from pin_susp.as_set import check_branches
     from pin_susp.errors import InputError
+    from pin_susp.solve.as_set import check_branches
 
     g = pin_susp.load_geometry(EXAMPLES / "double_wishbone.yaml")
     points = dict(g.hardpoints)

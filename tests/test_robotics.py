@@ -20,7 +20,7 @@ from conftest import EXAMPLES, ROOT, example, mirrored, torsion_bar
 
 import pin_susp
 from pin_susp.cli import main
-from pin_susp.mjcf import tree_to_mjcf
+from pin_susp.model.mjcf import tree_to_mjcf
 
 URDFS = sorted((ROOT / "urdf").glob("*.urdf"))
 NS = {"pin_susp": "https://github.com/pin-susp/pin_susp/urdf"}

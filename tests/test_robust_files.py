@@ -16,7 +16,7 @@ from conftest import EXAMPLES, example, sweep_csv
 import pin_susp
 from pin_susp.cli import main
 from pin_susp.errors import InputError, PinSuspError
-from pin_susp.mjcf import check_mjcf, tree_to_mjcf
+from pin_susp.model.mjcf import check_mjcf, tree_to_mjcf
 from pin_susp.plots import ResultsFile, check_image_path, report_figure, save_figure
 from pin_susp.validate import validate
 
@@ -276,7 +276,9 @@ def test_image_endings_are_matplotlibs_and_case_insensitive(tmp_path):
     for ext in ("png", "PNG", "Pdf", "svg", "jpeg"):
         check_image_path(f"out.{ext}")
     assert "png" in FigureCanvasBase.get_supported_filetypes()
-    drawing = pin_susp.drawing.drawing_figure(pin_susp.Corner(EXAMPLES / "double_wishbone.yaml"))
+    drawing = pin_susp.viz.drawing.drawing_figure(
+        pin_susp.Corner(EXAMPLES / "double_wishbone.yaml")
+    )
     save_figure(drawing, tmp_path / "d.PNG")
     assert (tmp_path / "d.PNG").read_bytes()[:4] == b"\x89PNG"
 

@@ -8,11 +8,11 @@ from conftest import EXAMPLES, example, mirrored
 from pointwise import PointwiseCorner, shim_assembly, spec_metrics
 
 import pin_susp
+from pin_susp.analyses.setup import SetupModel, apply_setup, setup_values, solve_setup, with_setup
 from pin_susp.cli import main
-from pin_susp.geometry import load_geometry
-from pin_susp.metrics import STANDARD
-from pin_susp.setup import SetupModel, apply_setup, setup_values, solve_setup, with_setup
-from pin_susp.shim import ShimAssembly
+from pin_susp.columns.metrics import STANDARD
+from pin_susp.model.geometry import load_geometry
+from pin_susp.solve.shim import ShimAssembly
 
 MM = 1e-3
 

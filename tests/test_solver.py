@@ -203,7 +203,7 @@ def test_relative_target_along_a_reversed_vector_moves_the_other_way(corner):
 
 def test_singular_jacobian_takes_a_bounded_damped_step(corner):
     """At a lock-up J has no inverse: the step is damped least squares, finite and bounded."""
-    from pin_susp.solver import MAX_STEP
+    from pin_susp.solve.solver import MAX_STEP
 
     solver = corner.solver_for(
         [pin_susp.Target("wheel_center", "z", 0.0), pin_susp.Target("trackrod_inboard", "y", 0)]

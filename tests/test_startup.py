@@ -33,27 +33,27 @@ HEAVY = (
     "yourdfpy",
     "mujoco",
     "pydrake",
-    "pin_susp.loads",
-    "pin_susp.load_case",
-    "pin_susp.statics",
-    "pin_susp.sensitivity",
+    "pin_susp.analyses.loads",
+    "pin_susp.analyses.load_case",
+    "pin_susp.analyses.statics",
+    "pin_susp.analyses.sensitivity",
     "pin_susp.study",
-    "pin_susp.study_plots",
+    "pin_susp.study.plots",
     "pin_susp.validate",
-    "pin_susp.pointwise",
+    "pin_susp.analyses.pointwise",
     "pin_susp.plots",
-    "pin_susp.drawing",
-    "pin_susp.drawing_centres",
-    "pin_susp.drawing_labels",
-    "pin_susp.viz",
-    "pin_susp.view_parts",
-    "pin_susp.force_colours",
-    "pin_susp.meshcat_server",
-    "pin_susp.axle",
+    "pin_susp.viz.drawing",
+    "pin_susp.viz.drawing_centres",
+    "pin_susp.viz.drawing_labels",
+    "pin_susp.viz.scene",
+    "pin_susp.viz.view_parts",
+    "pin_susp.viz.force_colours",
+    "pin_susp.viz.server",
+    "pin_susp.subjects.axle",
     # a double wishbone's corner loads no other mechanism
-    "pin_susp.mechanisms.macpherson",
-    "pin_susp.mechanisms.multilink",
-    "pin_susp.mechanisms.trailing_arm",
+    "pin_susp.model.mechanisms.macpherson",
+    "pin_susp.model.mechanisms.multilink",
+    "pin_susp.model.mechanisms.trailing_arm",
 )
 
 
@@ -76,7 +76,7 @@ def test_a_plain_sweep_to_csv_imports_nothing_heavy(inputs):
     assert code == 0, proc.stderr
     assert imported(modules, HEAVY) == []
     # what it does need, it has
-    assert {"numpy", "pinocchio", "yaml", "pin_susp.solver", "pin_susp.io.tables"} <= modules
+    assert {"numpy", "pinocchio", "yaml", "pin_susp.solve.solver", "pin_susp.io.tables"} <= modules
     # the CSV is the sweep's: 41 rows, each camber the very float the API computes
     lines = (inputs / "out.csv").read_text().splitlines()
     rows = list(csv.DictReader(line for line in lines if not line.startswith("#")))
@@ -138,36 +138,36 @@ def test_import_pin_susp_loads_no_submodule_until_a_name_is_used(tmp_path):
     assert proc.returncode == 0, proc.stderr
     before, after = json.loads(proc.stdout)
     assert before == []
-    assert "pin_susp.geometry" in after
+    assert "pin_susp.model.geometry" in after
     assert imported(set(after), HEAVY) == []
 
 
 # Every public name and the module that defines it (as pin_susp/__init__.py imported
 # them all before they were loaded lazily).
 PUBLIC = {
-    "Axle": "axle",
-    "AxleModel": "axle",
-    "AxleResults": "axle",
-    "load_axle": "axle",
-    "Corner": "corner",
-    "Results": "corner",
+    "Axle": "subjects.axle",
+    "AxleModel": "subjects.axle",
+    "AxleResults": "subjects.axle",
+    "load_axle": "subjects.axle",
+    "Corner": "subjects.corner",
+    "Results": "subjects.corner",
     "InputError": "errors",
     "PinSuspError": "errors",
-    "Geometry": "geometry",
-    "load_geometry": "geometry",
-    "LoadCase": "loads",
-    "load_cases": "loads",
-    "member_forces": "loads",
-    "METRICS": "metrics",
-    "Pose": "metrics",
-    "hardpoint_sensitivities": "sensitivity",
-    "SetupModel": "setup",
-    "apply_setup": "as_set",
-    "setup_sheet": "setup",
-    "solve_setup": "setup",
-    "Sweep": "sweep",
-    "Target": "sweep",
-    "load_sweep": "sweep",
+    "Geometry": "model.geometry",
+    "load_geometry": "model.geometry",
+    "LoadCase": "analyses.loads",
+    "load_cases": "analyses.loads",
+    "member_forces": "analyses.loads",
+    "METRICS": "columns.metrics",
+    "Pose": "columns.metrics",
+    "hardpoint_sensitivities": "analyses.sensitivity",
+    "SetupModel": "analyses.setup",
+    "apply_setup": "solve.as_set",
+    "setup_sheet": "analyses.setup",
+    "solve_setup": "analyses.setup",
+    "Sweep": "model.sweep",
+    "Target": "model.sweep",
+    "load_sweep": "model.sweep",
 }
 
 
@@ -182,7 +182,7 @@ def test_every_public_name_still_resolves():
     assert set(PUBLIC) <= set(namespace)
     assert pin_susp.__version__ == "0.1.0"
     # a submodule by attribute, as when `import pin_susp` imported them all
-    assert pin_susp.loads.load_cases is pin_susp.load_cases
+    assert pin_susp.analyses.loads.load_cases is pin_susp.load_cases
     with pytest.raises(AttributeError, match="no_such_name"):
         pin_susp.no_such_name  # noqa: B018
     assert not hasattr(pin_susp, "__wrapped__")
@@ -191,7 +191,7 @@ def test_every_public_name_still_resolves():
 def test_a_yaml_file_read_twice_gives_each_caller_its_own_copy(tmp_path):
     """load_yaml parses a content once (the CLI reads a geometry's scope, then the
     geometry): each caller still gets its own mapping, and a changed file is re-read."""
-    from pin_susp.yamlio import load_yaml
+    from pin_susp.io.yamlio import load_yaml
 
     path = shutil.copy(EXAMPLES / "double_wishbone.yaml", tmp_path / "g.yaml")
     expected = yaml.safe_load((EXAMPLES / "double_wishbone.yaml").read_text())

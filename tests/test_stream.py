@@ -12,7 +12,7 @@ import yaml
 from conftest import EXAMPLES
 
 import pin_susp
-import pin_susp.corner
+import pin_susp.subjects.corner
 from pin_susp.cli import main
 from pin_susp.cli.commands import sweep as sweep_command
 from pin_susp.cli.report import Digest
@@ -35,8 +35,10 @@ def small_chunks(monkeypatch):
     """Stream sweeps longer than 300 steps, 250 steps at a time (the real sizes are
     10 000: the same code, at a test's length)."""
     monkeypatch.setattr(sweep_command, "STREAM_STEPS", 300)
-    monkeypatch.setattr(pin_susp.corner, "CHUNK", 250)
-    monkeypatch.setattr(pin_susp.corner.Corner.run_sweep_chunks, "__defaults__", (250, None))
+    monkeypatch.setattr(pin_susp.subjects.corner, "CHUNK", 250)
+    monkeypatch.setattr(
+        pin_susp.subjects.corner.Corner.run_sweep_chunks, "__defaults__", (250, None)
+    )
 
 
 def run(argv, capsys):
@@ -50,16 +52,18 @@ def test_a_streamed_sweep_writes_the_held_sweeps_rows_and_summary(tmp_path, caps
     code, held_out, _ = run(["sweep", GEOMETRY, sweep, "-o", tmp_path / "held.csv"], capsys)
     assert code == 0
     monkeypatch.setattr(sweep_command, "STREAM_STEPS", 300)
-    monkeypatch.setattr(pin_susp.corner.Corner.run_sweep_chunks, "__defaults__", (250, None))
+    monkeypatch.setattr(
+        pin_susp.subjects.corner.Corner.run_sweep_chunks, "__defaults__", (250, None)
+    )
     seen = []
-    chunks = pin_susp.corner.Corner.run_sweep_chunks
+    chunks = pin_susp.subjects.corner.Corner.run_sweep_chunks
 
     def counted(self, *args, **kwargs):
         for part in chunks(self, *args, **kwargs):
             seen.append(len(part))
             yield part
 
-    monkeypatch.setattr(pin_susp.corner.Corner, "run_sweep_chunks", counted)
+    monkeypatch.setattr(pin_susp.subjects.corner.Corner, "run_sweep_chunks", counted)
     code, out, _ = run(["sweep", GEOMETRY, sweep, "-o", tmp_path / "streamed.csv"], capsys)
     assert code == 0 and seen == [250, 250, 200]
     residual = re.compile(r"max residual \S+ mm")  # each path's own last digits
@@ -95,7 +99,9 @@ def test_steps_out_of_reach_are_reported_as_for_a_held_sweep(tmp_path, capsys, m
     code, out, held_err = run(["sweep", GEOMETRY, sweep, "-o", tmp_path / "held.csv"], capsys)
     assert code == 1 and "did not converge" in held_err
     monkeypatch.setattr(sweep_command, "STREAM_STEPS", 300)
-    monkeypatch.setattr(pin_susp.corner.Corner.run_sweep_chunks, "__defaults__", (250, None))
+    monkeypatch.setattr(
+        pin_susp.subjects.corner.Corner.run_sweep_chunks, "__defaults__", (250, None)
+    )
     code, _, err = run(["sweep", GEOMETRY, sweep, "-o", tmp_path / "streamed.csv"], capsys)
     assert code == 1 and err == held_err
     held = pd.read_csv(tmp_path / "held.csv", comment="#")
@@ -105,7 +111,7 @@ def test_steps_out_of_reach_are_reported_as_for_a_held_sweep(tmp_path, capsys, m
 
 def test_an_interrupt_part_way_leaves_no_file(tmp_path, monkeypatch, small_chunks):
     sweep = sweep_file(tmp_path, 700)
-    chunks = pin_susp.corner.Corner.run_sweep_chunks
+    chunks = pin_susp.subjects.corner.Corner.run_sweep_chunks
 
     def interrupted(self, *args, **kwargs):
         for i, part in enumerate(chunks(self, *args, **kwargs)):
@@ -113,7 +119,7 @@ def test_an_interrupt_part_way_leaves_no_file(tmp_path, monkeypatch, small_chunk
                 raise KeyboardInterrupt
             yield part
 
-    monkeypatch.setattr(pin_susp.corner.Corner, "run_sweep_chunks", interrupted)
+    monkeypatch.setattr(pin_susp.subjects.corner.Corner, "run_sweep_chunks", interrupted)
     before = set(tmp_path.iterdir())
     code = main(["sweep", str(GEOMETRY), str(sweep), "-o", str(tmp_path / "out.csv"), "-q"])
     assert code != 0
@@ -124,8 +130,8 @@ def test_no_more_than_two_chunks_are_alive(tmp_path, monkeypatch, small_chunks):
     """What keeps memory flat: when a chunk starts solving, the chunks before it are
     gone (garbage) but the one being written, so a sweep of any length holds two chunks
     of rows at most."""
-    chunks = pin_susp.corner.Corner.run_sweep_chunks
-    solve = pin_susp.corner.Corner.solve_steps
+    chunks = pin_susp.subjects.corner.Corner.run_sweep_chunks
+    solve = pin_susp.subjects.corner.Corner.solve_steps
     refs, alive = [], []
 
     def watched(self, *args, **kwargs):
@@ -139,8 +145,8 @@ def test_no_more_than_two_chunks_are_alive(tmp_path, monkeypatch, small_chunks):
         alive.append(sum(ref() is not None for ref in refs))
         return solve(self, *args, **kwargs)
 
-    monkeypatch.setattr(pin_susp.corner.Corner, "run_sweep_chunks", watched)
-    monkeypatch.setattr(pin_susp.corner.Corner, "solve_steps", solving)
+    monkeypatch.setattr(pin_susp.subjects.corner.Corner, "run_sweep_chunks", watched)
+    monkeypatch.setattr(pin_susp.subjects.corner.Corner, "solve_steps", solving)
     sweep = sweep_file(tmp_path, 2000)
     assert main(["sweep", str(GEOMETRY), str(sweep), "-o", str(tmp_path / "o.csv"), "-q"]) == 0
     assert len(refs) == 8 and max(alive) <= 1, alive
@@ -149,7 +155,7 @@ def test_no_more_than_two_chunks_are_alive(tmp_path, monkeypatch, small_chunks):
 def test_a_sweep_too_long_to_hold_is_refused_where_it_would_be_held(tmp_path, capsys, monkeypatch):
     """--plot holds every step: a sweep too long for memory gets one clear line (exit 2);
     without --plot the same sweep is streamed."""
-    from pin_susp import sweep as sweeps
+    from pin_susp.model import sweep as sweeps
 
     monkeypatch.setattr(sweeps, "_available_memory", lambda: 2 * 12_500 * 500)
     sweep = sweep_file(tmp_path, 600)

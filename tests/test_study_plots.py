@@ -16,8 +16,8 @@ import yaml
 from pin_susp.cli import main
 from pin_susp.plots import save_figure
 from pin_susp.study import Variable, load_study
-from pin_susp.study_plots import TOP, describe, study_figure
-from pin_susp.study_summary import main_effects
+from pin_susp.study.plots import TOP, describe, study_figure
+from pin_susp.study.summary import main_effects
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 SUMMARY = ["camber", "roadwheel_angle", "deriv_roadwheel_angle_wrt_hub_z"]

@@ -12,9 +12,10 @@ import pytest
 from conftest import EXAMPLES
 
 import pin_susp
-from pin_susp import pointwise, solver
-from pin_susp.axle import AxleModel, load_axle, solve_axle_sweep
-from pin_susp.sweep import load_sweep
+from pin_susp.analyses import pointwise
+from pin_susp.model.sweep import load_sweep
+from pin_susp.solve import solver
+from pin_susp.subjects.axle import AxleModel, load_axle, solve_axle_sweep
 from pin_susp.validate import scope_of
 
 # The sweep: examples/roll.yaml to 89° over 11 steps (steps 1–10 out of reach).

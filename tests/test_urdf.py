@@ -10,7 +10,7 @@ import yourdfpy
 from conftest import EXAMPLES, ROOT
 
 import pin_susp
-from pin_susp.urdf import read_closures
+from pin_susp.model.urdf import read_closures
 
 # corner files: a top-level hardpoints block (an axle file, scope: axle, has no corner
 # URDF of its own yet; a study file's all_hardpoints is no geometry)

@@ -21,12 +21,12 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import JointIndex
 
 import pin_susp
-from pin_susp.axle import AxleModel, load_axle
 from pin_susp.cli import main
 from pin_susp.errors import PinSuspError
-from pin_susp.mjcf import tree_to_mjcf
-from pin_susp.rates import RATE_COLUMNS
-from pin_susp.urdf import read_closures
+from pin_susp.model.mjcf import tree_to_mjcf
+from pin_susp.model.urdf import read_closures
+from pin_susp.solve.rates import RATE_COLUMNS
+from pin_susp.subjects.axle import AxleModel, load_axle
 from pin_susp.validate import (
     CornerScope,
     DrakeCorner,

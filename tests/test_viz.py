@@ -14,8 +14,8 @@ from conftest import EXAMPLES, example, mirrored, sweep_csv
 
 import pin_susp
 from pin_susp.cli import main
-from pin_susp.drawing import drawing_figure
 from pin_susp.plots import ResultsFile, panels, report_figure
+from pin_susp.viz.drawing import drawing_figure
 
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 
@@ -67,7 +67,7 @@ def test_replay_renders_the_suspension_in_headless_chromium(replay, tmp_path):
 
 
 def test_scene_animates_one_frame_per_converged_step():
-    from pin_susp.viz import CornerScene
+    from pin_susp.viz.scene import CornerScene
 
     corner = pin_susp.Corner(EXAMPLES / "camber_shim.yaml")
     results = corner.run_sweep(EXAMPLES / "bump_steer.yaml")
@@ -318,7 +318,7 @@ def _transform(commands: list[dict], path: str) -> np.ndarray:
 
 @pytest.mark.parametrize("name", ["double_wishbone", "camber_shim", "right"])
 def test_scene_has_the_ground_at_the_contact_patch_and_the_camera_on_the_corner(name):
-    from pin_susp.viz import CornerScene, bounds
+    from pin_susp.viz.scene import CornerScene, bounds
 
     if name == "right":
         corner = pin_susp.Corner(mirrored(example("double_wishbone.yaml")))

@@ -10,7 +10,7 @@ from conftest import EXAMPLES, example, mirrored
 
 import pin_susp
 from pin_susp.cli import main
-from pin_susp.sweep import Sweep, Target
+from pin_susp.model.sweep import Sweep, Target
 
 RACK = np.linspace(-40.0, 40.0, 9)  # the example's rack from lock to lock, mm
 

@@ -10,7 +10,7 @@ from conftest import EXAMPLES
 
 from pin_susp.cli import main
 from pin_susp.errors import InputError
-from pin_susp.yamlio import MAX_DEPTH, MAX_LENGTH_MM, Reader, load_yaml
+from pin_susp.io.yamlio import MAX_DEPTH, MAX_LENGTH_MM, Reader, load_yaml
 
 
 def write(tmp_path, content: str | bytes, name: str = "corner.yaml"):

@@ -33,7 +33,7 @@ def geometry_argument(parser: argparse.ArgumentParser) -> None:
 
 def numbers(text: str) -> list[float]:
     """Lengths in mm separated by commas: finite, within the 100 m limit of any car."""
-    from ..yamlio import MAX_LENGTH_MM
+    from ..io.yamlio import MAX_LENGTH_MM
 
     try:
         values = [float(x) for x in text.split(",")]

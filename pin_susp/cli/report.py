@@ -105,7 +105,7 @@ class Digest:
     def add(self, results) -> None:
         import numpy as np
 
-        from ..metrics import METRICS
+        from ..columns.metrics import METRICS
 
         steps = np.asarray(results["step_index"])
         ok = np.asarray(results["solver_converged"], dtype=bool)
@@ -207,7 +207,7 @@ class Digest:
 
 
 def summary(results, path) -> None:
-    from ..metrics import METRIC_BY_NAME
+    from ..columns.metrics import METRIC_BY_NAME
 
     d = Digest.of(results)
     print(

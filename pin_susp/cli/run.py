@@ -25,7 +25,7 @@ def execute(args) -> int:
     interrupt or SIGTERM/SIGHUP as 128 + the signal, a closed pipe as success."""
     import numpy as np
 
-    from ..yamlio import read_once
+    from ..io.yamlio import read_once
     from .report import print_warnings
 
     with (

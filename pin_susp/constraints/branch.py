@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from ..jet import cross
+from ..maths.jet import cross
 from .kinematics import Kinematics
 
 

@@ -9,8 +9,8 @@ from dataclasses import dataclass, field
 import matplotlib.pyplot as plt
 import numpy as np
 
+from ..columns.metrics import METRIC_BY_NAME, Derivative
 from ..errors import InputError
-from ..metrics import METRIC_BY_NAME, Derivative
 from .results_file import ResultsFile
 
 LABELS = {  # columns the registry does not hold

@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..columns.metrics import HUB_Z, RACK, STANDARD
 from ..errors import InputError, PinSuspError
-from ..metrics import HUB_Z, RACK, STANDARD
 from .axes import (
     STEP_X,
     Panel,

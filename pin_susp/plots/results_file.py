@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
-from ..yamlio import read_input
+from ..io.yamlio import read_input
 
 EXTRA = (
     "svic_z",

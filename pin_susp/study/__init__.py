@@ -25,9 +25,8 @@ directory: manifest, part files, resume), ``cluster`` (Dask), ``run`` (a run).
 # ruff: noqa: F401 (the package's names, importable from pin_susp.study as before)
 from __future__ import annotations
 
-from ..axle_file import holds_wheels
 from ..errors import InputError
-from ..study_summary import summary_lines
+from ..subjects.axle_file import holds_wheels
 from .data import AXES, MISS, Job, Term, Variable, objective_residuals
 from .derivatives import linear_prediction, objective_jacobian, sensitivities
 from .folder import INFORMATION, finished_batches, read_steps, write_geometry
@@ -45,6 +44,7 @@ from .spec import (
     batches,
     load_study,
 )
+from .summary import summary_lines
 from .tasks import run_batch, run_start
 from .variants import Variant, build, variant_data, variant_table
 

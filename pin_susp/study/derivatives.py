@@ -62,7 +62,7 @@ def sensitivities(subject, sweep, results) -> tuple:
     Sensitivity}), one-sided names (``left_…``) on labelled corners; no steps where the
     sweep holds other than they hold (``Assembly.sensitivities_hold``: an axle's roll or
     heave sweep)."""
-    from ..sensitivity import SubjectSensitivity
+    from ..analyses.sensitivity import SubjectSensitivity
 
     model = SubjectSensitivity(subject, one_sided=True)
     at_design, steps = model.at(), {}
@@ -80,7 +80,7 @@ def linear_prediction(study: Study, variants) -> dict[str, np.ndarray] | None:
     variant, for ``<metric>_static``, ``_min`` and ``_max`` — the steps' only where the
     sweep holds what the sensitivities hold (``Assembly.sensitivities_hold``: an axle's
     roll or heave sweep, the static column alone)."""
-    from ..sweep import load_sweep
+    from ..model.sweep import load_sweep
 
     job = study.job()
     sweep = load_sweep(study.sweep_data)

@@ -14,10 +14,10 @@ import numpy as np
 
 from .. import __version__
 from ..errors import NoRoom
-from ..study_summary import summary_lines
 from . import cluster, folder, tasks
 from .derivatives import linear_prediction
 from .spec import MANIFEST, PARTS, Study, batches, load_study
+from .summary import summary_lines
 from .variants import Variant, variant_table
 
 
@@ -167,7 +167,7 @@ def _run(study, outdir, client, steps, resume, progress, dashboard, warn=None) -
             folder.write_geometry(study, best, outcome.best, comment.rstrip())
         if variants["converged"].any():
             from ..plots import save_figure
-            from ..study_plots import study_figure
+            from .plots import study_figure
 
             outcome.figure = outdir / "study.png"
             save_figure(study_figure(study, variants, outcome.linear, curves), outcome.figure)
@@ -184,7 +184,7 @@ def best_row(variants):
 def curves_of(study: Study, deltas) -> list[dict]:
     """Per objective term: the metric over the sweep before (design) and after (the
     variables at ``deltas``), and the target — for the figure."""
-    from ..sweep import load_sweep
+    from ..model.sweep import load_sweep
 
     job = study.job()
     sweep = load_sweep(study.sweep_data)

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..yamlio import Reader, load_yaml, read_once
+from ..io.yamlio import Reader, load_yaml, read_once
 from .data import AXES, Job, Term, Variable
 from .variants import at_design, build
 
@@ -221,7 +221,7 @@ class _Design:
     def __init__(self, geometry: dict, geometry_path: str, sweep_path: str):
         # errors name the files, as `pin-susp sweep` would
         self.subject = subject = build(geometry, geometry_path)
-        from ..sweep import load_sweep
+        from ..model.sweep import load_sweep
 
         self.sweep = load_sweep(sweep_path)
         subject.check_sweep(self.sweep)

@@ -17,7 +17,7 @@ def run_batch(job: Job, index: int, ids: np.ndarray, table: np.ndarray, steps: b
     """Solve one batch of variants: its summary rows and, with ``steps``, every step.
 
     Returns plain data (Arrow IPC bytes) so that any scheduler can carry it."""
-    from ..sweep import load_sweep
+    from ..model.sweep import load_sweep
 
     sweep = load_sweep(job.sweep)
     rows, frames = [], []
@@ -34,7 +34,7 @@ def run_start(job: Job, index: int, ids: np.ndarray, table: np.ndarray, steps: b
     the exact hardpoint sensitivities as its Jacobian; the optimum's row."""
     from scipy.optimize import least_squares
 
-    from ..sweep import load_sweep
+    from ..model.sweep import load_sweep
 
     sweep = load_sweep(job.sweep)
     low, high = job.bounds

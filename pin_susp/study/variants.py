@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import InputError, PinSuspError
-from ..subject import kind_of
+from ..subjects.subject import kind_of
 from .data import AXES, Job, Variable, missed, objective_residuals
 
 if TYPE_CHECKING:
@@ -90,7 +90,7 @@ def build(data: dict, source: str, variant: bool = False):
 
 def at_design(sweep):
     """A one-step sweep holding every target at its design value."""
-    from ..sweep import Sweep
+    from ..model.sweep import Sweep
 
     return Sweep([t.at_design() for t in sweep.targets], sweep.source, sweep.sha256)
 
@@ -99,7 +99,7 @@ class Variant:
     """One variant's geometry solved through the sweep: its results and design state."""
 
     def __init__(self, job: Job, deltas: np.ndarray, sweep=None, every_column: bool = True):
-        from ..sweep import load_sweep
+        from ..model.sweep import load_sweep
 
         self.job = job
         self.deltas = np.asarray(deltas, dtype=float)

@@ -74,7 +74,7 @@ def validate(
     ``subject``: an Assembly (a Corner, an AxleModel). Returns (results, reports), the reports
     in the order of ENGINES. ``mjcf_text`` (MuJoCo's) and ``urdf_text`` (Drake's)
     default to the subject's own export; given, each must be that export
-    (:func:`pin_susp.mjcf.check_mjcf`, :func:`check_urdf`, checked before any
+    (:func:`pin_susp.model.mjcf.check_mjcf`, :func:`check_urdf`, checked before any
     solving) and ``mjcf_source`` / ``urdf_source`` name it in errors (the file's
     path). A file that is not this corner's (axle's) model, or that its engine
     cannot load, raises PinSuspError; the engines' warnings are counted in the
@@ -82,7 +82,7 @@ def validate(
     MUJOCO_LOG.TXT). An engine that is not installed, or cannot model the
     subject, gets a report with a ``note`` saying why.
     """
-    from ..mjcf import check_mjcf
+    from ..model.mjcf import check_mjcf
 
     unknown = [e for e in engines if e not in ENGINES]
     if unknown:
@@ -128,7 +128,7 @@ def _not_installed(engine: str, module: str) -> EngineReport | None:
 def _engine_report(engine, scope, sweep, results, text, source, tolerance) -> EngineReport:
     """An engine's comparison (mujoco from the MJCF, drake from the URDF): the text
     given, else the subject's own export; a report saying how to install it if missing."""
-    from ..mjcf import tree_to_mjcf
+    from ..model.mjcf import tree_to_mjcf
 
     module, points_of, fmt = {
         "mujoco": ("mujoco", mujoco_run, "MJCF"),

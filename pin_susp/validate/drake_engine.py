@@ -12,9 +12,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..analyses.pointwise import Along, as_target
 from ..errors import PinSuspError
-from ..pointwise import Along, as_target
-from ..urdf import NAMESPACE, read_closures, tree_to_urdf
+from ..model.urdf import NAMESPACE, read_closures, tree_to_urdf
 from .engines import Warnings, target_rows, with_contact_patches
 from .scopes import scope_of
 
@@ -81,7 +81,7 @@ class DrakeCorner:
 
     Drake's own URDF parser builds the ``MultibodyPlant`` (the root link welded
     to the world); the loop closures are read back from the same text
-    (:func:`pin_susp.urdf.read_closures`): a ball closure is a position
+    (:func:`pin_susp.model.urdf.read_closures`): a ball closure is a position
     constraint (one anchor at the other, in its link's frame), a distance
     closure a point-to-point distance constraint at the length Drake's plant
     has at the design configuration (all joints 0). A target along a direction
@@ -324,7 +324,7 @@ def drake_run(scope, sweep, urdf_text: str, source: str):
 
 
 def check_urdf(text: str, tree, source: str = "URDF") -> None:
-    """Raise PinSuspError unless ``text`` is the URDF :func:`pin_susp.urdf.tree_to_urdf`
+    """Raise PinSuspError unless ``text`` is the URDF :func:`pin_susp.model.urdf.tree_to_urdf`
     writes for ``tree``: XML with a ``<robot>`` root holding the same links, the same
     joints (type, parent, child) and the same loop closures (type, the links of their
     frames). Positions and axes are not compared: the URDF of a corner whose hardpoints
@@ -335,7 +335,7 @@ def check_urdf(text: str, tree, source: str = "URDF") -> None:
 
 
 def _urdf_problem(text: str, tree) -> str | None:
-    from ..urdf import model_file_root, not_this_model
+    from ..model.urdf import model_file_root, not_this_model
 
     root, problem = model_file_root(text, "URDF")
     if problem:

@@ -7,8 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..analyses.pointwise import as_target
 from ..constraints import ContactPatchPoint
-from ..pointwise import as_target
 from .scopes import scope_of
 
 STEP = 1e-3  # m: the drivers' step for the engines' rates (±STEP, ±2·STEP)

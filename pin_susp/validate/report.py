@@ -89,7 +89,7 @@ class Branches:
 
     def __init__(self, tree):
         from ..constraints import MEASURES, LoopBranch, chirality, pick_branch
-        from ..deadcentre import tree_point_name
+        from ..model.deadcentre import tree_point_name
 
         design = {name: p.tolist() for name, (_, p) in tree.points.items()}
         self.checks = []  # (what flipped, measure, four point names, sign at design)

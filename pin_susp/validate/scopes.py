@@ -8,16 +8,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..jet import Dual
-from ..jet import value as plain
-from ..metrics import METRICS
-from ..pointwise import Along, PointwiseLinkage, Y, Z, labelled, sweep_values, targets_at
+from ..analyses.pointwise import Along, PointwiseLinkage, Y, Z, labelled, sweep_values, targets_at
+from ..columns.metrics import METRICS
+from ..maths.jet import Dual
+from ..maths.jet import value as plain
 
 RATE_METRICS = {m.name for m in METRICS if m.rates}
 
 
 def step_targets(subject, sweep) -> list[list]:
-    """Every step's targets as point-based targets (:mod:`pin_susp.pointwise`): a
+    """Every step's targets as point-based targets (:mod:`pin_susp.analyses.pointwise`): a
     point's coordinate along a direction (absolute, m), an axle's heave and roll."""
     return scope_of(subject).step_targets(sweep)
 

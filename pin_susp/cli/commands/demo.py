@@ -34,11 +34,11 @@ def run(args) -> int:
 
     import yaml
 
-    from ...corner import Corner
-    from ...geometry import load_geometry
     from ...io.atomic import all_or_none, check_folder, write_text
     from ...io.tables import csv_text
-    from ...sweep import load_sweep
+    from ...model.geometry import load_geometry
+    from ...model.sweep import load_sweep
+    from ...subjects.corner import Corner
 
     if str(args.output).strip() == "":
         raise PinSuspError(f"{args.output!r}: the demo writes several files: give a folder")
@@ -91,10 +91,10 @@ def _demo_pictures(corner, results, files, csv: str) -> None:
     import contextlib
     import io
 
-    from ...drawing import drawing_figure
     from ...io.atomic import write_text
     from ...plots import ResultsFile, report_figure, save_figure
-    from ...viz import CornerScene
+    from ...viz.drawing import drawing_figure
+    from ...viz.scene import CornerScene
 
     written = ResultsFile(files["results"], raw=csv.encode())
     save_figure(report_figure([written]), files["plots"])

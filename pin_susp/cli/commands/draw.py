@@ -65,9 +65,9 @@ def _step(args) -> tuple[str, str | None]:
 
 
 def run(args) -> int:
-    from ...drawing import subject_figure
     from ...plots import ResultsFile, save_figure
-    from ...subject import load_subject, subject_class
+    from ...subjects.subject import load_subject, subject_class
+    from ...viz.drawing import subject_figure
 
     check_outputs(args, args.output)
     check_image(args.output)

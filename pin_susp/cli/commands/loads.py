@@ -58,9 +58,9 @@ def run(args) -> int:
 def load_inputs(geometry, sweep, cases):
     """A corner or an axle, its sweep and load cases, every input error said before any
     work."""
-    from ...loads import Statics, load_cases
-    from ...subject import load_subject
-    from ...sweep import load_sweep
+    from ...analyses.loads import Statics, load_cases
+    from ...model.sweep import load_sweep
+    from ...subjects.subject import load_subject
 
     subject = load_subject(geometry)
     sweep = load_sweep(sweep)
@@ -72,7 +72,7 @@ def load_inputs(geometry, sweep, cases):
 
 def solve_forces(corner, sweep, cases, quiet: bool):
     """The sweep's results and, at every step and load case, the forces."""
-    from ...loads import member_forces
+    from ...analyses.loads import member_forces
 
     solutions, results = corner.solve_sweep(sweep, progress=progress_bar(sweep.steps, quiet))
     return results, member_forces(corner, sweep, cases, solutions, results)

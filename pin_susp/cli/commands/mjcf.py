@@ -22,8 +22,8 @@ def arguments(parser) -> None:
 
 def run(args) -> int:
     from ...io.atomic import write_text
-    from ...mjcf import tree_to_mjcf
-    from ...subject import load_subject
+    from ...model.mjcf import tree_to_mjcf
+    from ...subjects.subject import load_subject
 
     check_outputs(args, args.output)
     subject = load_subject(args.geometry)  # a corner, or both corners on one chassis

@@ -51,15 +51,15 @@ def run(args) -> int:
     """Each labelled corner's columns (an axle's suffixed _left, _right) and the subject's
     own of its corners together (an axle's track, roll centre, roll rates); an axle's
     points moved symmetrically on both sides, or one side alone (--one-sided)."""
-    from ...sensitivity import (
+    from ...analyses.sensitivity import (
         ONE_SIDED_MOVE,
         SYMMETRIC_MOVE,
         SubjectSensitivity,
         select_points,
         subject_sensitivities,
     )
-    from ...subject import load_subject, subject_class
-    from ...sweep import load_sweep
+    from ...model.sweep import load_sweep
+    from ...subjects.subject import load_subject, subject_class
 
     check_outputs(args, args.output)
     # a labelled corner's points move alone; a corner's one, unlabelled, has no other
@@ -109,7 +109,7 @@ def _sensitivity_report(
     """The CSV (``csv_notes`` in its head), the steps without sensitivities, and the
     printed table: a title, ``notes``, then per group (heading, columns) the largest
     entries among ``points``. The exit code."""
-    from ...sensitivity import POINT_GROUPS
+    from ...analyses.sensitivity import POINT_GROUPS
 
     if args.output is not None:
         _sensitivity_csv(states, geometry.source, args.output, csv_notes)
@@ -140,7 +140,7 @@ def _sensitivity_table(s, names, top: int, points: set) -> None:
     columns these points do not move, and those undefined here."""
     import numpy as np
 
-    from ...sensitivity import STEP, largest
+    from ...analyses.sensitivity import STEP, largest
 
     unmoved, undefined = [], []
     for name in names:

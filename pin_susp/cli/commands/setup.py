@@ -105,9 +105,9 @@ SETUP_COLUMNS = ("shim_thickness", "trackrod_length_delta", "pushrod_length_delt
 def run(args) -> int:
     import numpy as np
 
-    from ... import setup
+    from ...analyses import setup
     from ...io.atomic import all_or_none
-    from ...subject import load_drawn
+    from ...subjects.subject import load_drawn
 
     check_outputs(args, args.output, args.csv)
     targets = {

@@ -42,8 +42,8 @@ def run(args) -> int:
     check_outputs(args, args.output, args.plot)  # before the numerics are imported
     if args.plot is not None:
         check_image(args.plot)
-    from ...subject import load_subject
-    from ...sweep import load_sweep
+    from ...model.sweep import load_sweep
+    from ...subjects.subject import load_subject
 
     subject = load_subject(args.geometry)  # a corner, or an axle: its columns per side
     sweep = load_sweep(args.sweep)

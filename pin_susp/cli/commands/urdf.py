@@ -31,7 +31,7 @@ def arguments(parser) -> None:
 
 def run(args) -> int:
     from ...io.atomic import all_or_none, is_stream, write_text
-    from ...subject import load_subject, subject_class
+    from ...subjects.subject import load_subject, subject_class
 
     if args.at is not None and args.output is None:
         raise PinSuspError("--at writes a sidecar beside the URDF: give -o OUT.urdf too")
@@ -63,7 +63,7 @@ def run(args) -> int:
 
 def _pose_at(corner, at: str) -> dict:
     """Joint values of one solved sweep step, by joint name (rad, m)."""
-    from ...sweep import load_sweep
+    from ...model.sweep import load_sweep
 
     path, _, step = at.rpartition(":")
     if not path or not re.fullmatch(r"[0-9]{1,9}", step):

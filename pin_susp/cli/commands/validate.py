@@ -49,10 +49,10 @@ def arguments(parser) -> None:
 
 
 def run(args) -> int:
-    from ...subject import load_subject
-    from ...sweep import load_sweep
+    from ...io.yamlio import read_input
+    from ...model.sweep import load_sweep
+    from ...subjects.subject import load_subject
     from ...validate import validate
-    from ...yamlio import read_input
 
     corner = load_subject(args.geometry)
     sweep = load_sweep(args.sweep)

@@ -42,9 +42,9 @@ def run(args) -> int:
     import time
 
     from ...io.atomic import write_text
-    from ...subject import load_subject
-    from ...sweep import load_sweep
-    from ...viz import Scene, force_caption, force_key, roll_centres, signals_held
+    from ...model.sweep import load_sweep
+    from ...subjects.subject import load_subject
+    from ...viz.scene import Scene, force_caption, force_key, roll_centres, signals_held
 
     check_outputs(args, args.html)
     if args.case is not None and args.cases is None:

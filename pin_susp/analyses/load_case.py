@@ -1,0 +1,113 @@
+"""Load-case files (docs/loads.md): the loads on each wheel, world (chassis) axes —
+a force at the contact patch, a force at the wheel centre, a moment — one case a
+row of ``pin-susp loads``' table; a corner's at each case's top, each of an axle's
+corners in a block of its label's name (``left:``, ``right:``)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..io.yamlio import Reader, load_yaml
+
+CASE_KEYS = ("contact_patch", "wheel_center", "moment")
+SIDES = ("left", "right")  # an axle's corners: a block of loads each
+
+
+@dataclass(frozen=True)
+class LoadCase:
+    """Loads on one wheel, world (chassis) axes: force at the contact patch (N, the
+    road on the tyre), force at the wheel centre (N) and a moment (N·m)."""
+
+    name: str
+    contact_patch: np.ndarray
+    wheel_center: np.ndarray
+    moment: np.ndarray
+
+    def wheel(self, label: str) -> LoadCase:
+        """The loads on a corner's wheel by its label: a corner's one (``""``)."""
+        return self
+
+
+@dataclass(frozen=True)
+class AxleLoadCase:
+    """An axle's load case: one LoadCase per wheel (a side not given: no load)."""
+
+    name: str
+    left: LoadCase
+    right: LoadCase
+
+    def wheel(self, label: str) -> LoadCase:
+        """The loads on the wheel of the corner labelled ``left`` or ``right``."""
+        return getattr(self, label)
+
+
+def load_cases(source, axle: bool = False, labels: tuple[str, ...] | None = None) -> list:
+    """Read a load-case file (docs/loads.md): ``cases:`` a list of {name,
+    contact_patch: {fx, fy, fz}, wheel_center: {…}, moment: {mx, my, mz}}. The loads
+    are per corner of the subject whose ``labels`` are given (default: an axle's
+    ``left``, ``right`` with ``axle``, else a corner's ``""``): a corner labelled ``""``
+    has them at the case's top, each labelled one in a block of its label's name."""
+    labels = (SIDES if axle else ("",)) if labels is None else tuple(labels)
+    blocks = tuple(label for label in labels if label)  # the corners named in the file
+    data, name, _ = load_yaml(source)
+    r = Reader(name)
+    r.mapping(data, "", required=("cases",), optional=("version",))
+    if "version" in data and data["version"] != 1:
+        r.fail("version", f"expected 1 (this file format's version), got {data['version']!r}")
+    cases = data["cases"]
+    if not isinstance(cases, list) or not cases:
+        r.fail("cases", "expected a list of load cases")
+    out, seen = [], set()
+    for i, case in enumerate(cases):
+        key = f"cases[{i}]"
+        if not blocks and isinstance(case, dict):
+            for side in SIDES:
+                if side in case:
+                    r.fail(f"{key}.{side}", "a side block is for an axle's load cases")
+        r.mapping(case, key, required=("name",), optional=(*CASE_KEYS, *blocks))
+        title = str(r.text(case["name"], f"{key}.name")).strip()
+        if not title:
+            r.fail(f"{key}.name", "empty: name the case")
+        if title in seen:
+            r.fail(f"{key}.name", f"{title!r} names two cases")
+        seen.add(title)
+        if not blocks:
+            out.append(_wheel_loads(case, key, title, r))
+            continue
+        for part in CASE_KEYS:
+            if part in case:
+                r.fail(f"{key}.{part}", "an axle's loads go in left: and right: blocks")
+        if not any(b in case for b in blocks):
+            r.fail(key, "an axle's case needs a left: or right: block of loads")
+        wheels = {
+            b: _wheel_loads(r.mapping(case.get(b, {}), f"{key}.{b}", optional=CASE_KEYS),
+                            f"{key}.{b}", str(title), r)
+            for b in blocks
+        }  # fmt: skip
+        out.append(AxleLoadCase(str(title), **wheels))
+    return out
+
+
+def _wheel_loads(case: dict, key: str, title: str, r: Reader) -> LoadCase:
+    """One wheel's loads: each block given in full (a block left out: no such load)."""
+    vectors = {}
+    for part, axes in (("contact_patch", "f"), ("wheel_center", "f"), ("moment", "m")):
+        names = tuple(f"{axes}{a}" for a in "xyz")
+        given = part in case
+        block = r.mapping(
+            case.get(part, {}), f"{key}.{part}", required=names if given else (), optional=names
+        )
+        vectors[part] = np.array([_load(block.get(n, 0.0), f"{key}.{part}.{n}", r) for n in names])
+    return LoadCase(title, **vectors)
+
+
+MAX_LOAD = 1e7  # N and N·m: far beyond any wheel's (a unit mistake, or a typo)
+
+
+def _load(value, key: str, r: Reader) -> float:
+    x = r.number(value, key)
+    if abs(x) > MAX_LOAD:
+        r.fail(key, f"{x:g} is beyond {MAX_LOAD:g} (N, N·m): no wheel carries that")
+    return x

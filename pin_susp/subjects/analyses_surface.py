@@ -1,0 +1,138 @@
+"""What the analyses ask every subject (README, How it works): the defaults of an
+Assembly's answers to setup, drawings and hardpoint sensitivities, for a corner; an
+axle's own answers are in axle_file.AxleAssembly. Kept apart from assembly.py, whose
+job is the subject's targets, sweep and columns.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+from ..errors import InputError
+
+
+class AnalysesSurface:
+    """The analyses' questions to an :class:`~pin_susp.subjects.assembly.Assembly`, with a
+    corner's answers as the defaults (``labels``, ``corners``, ``source`` and
+    ``solve_sweep`` are the Assembly's)."""
+
+    # -- setup and sensitivity (setup.py, sensitivity.py, their commands) ----------
+
+    @classmethod
+    def as_drawn(cls, path, label: str | None = None):
+        """The subject of a geometry file as the file draws it, for the setup analyses:
+        its labels, its corners as drawn, its source, name and setup answers, but no
+        model built and no setup applied (a setup that cannot be applied is the setup
+        analysis's to report). ``label``: a setup option's (``--side``), refused here
+        where the kind has no such label, before the file is read further."""
+        raise NotImplementedError
+
+    @property
+    def drawn_corners(self) -> dict:
+        """label → the corner's Geometry as drawn, with its setup values (its shim stack
+        and length deltas as the file gives them): what the setup analyses vary."""
+        return {label: g.drawn or g for label, g in self.corners.items()}
+
+    def setup_labels(self, label: str | None = None) -> tuple[str, ...]:
+        """The labels a setup option sets (``--side``): every corner's, or ``label``'s
+        alone."""
+        if label is None:
+            return self.labels
+        if label not in self.labels:
+            known = " or ".join(self.labels)
+            raise InputError("--side", "", f"unknown side {label!r} ({known})")
+        return (label,)
+
+    def setup_owner(self, label: str) -> str:
+        """The label whose setup a corner takes: its own (a mirrored axle's right side:
+        the left's)."""
+        return label
+
+    def file_key(self, label: str, key: str) -> str:
+        """A key of a corner's setup as the subject's file names it (a corner's own file:
+        as it is)."""
+        return key
+
+    def setup_error(self, label: str, exc: InputError) -> InputError:
+        """A corner's setup error as the subject reports it: a labelled corner's names its
+        label, and its file's key as the file spells it."""
+        if not label:
+            return exc
+        key = self.file_key(label, exc.key) if exc.source == self.source else exc.key
+        return InputError(exc.source, key, f"{label} corner: {exc.problem}")
+
+    def setup_data(self, geometries: dict) -> dict:
+        """The subject's file data with each given corner's setup (label → Geometry)
+        written in."""
+        raise NotImplementedError
+
+    # -- drawings (drawing.py, pin-susp draw) ----------------------------------------
+
+    # the views its drawing shows: a corner's front and side; the front alone where its
+    # corners stand side by side on one road (an axle's: the roll centre where each
+    # contact patch's line through its instant centre crosses the other)
+    drawing_views: tuple[str, ...] = ("front", "side")
+    # whether it is drawn at a step of its sweep results too (draw --from-results), not
+    # only at its design state
+    drawn_at_steps: bool = False
+
+    # -- hardpoint sensitivities (sensitivity.py, its command) ---------------------
+
+    # the points its shared elements add (an axle's bar and heave link), no corner's
+    # hardpoints: their sensitivities are not computed
+    element_points: frozenset[str] = frozenset()
+    # its own columns of its corners together that its sensitivities give, after each
+    # corner's (an axle's track, roll centre, ...; a corner: none)
+    sensitivity_columns: tuple[str, ...] = ()
+
+    def corner_linkage(self, label: str):
+        """The Linkage of a labelled corner alone, as set: its sensitivities' model."""
+        from ..solve.linkage import Linkage
+
+        return Linkage(self.corners[label])
+
+    def sensitivity_sweep(self, sweep) -> tuple[list, object]:
+        """A sweep solved for its sensitivities: its steps' solutions, and the results the
+        failure report reads (the steps without sensitivities): here every column."""
+        return self.solve_sweep(sweep)
+
+    def held_at(self, sweep, step: int) -> list | None:
+        """What its sensitivities hold at a sweep's step: the sweep's targets there (None:
+        each corner's wheel-centre height and rack as solved there)."""
+        return [replace(t, values=t.values[step]) for t in sweep.targets]
+
+    def sensitivities_hold(self, sweep) -> bool:
+        """Whether its hardpoint sensitivities at a sweep's steps hold what the sweep
+        holds: a corner's hold the sweep's own targets (``held_at``) (an axle's, each
+        wheel centre's height and the rack alone)."""
+        return True
+
+    def sensitivity_held(self) -> str | None:
+        """What its sensitivities hold, as its table and CSV say it (None: the sweep's
+        targets, or the design's, unsaid)."""
+        return None
+
+    def sensitivity_groups(self, columns: list[str]) -> list[tuple[str, list]]:
+        """The printed table's groups, (heading, columns): each labelled corner's own
+        (a corner's one: every column, no heading); a corner that takes another's setup
+        (a mirrored axle's right side) mirrors it, and is left out."""
+        groups = []
+        for label in self.labels:
+            if self.setup_owner(label) == label:
+                suffix = self.suffix(label)
+                names = [n for n in columns if n.endswith(suffix)]
+                heading = f"the {label} corner (columns suffixed {suffix}):" if label else ""
+                groups.append((heading, names))
+        return groups
+
+    # -- studies (study/) -----------------------------------------------------------
+
+    def sweep_and_design(self, sweep, only=None) -> tuple[object, dict]:
+        """A sweep's results and its design state's columns (name → a one-value array),
+        each solved as ``pin-susp sweep`` solves it (the design: every target at its
+        design value); ``only``: the columns wanted (a subject may give every one): a
+        study's variant."""
+        from ..model.sweep import Sweep
+
+        design = Sweep([t.at_design() for t in sweep.targets], sweep.source, sweep.sha256)
+        return self.solve_sweep(sweep)[1], self.solve_sweep(design)[1].columns

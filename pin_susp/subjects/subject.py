@@ -1,0 +1,111 @@
+"""The one place that reads which kind of subject a geometry file holds: a corner's
+file, or an axle's (``scope: axle``, docs/axle.md), and builds it.
+
+:func:`load_subject` returns a :class:`~pin_susp.subjects.corner.Corner` or an
+:class:`~pin_susp.subjects.axle.AxleModel`, both an :class:`~pin_susp.subjects.assembly.Assembly`:
+what takes one asks the Assembly's surface, not its kind. :func:`kind_of` gives how a
+subject is built from its file's data, as a study builds its design and its variants.
+"""
+
+from __future__ import annotations
+
+import copy
+
+from .assembly import Assembly
+
+
+def is_axle_file(path) -> bool:
+    """Whether a geometry file is an axle's (``scope: axle``)."""
+    from ..io.yamlio import load_yaml
+
+    data, _, _ = load_yaml(path)
+    return is_axle_data(data)
+
+
+def is_axle_data(data: dict) -> bool:
+    """Whether a geometry file's data, as read, is an axle's (``scope: axle``)."""
+    return data.get("scope") == "axle"
+
+
+def subject_class(path) -> type[Assembly]:
+    """The class a geometry file's subject is (Corner or AxleModel), before it is built:
+    what it can do (``poses_at_steps``, ...) said before any work."""
+    if is_axle_file(path):
+        from .axle import AxleModel
+
+        return AxleModel
+    from .corner import Corner
+
+    return Corner
+
+
+def load_subject(path, warn: bool = True) -> Assembly:
+    """The subject of a geometry file, set up: a Corner (its shim and adjusters applied)
+    or an AxleModel (both corners as set, the axle's shared elements). ``warn``: a
+    corner's PlausibilityWarning for each implausible design metric (Corner's)."""
+    if is_axle_file(path):
+        from .axle import AxleModel, load_axle
+
+        return AxleModel(load_axle(path))
+    from ..model.geometry import load_geometry
+    from .corner import Corner
+
+    return Corner(load_geometry(path), warn=warn)
+
+
+def load_drawn(path, label: str | None = None) -> Assembly:
+    """The subject of a geometry file as the file draws it, for the setup analyses
+    (``Assembly.as_drawn``): no model built, no setup applied; ``label``: a setup
+    option's (``--side``), refused first where the kind has no such label."""
+    return subject_class(path).as_drawn(path, label)
+
+
+class SubjectKind:
+    """How one kind of subject is built from its geometry file's data, as a study builds
+    its design and its variants (docs/studies.md): ``build``, and ``variant_data`` (the
+    data a variant's hardpoints are moved in)."""
+
+    def build(self, data: dict, source: str, variant: bool = False) -> Assembly:
+        """The subject of a geometry file's data (errors name ``source``). A
+        ``variant``'s goes without the plausibility warnings (the design's were shown)
+        and, a corner's, without the URDF's shapes (never drawn)."""
+        raise NotImplementedError
+
+    def variant_data(self, data: dict) -> dict:
+        """A copy of the data in which each labelled corner's hardpoints are its own to
+        move (``data["hardpoints"][label]``; a corner's one, unlabelled, at
+        ``data["hardpoints"]``)."""
+        return copy.deepcopy(data)
+
+
+class _CornerKind(SubjectKind):
+    def build(self, data: dict, source: str, variant: bool = False) -> Assembly:
+        from ..io.yamlio import Reader
+        from ..model.geometry import parse_geometry, warn_dead_centres
+        from .corner import Corner
+
+        geometry = parse_geometry(data, Reader("<dict>"), None)
+        if not variant:  # a link near dead centre, as every command says
+            warn_dead_centres(geometry, source)
+        return Corner(geometry, warn=not variant, visuals=not variant)
+
+
+class _AxleKind(SubjectKind):
+    def build(self, data: dict, source: str, variant: bool = False) -> Assembly:
+        from .axle import AxleModel, load_axle
+
+        return AxleModel(load_axle(data, None if variant else source))
+
+    def variant_data(self, data: dict) -> dict:
+        out = super().variant_data(data)
+        points = out["hardpoints"]
+        if "right" not in points or points["right"] is None:  # mirrored: made explicit
+            from .axle_file import mirror_corner
+
+            points["right"] = mirror_corner({"hardpoints": points["left"]})["hardpoints"]
+        return out
+
+
+def kind_of(data: dict) -> SubjectKind:
+    """The kind of subject a geometry file's data, as read, holds (its ``scope``)."""
+    return _AxleKind() if is_axle_data(data) else _CornerKind()
