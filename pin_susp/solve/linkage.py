@@ -118,24 +118,27 @@ class FrameMotion:
         ]
 
     def __call__(
-        self, qs: list, tangent_at, k: int, tangents=None
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """Positions (n, m, 3) and rates (k, n, m, 3) of the m points at the n
-        configurations; ``tangent_at(i, q)`` updates the kinematics (Jacobians too) at
-        q and returns dq per driver (nv × k). A None configuration gives NaN.
+        self, qs: list, tangent_at, k: int, tangents=None, columns=None
+    ) -> tuple[np.ndarray, list]:
+        """Positions (m, n, 3) of the m points at the n configurations and, for each
+        list of driver columns in ``columns`` (default: all k), their rates along
+        those drivers (m, len(columns), n, 3): each point's own rates contiguous;
+        ``tangent_at(i, q)`` updates the kinematics (Jacobians too) at q and returns dq
+        per driver (nv × k). A None configuration gives NaN.
 
         ``tangents(Q, steps, placed)``: dq per driver at every solved configuration at
         once ((len(Q), nv, k), or None; ``placed``: the tree's placements at Q): then
         every step is evaluated at once on the model's tree (bulk.Tree) instead of one
         Pinocchio call after another.
         """
+        columns = [list(range(k))] if columns is None else [list(c) for c in columns]
         solved = [i for i, q in enumerate(qs) if q is not None]
         if tangents is not None and tree_of(self.kin).supported and solved:
             Q = np.array([qs[i] for i in solved]).reshape(len(solved), self.kin.model.nq)
             placed = tree_of(self.kin).placements(Q)
             T = tangents(Q, solved, placed)
             if T is not None:
-                return self._at_once(len(qs), solved, placed, T, k)
+                return self._at_once(len(qs), solved, placed, T, columns)
         n, m = len(qs), len(self.names)
         pos = np.full((n, m, 3), np.nan)
         rates = np.full((k, n, m, 3), np.nan)
@@ -170,31 +173,42 @@ class FrameMotion:
         unsolved = np.array([q is None for q in qs])
         pos[unsolved] = np.nan
         rates[:, unsolved] = np.nan
-        return pos, rates
+        own = [np.ascontiguousarray(np.moveaxis(rates[c], 2, 0)) for c in columns]
+        return np.ascontiguousarray(pos.transpose(1, 0, 2)), own
 
-    def _at_once(self, n: int, solved: list, placed: tuple, T: np.ndarray, k: int):
+    def _at_once(self, n: int, solved: list, placed: tuple, T: np.ndarray, columns: list):
         """__call__ for every solved configuration at once (``placed``: the tree's
-        placements there, T: their tangents)."""
+        placements there, T: their tangents), each list of columns' rates written
+        straight in its final layout (m, k, n, 3)."""
         tree = tree_of(self.kin)
         R, o = placed
         a = tree.axes(R)
-        count = len(T)
-        pos = np.empty((count, len(self.names), 3))
-        rates = np.empty((k, count, len(self.names), 3))
+        count, m = len(T), len(self.names)
+        pos = np.empty((m, count, 3))
+        rates = [np.empty((m, len(c), count, 3)) for c in columns]
         for j, index, local in self.groups:
             if j == 0:  # the chassis: fixed points
-                pos[:, index] = local
-                rates[:, :, index] = 0.0
+                pos[index] = local[:, None]
+                for out in rates:
+                    out[index] = 0.0
                 continue
-            arms = (R[j].reshape(-1, 3) @ local.T).reshape(count, 3, -1).transpose(0, 2, 1)
-            pos[:, index] = arms + o[j][:, None]
+            # arms (g, 1, n, 3): each point's offset from its joint's origin
+            arms = (R[j].reshape(-1, 3) @ local.T).reshape(count, 3, -1).transpose(2, 0, 1)
+            pos[index] = arms + o[j][None]
             twist = (tree.twist_jacobian(j, o, a) @ T).transpose(2, 0, 1)  # (k, n, 6)
-            rates[:, :, index] = twist[:, :, None, :3] + cross(twist[:, :, None, 3:], arms[None])
+            arms = arms[:, None]
+            for c, out in zip(columns, rates, strict=True):
+                tw = twist[c][None]  # (1, k_c, n, 6)
+                out[index] = tw[..., :3] + cross(tw[..., 3:], arms)
         if count == n:
             return pos, rates
-        out_pos = np.full((n, len(self.names), 3), np.nan)
-        out_rates = np.full((k, n, len(self.names), 3), np.nan)
-        out_pos[solved], out_rates[:, solved] = pos, rates
+        out_pos = np.full((m, n, 3), np.nan)
+        out_pos[:, solved] = pos
+        out_rates = []
+        for r in rates:
+            full = np.full((m, r.shape[1], n, 3), np.nan)
+            full[:, :, solved] = r
+            out_rates.append(full)
         return out_pos, out_rates
 
 
@@ -377,15 +391,13 @@ class Composed:
             return solve_all(J, self.drive_rhs)
 
         many = at_once if len(qs) >= self.motion_at_once_from else None
-        pos, rates = self._frame_motion(qs, tangent_at, k, many)
-        own = {}  # each label's drivers' rates, point by point: (m, k_label, n, 3)
-        for label, columns in self.driver_columns.items():
-            if columns == list(range(k)):
-                own[label] = np.moveaxis(rates, 2, 0)
-            else:  # each point's own rates contiguous
-                own[label] = np.ascontiguousarray(np.moveaxis(rates[columns], 2, 0))
+        labels = list(self.driver_columns)
+        pos, rates = self._frame_motion(
+            qs, tangent_at, k, many, [self.driver_columns[label] for label in labels]
+        )
+        own = dict(zip(labels, rates, strict=True))  # each label's rates: (m, k_label, n, 3)
         out = {
-            name: {label: Dual(pos[:, j], own[label][j]) for label in own}
+            name: {label: Dual(pos[j], own[label][j]) for label in own}
             for j, name in enumerate(self._frame_motion.names)
         }
         for label, g in self._corners.items():

@@ -388,25 +388,36 @@ class Assembly(Composed, AnalysesSurface):
         (J_drive·T of the steps solved at once evaluated here, on the model's tree)."""
         frames, rack_v = self._drive_frames()
         at_once = [i for i, f in enumerate(found) if f is not None and f[1] is None]
-        if at_once:
+        kept = [i for i, f in enumerate(found) if f is not None]
+        if not kept:
+            return found
+        if at_once:  # each wheel centre's z row in the columns that move it, times T
+            tree = tree_of(self.kin)
             Q = np.array([solutions[i].q for i in at_once])
-            _, J = Frames(tree_of(self.kin), frames).evaluate(Q)
+            many = Frames(tree, frames)
+            R, o = tree.placements(Q)
+            Jc, _ = many.compact(many.positions(R, o), o, tree.axes(R))
             T = np.array([found[i][0] for i in at_once])
-            rows = [np.einsum("nv,nvk->nk", Jf[:, 2], T) for Jf in J]
+            rows = [
+                np.einsum("sn,nsk->nk", Jf[:, :, 2], T[:, cols])
+                for Jf, cols in zip(Jc, many.cols, strict=True)
+            ]
             if rack_v is not None:
                 rows.append(T[:, rack_v])
-            across = np.stack(rows, axis=1)
-            for i, t, a in zip(at_once, T, across, strict=True):
-                found[i] = (t, a)
-        kept = [i for i, f in enumerate(found) if f is not None]
-        if kept:
-            across = np.array([found[i][1] for i in kept])
-            ok = np.abs(np.linalg.det(across)) > 0.0
-            inverse = np.full_like(across, np.nan)
-            inverse[ok] = np.linalg.inv(across[ok])
+            ready = np.stack(rows, axis=1)
+        if len(at_once) == len(kept):  # every step's at once: no step's own
+            per_target, across = T, ready
+        else:
+            if at_once:
+                for i, t, a in zip(at_once, T, ready, strict=True):
+                    found[i] = (t, a)
             per_target = np.array([found[i][0] for i in kept])
-            for i, tangent in zip(kept, per_target @ inverse, strict=True):
-                found[i] = tangent
+            across = np.array([found[i][1] for i in kept])
+        ok = np.abs(np.linalg.det(across)) > 0.0
+        inverse = np.full_like(across, np.nan)
+        inverse[ok] = np.linalg.inv(across[ok])
+        for i, tangent in zip(kept, per_target @ inverse, strict=True):
+            found[i] = tangent
         return found
 
     # ------------------------------------------------------------ columns
