@@ -466,6 +466,13 @@ sys.exit(cli.main(sys.argv[3:]))
 """
 
 
+def _ctrl_c_as_on_a_terminal() -> None:
+    """In the child, before exec: SIGINT as a terminal's shell starts a command, not
+    ignored — a suite run as a background job (``make test &`` in a script) hands its
+    children SIGINT ignored, and Python then never turns Ctrl+C into an interrupt."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _servers_of(pid: int) -> list[int]:
     """Processes still running meshcat's server for the process ``pid``."""
     found = []
@@ -501,6 +508,7 @@ def test_view_html_interrupted_at_any_moment_exits_130_or_143_and_leaves_nothing
         stderr=subprocess.PIPE,
         text=True,
         start_new_session=True,
+        preexec_fn=_ctrl_c_as_on_a_terminal,
     )
     out, err = proc.communicate(timeout=120)
     assert proc.returncode == 128 + getattr(signal, sig), (out, err)
@@ -527,6 +535,7 @@ def test_ctrl_c_sent_to_a_long_view_html_exits_130_and_leaves_nothing(tmp_path, 
         stderr=subprocess.PIPE,
         text=True,
         start_new_session=True,
+        preexec_fn=_ctrl_c_as_on_a_terminal,
     )
     time.sleep(delay)
     proc.send_signal(signal.SIGINT)
