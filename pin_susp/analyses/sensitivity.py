@@ -106,11 +106,6 @@ SYMMETRIC_MOVE = (
 ONE_SIDED_MOVE = "a one-sided move: left_P and right_P each move alone"
 
 
-def axle_held(model) -> str:
-    """What an axle's sensitivities hold (the note on its table and CSV)."""
-    return model.sensitivity_held()
-
-
 class SubjectSensitivity:
     """d(column)/d(hardpoint coordinate) of a subject (an Assembly), exact.
 

@@ -467,11 +467,6 @@ def _axle_model(axle):
     return AxleModel(axle)
 
 
-def set_sides(axle, side: str | None = None) -> tuple[str, ...]:
-    """The sides a setup option sets (``Assembly.setup_labels``)."""
-    return _axle_model(axle).setup_labels(side)
-
-
 def axle_setup_sheet(axle, shim=(), trackrod=(), pushrod=(), side: str | None = None) -> dict:
     """:func:`subject_setup_sheet` of an axle file's model, per side."""
     return subject_setup_sheet(_axle_model(axle), shim, trackrod, pushrod, side)
@@ -480,8 +475,3 @@ def axle_setup_sheet(axle, shim=(), trackrod=(), pushrod=(), side: str | None = 
 def solve_axle_setup(axle, targets: dict[str, float], side: str | None = None) -> dict:
     """:func:`solve_subject_setup` of an axle file's model, per side."""
     return solve_subject_setup(_axle_model(axle), targets, side)
-
-
-def axle_static(axle, states: dict) -> dict[str, float]:
-    """:func:`static_state` of an axle file's model: track, roll centre y and z (mm)."""
-    return static_state(_axle_model(axle), states)

@@ -207,9 +207,3 @@ def warn_dead_centres(tree, source: str, mirrored: bool = False) -> list[Transmi
         note = " (the mirrored right side likewise)" if left else ""
         warnings.warn(t.message(source) + note, PlausibilityWarning, stacklevel=3)
     return found
-
-
-def geometry_dead_centres(g) -> list[Transmission]:
-    """A corner Geometry's links near dead centre at design (its tree built without
-    its shapes)."""
-    return dead_centres(g.mechanism.tree(g))

@@ -277,10 +277,3 @@ def axle_results(model: AxleModel, sweep, solutions: list) -> AxleResults:
     >>> results.to_pandas()  # a DataFrame, a row per step (model.run_sweep does both)
     """
     return model.sweep_results(sweep, solutions)
-
-
-def axle_metric_columns(model: AxleModel, points: dict) -> dict:
-    """name → (values, unit): each side's corner columns (suffixed), the axle's, and
-    the roll derivatives, from the points of ``AxleModel.motion`` (or any engine's
-    points with their rates in that form): ``model.metric_columns``."""
-    return model.metric_columns(points)
