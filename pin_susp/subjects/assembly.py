@@ -152,7 +152,7 @@ class Assembly(Composed, AnalysesSurface):
     @property
     def quantities(self) -> dict:
         """quantity → the shared element whose row it is (an axle's heave, roll)."""
-        return {q: e for e in self.shared for q in getattr(e, "quantities", ())}
+        return {q: e for e in self.shared for q in e.quantities}
 
     def target_rows(self, targets: list, source: str = "<targets>") -> list:
         """The solver's rows for a sweep's targets (one value each, set later), each
@@ -437,8 +437,7 @@ class Assembly(Composed, AnalysesSurface):
             suffix = self.suffix(label)
             out |= {f"{name}{suffix}": c for name, c in sides[label].items()}
         for element in self.shared:
-            if hasattr(element, "columns_of"):
-                out |= element.columns_of(self, points, sides)
+            out |= element.columns_of(self, points, sides)
         return out
 
     def label_corner(self, label: str, plain: dict, qs: list) -> tuple:

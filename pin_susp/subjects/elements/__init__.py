@@ -11,6 +11,11 @@ An element is built from the axle file's data (an AxleGeometry) and contributes:
 - where it has them, its rates (``rate_columns``) and its part in the roll
   stiffness (``anti_roll_bar``).
 
+As one of an Assembly's ``shared`` elements (the axle's pair of corners,
+``wheel_pair.py``, is one too) it also answers ``quantities`` (the sweep quantities
+that are its rows: none, or heave and roll), ``check_targets(targets, source)`` and
+``columns_of(model, points, sides)`` (its columns among the results').
+
 ``elements_of(axle)`` lists an axle's elements in the order they add to the tree.
 """
 

@@ -33,6 +33,13 @@ class AntiRollBar:
         self.rigid = bool(spec) and spec.anti_roll_rigid
         self.center = spec.center if spec else {}
 
+    quantities = ()  # no sweep target is its row
+
+    def columns_of(self, model, points: dict, sides: dict) -> dict:
+        """None of its own at this level: the axle's pair of corners (wheel_pair.py)
+        writes its ``columns`` among the axle's, in the results' column order."""
+        return {}
+
     def check_targets(self, targets, source: str) -> None:
         """A rigid bar locks the corners together: a roll target refused."""
         for i, t in enumerate(targets):

@@ -15,6 +15,13 @@ class HeaveLink:
         self.kind = axle.heave_link
         self.side_points = axle.side_points
 
+    quantities = ()  # no sweep target is its row
+
+    def columns_of(self, model, points: dict, sides: dict) -> dict:
+        """None of its own at this level: the axle's pair of corners (wheel_pair.py)
+        writes its ``columns`` among the axle's, in the results' column order."""
+        return {}
+
     def check_targets(self, targets, source: str) -> None:
         """Nothing: the link only measures."""
 
