@@ -245,18 +245,23 @@ def summary(results, path) -> None:
     print("  (every column, derivatives included, is in the CSV)")
 
 
-def sweep_summary(results, digest: Digest, path, columns: tuple[str, ...] | None) -> None:
+def sweep_summary(
+    results, digest: Digest, path, columns: tuple[str, ...] | None, suffixes: str = ""
+) -> None:
     """A sweep's printed summary: every metric column (``columns`` None), or those the
-    subject names (Assembly.summary_columns: an axle's own and each side's main)."""
+    subject names (Assembly.summary_columns: an axle's own and each side's main);
+    ``suffixes``: its corners' column suffixes, as the last line names them."""
     if columns is None:
         summary(digest, path)
     else:
-        columns_summary(results, digest, path, columns)
+        columns_summary(results, digest, path, columns, suffixes or "_left/_right")
 
 
-def columns_summary(results, digest: Digest, path, columns: tuple[str, ...]) -> None:
+def columns_summary(
+    results, digest: Digest, path, columns: tuple[str, ...], suffixes: str = "_left/_right"
+) -> None:
     """Its steps and notes, then first, last, min and max of ``columns`` (every column
-    is in the CSV)."""
+    is in the CSV, each corner's with its suffix)."""
     import numpy as np
 
     ok = results["solver_converged"]
@@ -286,7 +291,8 @@ def columns_summary(results, digest: Digest, path, columns: tuple[str, ...]) -> 
             f"  (blank: an empty cell in the CSV; {failed} of {len(results)} steps did not "
             "converge, and their columns are blank)"
         )
-    print("  (every column of both corners, suffixed _left/_right, is in the CSV)")
+    corners = "both corners" if suffixes.count("/") == 1 else "every corner"
+    print(f"  (every column of {corners}, suffixed {suffixes}, is in the CSV)")
 
 
 def cell(value: float, width: int = 13) -> str:

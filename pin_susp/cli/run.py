@@ -40,6 +40,7 @@ def execute(args) -> int:
         warnings.simplefilter("always", PlausibilityWarning)
         args.warnings = caught
         try:
+            refuse_unbuilt(args)
             code = args.run(args)
             print_warnings(args)  # only for a run that went through: exit 2 is one line
             return code
@@ -60,6 +61,27 @@ def execute(args) -> int:
             name = exc.filename if exc.filename is not None else "a path"
             print(f"pin-susp: error: {name}: a name too long for the file system", file=sys.stderr)
             return EXIT_INPUT
+
+
+def refuse_unbuilt(args) -> None:
+    """A command its subject does not take yet (Assembly.commands: a vehicle's sweep
+    alone) refused with one line, before any work; a file that cannot be read is left to
+    the command's own message."""
+    geometry, name = vars(args).get("geometry"), vars(args).get("command_name")
+    if geometry is None or name is None:
+        return
+    from ..errors import InputError
+    from ..subjects.subject import subject_class
+
+    try:
+        kind = subject_class(geometry)
+    except PinSuspError:
+        return
+    if kind.commands is not None and name not in kind.commands:
+        takes = ", ".join(f"pin-susp {c}" for c in kind.commands)
+        raise InputError(
+            str(geometry), "scope", f"a {kind.noun} takes {takes} so far: {name} is not built yet"
+        )
 
 
 def unwritten(args) -> str:

@@ -26,6 +26,10 @@ STREAMED_BYTES_PER_STEP = 100
 
 AXES = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
 QUANTITIES = ("heave", "roll")  # an axle's own targets: heave mm, roll deg
+# a vehicle's (docs/vehicle.md): the body's pitch (deg), a corner's road height (mm,
+# ``corner:``), the steering wheel (deg)
+VEHICLE_QUANTITIES = ("pitch", "road_z", "steering_wheel")
+CORNERS = ("fl", "fr", "rl", "rr")  # a vehicle's corners
 
 
 @dataclass(frozen=True)
@@ -59,7 +63,7 @@ class Target:
         """(point, unit direction[, side]) or the quantity: what the target holds,
         however it was written."""
         if self.quantity is not None:
-            return (self.quantity,)
+            return (self.quantity,) if self.side is None else (self.quantity, self.side)
         key = (self.point, tuple(self.unit_direction.tolist()))
         return key if self.side is None else (*key, self.side)
 
@@ -106,9 +110,19 @@ def load_sweep(source: str | Path | dict) -> Sweep:
 
 def _target(value, key: str, steps: int | None, r: Reader) -> Target:
     if isinstance(value, dict) and "quantity" in value:  # an axle's heave or roll
-        t = r.mapping(value, key, required=("quantity",), optional=("start", "stop", "values"))
-        quantity = r.choice(t["quantity"], f"{key}.quantity", QUANTITIES)
-        return Target(None, None, _values(t, key, steps, r), "relative", quantity=quantity)
+        t = r.mapping(
+            value, key, required=("quantity",), optional=("start", "stop", "values", "corner")
+        )
+        quantity = r.choice(t["quantity"], f"{key}.quantity", QUANTITIES + VEHICLE_QUANTITIES)
+        corner = None
+        if quantity == "road_z":
+            if "corner" not in t:
+                r.fail(f"{key}.corner", "missing: road_z names its corner (fl, fr, rl, rr)")
+            corner = r.choice(t["corner"], f"{key}.corner", CORNERS)
+        elif "corner" in t:
+            r.fail(f"{key}.corner", f"only road_z names a corner, not {quantity}")
+        values = _values(t, key, steps, r)
+        return Target(None, None, values, "relative", side=corner, quantity=quantity)
     t = r.mapping(
         value,
         key,
@@ -116,7 +130,8 @@ def _target(value, key: str, steps: int | None, r: Reader) -> Target:
         optional=("mode", "start", "stop", "values", "side"),
     )
     point = r.text(t["point"], f"{key}.point")
-    side = None if "side" not in t else r.choice(t["side"], f"{key}.side", ("left", "right"))
+    sides = ("left", "right", *CORNERS)
+    side = None if "side" not in t else r.choice(t["side"], f"{key}.side", sides)
     d = r.mapping(t["direction"], f"{key}.direction", optional=("axis", "vector"))
     if ("axis" in d) == ("vector" in d):
         r.fail(f"{key}.direction", "give exactly one of axis: x|y|z or vector: [x, y, z]")

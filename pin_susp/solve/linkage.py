@@ -231,6 +231,9 @@ class Composed:
     # shorter one's one Pinocchio call after another (an axle's: the numbers it always
     # had, to the last bit — its loads' forces move in the 12th digit otherwise)
     motion_at_once_from = 0
+    # joints the drivers hold (a vehicle's body on the road: its rates are the chassis
+    # frame's, the body still)
+    held_joints: tuple[str, ...] = ()
 
     def _compose(
         self, corners: dict, elements=(), name: str = "", comment: str = "", visuals: bool = True
@@ -295,10 +298,13 @@ class Composed:
         rack = self.model.existJointName("rack_slide")
         if rack:
             drive.append(JointTarget(self.model, "rack_slide"))
+        drive += [JointTarget(self.model, joint) for joint in self.held_joints]
         self._drive = NewtonSolver(self.kin, self.closures, drive, self.branches)
         self.drive_rhs, self.driver_columns = self._drive.unit_rhs, {}
         for c, (label, g) in enumerate(self._corners.items()):
-            self.driver_columns[label] = [c, len(labels)] if rack else [c]
+            # the rack: its corners' (a vehicle's rear, on toe links, has none of it)
+            steered = rack and g.steering == "rack"
+            self.driver_columns[label] = [c, len(labels)] if steered else [c]
             if g.steering == "none" and g.steering_points:
                 toe = np.zeros((self._drive.nrows, 1))
                 toe[closure_row(self.closures, f"{prefix[label]}toe_link")] = 1.0

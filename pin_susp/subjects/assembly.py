@@ -99,6 +99,7 @@ class Assembly(Composed, AnalysesSurface):
     static_columns: tuple[tuple[str, str], ...] = ()
     elements: tuple = ()
     noun: str = "assembly"
+    commands: tuple[str, ...] | None = None  # the commands that take it (None: every one)
     tree: object
     urdf: str
     output_points: list[str]
@@ -450,7 +451,10 @@ class Assembly(Composed, AnalysesSurface):
             return self, qs
         g = self.corners[label]
         corner = Linkage(g)
-        with_rack = self.model.existJointName(rack.JOINT)
+        # (a corner on a toe link has no rack of its own: a vehicle's rear)
+        with_rack = self.model.existJointName(rack.JOINT) and corner.model.existJointName(
+            rack.JOINT
+        )
         index = self.model.joints[self.model.getJointId(rack.JOINT)].idx_q if with_rack else None
         targets = [PointTarget(corner.points["wheel_center"], Z)]
         if with_rack:

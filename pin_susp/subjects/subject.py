@@ -27,9 +27,21 @@ def is_axle_data(data: dict) -> bool:
     return data.get("scope") == "axle"
 
 
+def is_vehicle_file(path) -> bool:
+    """Whether a geometry file is a whole car's (``scope: vehicle``, docs/vehicle.md)."""
+    from ..io.yamlio import load_yaml
+
+    data, _, _ = load_yaml(path)
+    return data.get("scope") == "vehicle"
+
+
 def subject_class(path) -> type[Assembly]:
-    """The class a geometry file's subject is (Corner or AxleModel), before it is built:
-    what it can do (``poses_at_steps``, ...) said before any work."""
+    """The class a geometry file's subject is (Corner, AxleModel or Vehicle), before it
+    is built: what it can do (``poses_at_steps``, ...) said before any work."""
+    if is_vehicle_file(path):
+        from .vehicle import Vehicle
+
+        return Vehicle
     if is_axle_file(path):
         from .axle import AxleModel
 
@@ -42,7 +54,12 @@ def subject_class(path) -> type[Assembly]:
 def load_subject(path, warn: bool = True) -> Assembly:
     """The subject of a geometry file, set up: a Corner (its shim and adjusters applied)
     or an AxleModel (both corners as set, the axle's shared elements). ``warn``: a
-    corner's PlausibilityWarning for each implausible design metric (Corner's)."""
+    corner's PlausibilityWarning for each implausible design metric (Corner's); a
+    Vehicle (``scope: vehicle``)."""
+    if is_vehicle_file(path):
+        from .vehicle import Vehicle
+
+        return Vehicle(path)
     if is_axle_file(path):
         from .axle import AxleModel, load_axle
 

@@ -63,4 +63,4 @@ def load(name: str, parser) -> None:
     parser.description = module.DESCRIPTION
     parser.epilog = getattr(module, "EPILOG", None)
     module.arguments(parser)
-    parser.set_defaults(run=module.run)
+    parser.set_defaults(run=module.run, command_name=name)

@@ -55,7 +55,8 @@ def run(args) -> int:
     warn_transmission(digest)
     plot = write_results(args, results)
     if not args.quiet:
-        sweep_summary(results, digest, args.output, subject.summary_columns)
+        suffixes = "/".join(subject.suffix(label) for label in subject.labels)
+        sweep_summary(results, digest, args.output, subject.summary_columns, suffixes)
         if plot:
             print(f"wrote {args.plot}")
     return report_failures(digest)

@@ -1,0 +1,398 @@
+"""The whole car: a front and a rear axle under one sprung body on the road
+(docs/vehicle.md).
+
+A vehicle file (``scope: vehicle``) names two axle files (docs/axle.md: a path
+relative to it, or the axle inline) and ``vehicle_config``: the wheelbase (a check
+of the axles' points), the CG, the masses, the brake and drive split and the
+steering's c-factor. Its corners are labelled ``fl``, ``fr``, ``rl``, ``rr`` —
+each corner's column gets that suffix (``camber_fl``), each point that prefix
+(``fl_wheel_center``) — under one chassis that is the body on the road
+(elements/body.py: heave, pitch and roll at the CG).
+
+A sweep gives the body's heave, pitch and roll, the steering (``steering_wheel``,
+or a rack target as on an axle; the rack held at design without one) and, where
+the road is not flat, a corner's ``road_z``: the rows are every corner's closures,
+its contact patch on the road and the targets. A corner's columns are its own
+(metrics.py) in the chassis frame, with its exact rates along its own
+wheel-centre height (the body and the other wheels held) and the rack — so they
+equal that corner's own sweep at the same chassis-frame height and rack; the
+points are written in the chassis frame too. The body's pose and what is seen
+from the road (camber to ground, the wheelbase on the road) follow.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .. import __version__
+from ..io.yamlio import Reader, load_yaml
+from ..maths.vectors import unit
+from ..model.geometry import Geometry, contact_patch, summary_repr
+from ..model.mechanisms import xml_name
+from ..solve.bulk import Frames, rows_of, solve_all, tree_of
+from ..solve.linkage import RACK_HELD, Linkage
+from .assembly import Assembly
+from .axle_file import AxleGeometry, load_axle
+from .corner import Results
+from .elements import rack
+from .elements.body import JOINTS, BodyOnRoad
+
+LABELS = ("fl", "fr", "rl", "rr")
+AXLES = {"front": ("fl", "fr"), "rear": ("rl", "rr")}
+CONFIG_KEYS = ("wheelbase", "cg", "masses", "brakes", "drive", "steering")
+WHEELBASE_CHECK = 1.0  # mm: vehicle_config.wheelbase against the axles' wheel centres
+DERIVED = ("camber", "roadwheel_angle")  # the corner columns rated along heave, pitch, roll
+
+
+@dataclass(frozen=True)
+class VehicleGeometry:
+    """A vehicle file as read: its two axles (AxleGeometry) and vehicle_config (mm and
+    kg as given; ``cg`` (3,) m in the chassis frame)."""
+
+    name: str
+    front: AxleGeometry
+    rear: AxleGeometry
+    wheelbase: float  # mm
+    cg: np.ndarray  # m, chassis frame (y 0)
+    masses: dict
+    brakes: dict
+    drive: dict
+    c_factor: float | None  # mm of rack per steering-wheel turn
+    source: str = "<dict>"
+    sha256: str | None = None
+    data: dict = field(default_factory=dict, repr=False)
+
+    def corner(self, label: str) -> Geometry:
+        axle = self.front if label[0] == "f" else self.rear
+        return axle.left if label[1] == "l" else axle.right
+
+
+def load_vehicle(source) -> VehicleGeometry:
+    """Read and validate a vehicle file (``scope: vehicle``, docs/vehicle.md): a path or
+    a dict. Every problem raises InputError naming the file and the key."""
+    data, name, sha = load_yaml(source)
+    r = Reader(name)
+    r.mapping(
+        data,
+        "",
+        required=("scope", "vehicle_config", "front", "rear"),
+        optional=("name", "version", "units"),
+    )
+    r.choice(data["scope"], "scope", ("vehicle",))
+    r.choice(data.get("units", "millimeters"), "units", ("millimeters",))
+    config = r.mapping(
+        data["vehicle_config"], "vehicle_config", required=("wheelbase", "cg"), optional=CONFIG_KEYS
+    )
+    here = Path(name).parent if not isinstance(source, dict) else Path(".")
+    axles = {}
+    for end in AXLES:
+        given = data[end]
+        if isinstance(given, str):
+            path = here / given
+            if not path.is_file():
+                r.fail(end, f"no axle file {given!r} (paths are relative to {name})")
+            axles[end] = load_axle(path)
+        elif isinstance(given, dict):
+            axles[end] = load_axle(given, name)
+        else:
+            r.fail(end, "expected an axle file's path or the axle inline (a mapping)")
+        a = axles[end]
+        for what, value in (("anti_roll", a.anti_roll), ("heave_link", a.heave_link)):
+            if value != "none":
+                r.fail(
+                    f"{end}.axle_config.{what}",
+                    f"a vehicle's axles have no {what.replace('_', '-')} yet (issue 26): "
+                    "give type: none, or sweep the axle on its own",
+                )
+    if axles["rear"].left.steering == "rack":
+        r.fail("rear.axle_config.steering", "rear steer (a rack on the rear axle) is not supported")
+    wheelbase = r.positive(config["wheelbase"], "vehicle_config.wheelbase")
+    centres = {end: a.left.design_points()["wheel_center"][0] * 1e3 for end, a in axles.items()}
+    drawn = centres["front"] - centres["rear"]
+    if abs(drawn - wheelbase) > WHEELBASE_CHECK:
+        r.fail(
+            "vehicle_config.wheelbase",
+            f"{wheelbase:g} mm, but the axles' wheel centres are {drawn:g} mm apart "
+            "(the rear axle is placed by its own points: the wheelbase is a check)",
+        )
+    cg = r.mapping(config["cg"], "vehicle_config.cg", required=("z",), optional=("x", "x_mm"))
+    if ("x" in cg) == ("x_mm" in cg):
+        r.fail("vehicle_config.cg", "give exactly one of x (a fraction of the wheelbase) or x_mm")
+    if "x" in cg:
+        x = centres["front"] - r.number(cg["x"], "vehicle_config.cg.x") * wheelbase
+    else:
+        x = r.length(cg["x_mm"], "vehicle_config.cg.x_mm")
+    z = r.positive(cg["z"], "vehicle_config.cg.z")
+    steering = r.mapping(
+        config.get("steering", {}), "vehicle_config.steering", optional=("c_factor",)
+    )
+    c_factor = None
+    if "c_factor" in steering:
+        c_factor = r.positive(steering["c_factor"], "vehicle_config.steering.c_factor")
+    dicts = {}
+    for key in ("masses", "brakes", "drive"):  # read by the attitude and anti columns
+        value = config.get(key, {})
+        if not isinstance(value, dict):
+            r.fail(f"vehicle_config.{key}", "expected a mapping")
+        dicts[key] = dict(value)
+    return VehicleGeometry(
+        str(data.get("name", Path(name).stem)),
+        axles["front"],
+        axles["rear"],
+        wheelbase,
+        np.array([x, 0.0, z]) * 1e-3,
+        dicts["masses"],
+        dicts["brakes"],
+        dicts["drive"],
+        c_factor,
+        name,
+        sha,
+        data,
+    )
+
+
+class Vehicle(Assembly):
+    """Four corners under one sprung body on the road, one Pinocchio model
+    (docs/vehicle.md): ``Vehicle("examples/vehicle_fs.yaml")`` or a VehicleGeometry.
+
+    >>> car = pin_susp.Vehicle("examples/vehicle_fs.yaml")
+    >>> results = car.run_sweep("examples/vehicle_roll.yaml")
+    >>> results["roll"], results["camber_fl"], results["deriv_camber_wrt_roll_fl"]
+    """
+
+    labels = LABELS
+    noun = "vehicle"
+    commands = ("sweep",)  # the rest of docs/vehicle.md's "Not built yet"
+    summary_columns = tuple(
+        "heave pitch roll steering_wheel_angle camber_fl camber_fr camber_rl camber_rr "
+        "camber_to_ground_fl camber_to_ground_fr camber_to_ground_rl camber_to_ground_rr "
+        "roadwheel_angle_fl roadwheel_angle_fr roadwheel_angle_rl roadwheel_angle_rr "
+        "wheel_travel_fl wheel_travel_rl wheelbase_left wheelbase_right".split()
+    )
+    held_joints = JOINTS  # a corner's rates: its own height with the body still
+    needs = (
+        "the body's heave, pitch and roll, and the steering (steering_wheel or a rack "
+        "target); each road_z is 0 unless given"
+    )
+
+    def __init__(self, vehicle):
+        from ..solve.as_set import apply_setup
+
+        if not isinstance(vehicle, VehicleGeometry):
+            vehicle = load_vehicle(vehicle)
+        self.vehicle, self.name, self.source = vehicle, vehicle.name, vehicle.source
+        self.corners = {label: apply_setup(vehicle.corner(label)) for label in LABELS}
+        front = self.corners["fl"]
+        sense = 1.0
+        if front.steering == "rack":  # the rack's travel left steers left where the
+            # trackrods are ahead of the wheel centre
+            p = front.design_points()
+            sense = 1.0 if p["trackrod_outboard"][0] > p["wheel_center"][0] else -1.0
+        self.body = BodyOnRoad(vehicle.cg, vehicle.c_factor, sense)
+        self.shared = (self.body,)
+        comment = f"generated by pin_susp {__version__}: a vehicle"
+        self._compose(self.corners, (self.body,), xml_name(self.name, "vehicle"), comment)
+        self._drivers()
+        self.kin.update(self.q_design)
+        self.spring_senses = {
+            label: (Linkage(g).spring_sense if g.spring == "torsion_bar" else 1.0)
+            for label, g in self.corners.items()
+        }
+        self.body_v = [self.model.joints[self.model.getJointId(j)].idx_v for j in JOINTS]
+
+    def __repr__(self) -> str:
+        v = self.vehicle
+        return summary_repr(
+            self,
+            lambda: (
+                self.source,
+                self.name,
+                f"front {v.front.left.type}",
+                f"rear {v.rear.left.type}",
+                f"wheelbase {v.wheelbase:g} mm",
+                f"{self.mobility} inputs",
+            ),
+        )
+
+    @property
+    def sha256(self) -> str | None:
+        return self.vehicle.sha256
+
+    @property
+    def results_class(self) -> type:
+        return VehicleResults
+
+    def undetermined(self, targets) -> str:
+        return "the targets do not fix the vehicle's pose at its design state"
+
+    def held_targets(self, targets: list) -> list:
+        """Its sweep's targets, each corner's road height (0) where none is given, and the
+        rack held at design where no steering target is (Composed.held_targets)."""
+        targets = self._on_flat_road(targets)
+        if any(t.quantity == "steering_wheel" for t in targets):
+            return targets
+        return super().held_targets(targets)
+
+    def _on_flat_road(self, targets) -> list:
+        """The targets with road_z 0 under each corner none names."""
+        from ..model.sweep import Target
+
+        targets = list(targets)
+        if not targets:
+            return targets
+        steps = len(targets[0].values)
+        given = {t.side for t in targets if t.quantity == "road_z"}
+        return targets + [
+            Target(None, None, np.zeros(steps), side=label, quantity="road_z")
+            for label in LABELS
+            if label not in given
+        ]
+
+    def sweep_notes(self, targets) -> list[str]:
+        """The rack held at design where its sweep steers by neither the steering wheel
+        nor a rack target (road heights at 0 go without saying)."""
+        targets = self._on_flat_road(getattr(targets, "targets", targets))
+        return [RACK_HELD] if len(self.held_targets(targets)) > len(targets) else []
+
+    # ------------------------------------------------------------ results
+
+    def chassis_configurations(self, qs: list) -> list:
+        """Each configuration with the body's three joints at zero: the model's points
+        then stand where they are in the chassis frame."""
+        out = []
+        for q in qs:
+            if q is None:
+                out.append(None)
+                continue
+            q = np.array(q, dtype=float)
+            q[self.body_v] = 0.0
+            out.append(q)
+        return out
+
+    def sweep_results(self, sweep, solutions: list, tangents=None, only=None):
+        """Every column (docs/vehicle.md): the solver's, each corner's metric columns in
+        the chassis frame (suffix ``_fl``…), their rates along heave, pitch and roll, the
+        body's pose, what the road sees, then every point in the chassis frame."""
+        from ..columns.metrics import point_columns
+        from ..solve.rates import rate_columns
+
+        kind = self.results_class
+        columns, units = kind.solver_columns(solutions)
+        qs = [s.q if s.converged else None for s in solutions]
+        chassis = self.chassis_configurations(qs)
+        points = self.label_motion(chassis)
+        for name, (values, unit_) in self.metric_columns(points, only).items():
+            columns[name], units[name] = values, unit_
+        plain = {name: p["fl"].val for name, p in points.items()}
+        for label, g in self.corners.items():
+            if not g.rated_spring:
+                continue
+            corner, poses = self.label_corner(label, plain, chassis)
+            for name, (values, unit_) in rate_columns(corner, poses).items():
+                columns[name + self.suffix(label)], units[name + self.suffix(label)] = values, unit_
+        for name, (values, unit_) in self.body_columns(sweep, qs, plain, columns).items():
+            columns[name], units[name] = values, unit_
+        for name, (values, unit_) in point_columns(self.output_points, plain).items():
+            if only is None or name in only:
+                columns[name], units[name] = values, unit_
+        meta = kind.solver_meta(solutions, (self.source, self.sha256), sweep, self)
+        meta["notes"] = self.sweep_notes(sweep.targets)
+        return kind(columns, units, meta)
+
+    def body_columns(self, sweep, qs: list, plain: dict, columns: dict) -> dict:
+        """The body's heave, pitch, roll and steering-wheel angle; each corner's camber
+        to ground; the wheelbase on the road per side; and the exact rates of each
+        corner's camber, toe and wheel-centre height along heave, pitch and roll."""
+        n = len(qs)
+        pose = np.full((n, 3), np.nan)
+        for i, q in enumerate(qs):
+            if q is not None:
+                pose[i] = [q[self.model.joints[self.model.getJointId(j)].idx_q] for j in JOINTS]
+        heave, pitch, roll = pose.T
+        out = {
+            "heave": (heave * 1e3, "mm"),
+            "pitch": (np.degrees(pitch), "deg"),
+            "roll": (np.degrees(roll), "deg"),
+        }
+        end = f"fl_{rack.INBOARD}"
+        travel = None
+        if end in plain:  # the rack's travel along y from design
+            travel = plain[end][:, 1] - self.design_positions[end][1]
+            out["rack_displacement"] = (travel * 1e3, "mm")
+        if travel is not None and self.body.c_factor is not None:
+            angle = self.body.steer_sense * travel * 1e3 / self.body.c_factor * 360.0
+            out["steering_wheel_angle"] = (angle, "deg")
+        world, contact = {}, {}
+        for label in LABELS:
+            p = f"{label}_"
+            w = {
+                k: self.body.to_world(plain[p + k], heave, pitch, roll)
+                for k in ("wheel_center", "axle_inboard", "axle_outboard")
+            }
+            spin = {"world": unit(w["axle_outboard"] - w["axle_inboard"])}
+            spin["chassis"] = unit(plain[p + "axle_outboard"] - plain[p + "axle_inboard"])
+            tilt = np.degrees(np.arcsin(spin["world"][:, 2]) - np.arcsin(spin["chassis"][:, 2]))
+            camber = columns.get(f"camber_{label}")
+            if camber is not None:
+                out[f"camber_to_ground_{label}"] = (camber - tilt, "deg")
+            contact[label] = contact_patch(
+                w["wheel_center"], spin["world"], self.corners[label].wheel.radius
+            )
+            world[label] = w
+        for side in ("left", "right"):
+            f, r = ("fl", "rl") if side == "left" else ("fr", "rr")
+            out[f"wheelbase_{side}"] = ((contact[f][:, 0] - contact[r][:, 0]) * 1e3, "mm")
+        for label in LABELS:
+            out[f"contact_patch_road_z_{label}"] = (contact[label][:, 2] * 1e3, "mm")
+        out |= self.body_rates(sweep, qs, columns)
+        return out
+
+    def body_rates(self, sweep, qs: list, columns: dict) -> dict:
+        """d(column)/d(heave) per mm and d/d(pitch), d/d(roll) per deg, the other targets
+        held: the sweep's tangent dq/d(target) at every solved step (its rows' Jacobian,
+        all steps at once), each corner's chassis-frame wheel-centre rate along it, times
+        the corner's own rate along its hub z (its rack held: the steering is a target)."""
+        solved = [i for i, q in enumerate(qs) if q is not None]
+        n = len(qs)
+        if not solved:
+            return {}
+        solver = self.solver_for(sweep.targets, sweep.source)
+        rows = rows_of(solver)
+        targets = self.held_targets(sweep.targets)
+        Q = np.array([qs[i] for i in solved])
+        zero = np.zeros((len(Q), len(targets)))
+        _, J = rows.evaluate(Q, zero)
+        want = [i for i, t in enumerate(targets) if t.quantity in ("heave", "pitch", "roll")]
+        rhs = np.zeros((rows.nrows, len(want)))
+        for c, i in enumerate(want):
+            rhs[rows.first_target + i, c] = 1.0
+        T = solve_all(J, rhs)
+        if T is None:
+            return {}
+        tree = tree_of(self.kin)
+        Qc = np.array(self.chassis_configurations(list(Q)))
+        frames = [self.points[f"{label}_wheel_center"].frame_id for label in LABELS]
+        _, Jw = Frames(tree, frames).evaluate(Qc)
+        moving = np.ones(self.model.nv, dtype=bool)
+        moving[self.body_v] = False
+        out = {}
+        for c, i in enumerate(want):
+            quantity = targets[i].quantity
+            scale, per = (1.0, "mm") if quantity == "heave" else (np.pi / 180.0 * 1e3, "deg")
+            for label, Jf in zip(LABELS, Jw, strict=True):
+                rate = np.full(n, np.nan)  # chassis-frame wheel-centre z, m per unit
+                rate[solved] = np.einsum("nv,nv->n", Jf[:, 2, moving], T[:, moving, c])
+                rate = rate * scale  # mm per mm, or mm per deg
+                out[f"deriv_wheel_center_z_wrt_{quantity}_{label}"] = (rate, f"mm/{per}")
+                for name in DERIVED:
+                    gain = columns.get(f"deriv_{name}_wrt_hub_z_{label}")
+                    if gain is not None:
+                        out[f"deriv_{name}_wrt_{quantity}_{label}"] = (gain * rate, f"deg/{per}")
+        return out
+
+
+class VehicleResults(Results):
+    """Columns of a solved vehicle sweep (docs/vehicle.md), in output units."""

@@ -1,0 +1,210 @@
+"""The whole car (docs/vehicle.md): four corners under one body on the road.
+
+Checked against computations of their own: each corner's columns against that
+corner's own sweep at the same chassis-frame wheel-centre height and rack; the
+contact patches on the road and the CG's heave from the written chassis-frame
+points and the body's pose (scipy's rotations, the wheel's lowest point); the
+rates along heave, pitch and roll against finite differences; left/right mirror
+symmetry.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+import pin_susp
+from pin_susp.errors import InputError
+from pin_susp.model.sweep import Sweep, Target, load_sweep
+from pin_susp.subjects.vehicle import LABELS, Vehicle, load_vehicle
+
+EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+FS = EXAMPLES / "vehicle_fs.yaml"
+
+
+@pytest.fixture(scope="module")
+def car():
+    return Vehicle(FS)
+
+
+def body_sweep(heave, pitch, roll, steer=0.0, roads=None) -> Sweep:
+    n = max(len(np.atleast_1d(v)) for v in (heave, pitch, roll, steer))
+    full = lambda v: np.broadcast_to(np.asarray(v, dtype=float), (n,)).copy()  # noqa: E731
+    targets = [
+        Target(None, None, full(heave), quantity="heave"),
+        Target(None, None, full(pitch), quantity="pitch"),
+        Target(None, None, full(roll), quantity="roll"),
+        Target(None, None, full(steer), quantity="steering_wheel"),
+    ]
+    for label, z in (roads or {}).items():
+        targets.append(Target(None, None, full(z), side=label, quantity="road_z"))
+    return Sweep(targets, "<test>")
+
+
+@pytest.fixture(scope="module")
+def combined(car):
+    return car.run_sweep(EXAMPLES / "vehicle_combined.yaml")
+
+
+def test_every_step_closes(car):
+    for name in ("heave", "pitch", "roll", "warp", "steer", "combined"):
+        r = car.run_sweep(EXAMPLES / f"vehicle_{name}.yaml")
+        assert r["solver_converged"].all(), name
+        assert np.max(r["solver_max_residual"]) <= 1e-9, name
+
+
+def test_corner_columns_are_the_corners_own(car, combined):
+    """Each corner at a vehicle step is its own corner solved at the chassis-frame
+    wheel-centre height and rack the vehicle gives it (to 1e-9)."""
+    for label in LABELS:
+        g = car.vehicle.corner(label)
+        corner = pin_susp.Corner(g, warn=False)
+        wc = combined[f"{label}_wheel_center_z"]
+        targets = [Target("wheel_center", "z", wc, "absolute")]
+        if g.steering == "rack":
+            rack = combined[f"{label}_trackrod_inboard_y"]
+            targets.append(Target("trackrod_inboard", "y", rack, "absolute"))
+        own = corner.run_sweep(Sweep(targets, "<own>"))
+        assert own["solver_converged"].all()
+        for column in (
+            "camber",
+            "caster",
+            "kpi",
+            "roadwheel_angle",
+            "scrub_radius",
+            "mechanical_trail",
+            "deriv_camber_wrt_hub_z",
+            "deriv_roadwheel_angle_wrt_hub_z",
+            "motion_ratio",
+            "wheel_rate",
+        ):
+            if column in own.columns:
+                np.testing.assert_allclose(
+                    combined[f"{column}_{label}"], own[column], rtol=0, atol=1e-9, err_msg=column
+                )
+
+
+def world(results, label: str, point: str, cg: np.ndarray) -> np.ndarray:
+    """A written (chassis-frame, mm) point in the road's frame, by scipy's rotations."""
+    p = np.stack([results[f"{label}_{point}_{a}"] for a in "xyz"], axis=1)
+    turn = Rotation.from_euler("YX", np.radians(np.stack([results["pitch"], results["roll"]], 1)))
+    return cg + turn.apply(p - cg) + np.outer(results["heave"], [0.0, 0.0, 1.0])
+
+
+def test_contact_patches_on_the_road(car):
+    """The wheel's lowest point below its centre, from the written points and the
+    body's pose, lies on the road (0, or its road_z) at every step."""
+    sweep = load_sweep(EXAMPLES / "vehicle_warp.yaml")
+    for r, roads in (
+        (car.run_sweep(sweep), {"fr": np.linspace(0, 20, 21), "rl": np.linspace(0, 20, 21)}),
+        (car.run_sweep(EXAMPLES / "vehicle_combined.yaml"), {}),
+    ):
+        cg = car.vehicle.cg * 1e3
+        for label in LABELS:
+            centre = world(r, label, "wheel_center", cg)
+            spin = world(r, label, "axle_outboard", cg) - world(r, label, "axle_inboard", cg)
+            spin /= np.linalg.norm(spin, axis=1)[:, None]
+            up = np.array([0.0, 0.0, 1.0])
+            down = -(up - (spin @ up)[:, None] * spin)  # the wheel plane's downward radius
+            down /= np.linalg.norm(down, axis=1)[:, None]
+            lowest = centre + car.corners[label].wheel.radius * 1e3 * down
+            road = roads.get(label, np.zeros(len(r)))
+            np.testing.assert_allclose(lowest[:, 2], road, rtol=0, atol=1e-9)
+
+
+def test_heave_is_the_cgs_rise(car, combined):
+    """A point at the CG, moved as the body's pose says, rises by the heave."""
+    cg = car.vehicle.cg
+    turn = Rotation.from_euler(
+        "YX", np.radians(np.stack([combined["pitch"], combined["roll"]], 1))
+    ).as_matrix()
+    assert np.allclose(turn @ np.zeros(3), 0.0)  # the CG does not move under a turn about it
+    np.testing.assert_allclose(combined["heave"], np.linspace(0, -10, 21), atol=1e-12)
+    np.testing.assert_allclose(combined["pitch"], np.linspace(0, 1, 21), atol=1e-12)
+    assert cg[1] == 0.0
+
+
+@pytest.mark.parametrize(("quantity", "at", "h"), [("heave", 5.0, 1e-3), ("roll", 0.7, 1e-4)])
+def test_rates_along_the_body(car, quantity, at, h):
+    """deriv_*_wrt_heave / _roll against central finite differences of the sweep."""
+    values = np.array([at - h, at, at + h])
+    pose = {"heave": 0.0, "pitch": 0.3, "roll": 0.0} | {quantity: values}
+    r = car.run_sweep(body_sweep(pose["heave"], pose["pitch"], pose["roll"], steer=20.0))
+    for label in LABELS:
+        for column in ("camber", "roadwheel_angle", "wheel_center_z"):
+            source = (
+                f"{label}_wheel_center_z" if column == "wheel_center_z" else f"{column}_{label}"
+            )
+            fd = (r[source][2] - r[source][0]) / (2 * h)
+            exact = r[f"deriv_{column}_wrt_{quantity}_{label}"][1]
+            assert exact == pytest.approx(fd, rel=1e-5, abs=1e-8), (label, column)
+
+
+def test_mirror_symmetry_in_roll(car):
+    """Rolled one way, the left corners are the right ones rolled the other way."""
+    roll = np.linspace(-2, 2, 9)
+    r = car.run_sweep(body_sweep(np.full(9, 3.0), np.full(9, 0.4), roll))
+    for a, b in (("fl", "fr"), ("rl", "rr")):
+        # (roadwheel_angle is each corner's own toe sign, mirrored with its corner)
+        for column in ("camber", "camber_to_ground", "wheel_travel", "kpi", "roadwheel_angle"):
+            np.testing.assert_allclose(
+                r[f"{column}_{a}"], r[f"{column}_{b}"][::-1], rtol=0, atol=1e-9
+            )
+
+
+def test_steering_wheel_is_the_rack_through_the_c_factor(car):
+    r = car.run_sweep(EXAMPLES / "vehicle_steer.yaml")
+    np.testing.assert_allclose(r["steering_wheel_angle"], np.linspace(-90, 90, 21), atol=1e-9)
+    np.testing.assert_allclose(
+        np.abs(r["rack_displacement"]), np.abs(np.linspace(-90, 90, 21)) / 360 * 90, atol=1e-9
+    )
+    # + turning left: each front wheel's spin axis turns anticlockwise seen from above
+    for label, outboard in (("fl", 1.0), ("fr", -1.0)):
+        axis = r[f"{label}_axle_outboard_x"] - r[f"{label}_axle_inboard_x"]
+        heading = np.degrees(np.arctan2(-axis * outboard, 150.0))  # the axle is 150 mm
+        assert np.all(np.diff(heading) > 0), label
+
+
+def test_bad_files(tmp_path):
+    data = {
+        "scope": "vehicle",
+        "vehicle_config": {"wheelbase": 1500, "cg": {"x": 0.5, "z": 280}},
+        "front": str(EXAMPLES / "vehicle" / "fs_front.yaml"),
+        "rear": str(EXAMPLES / "vehicle" / "fs_rear.yaml"),
+    }
+    with pytest.raises(InputError, match="wheelbase.*1530 mm apart"):
+        load_vehicle(data)
+    data["vehicle_config"]["wheelbase"] = 1530
+    data["vehicle_config"]["cg"] = {"z": 280}
+    with pytest.raises(InputError, match="cg: give exactly one of x"):
+        load_vehicle(data)
+    data["vehicle_config"]["cg"] = {"x": 0.5, "z": 280}
+    data["front"] = str(EXAMPLES / "axle_front.yaml")  # a U-bar: not in a vehicle yet
+    with pytest.raises(InputError, match="front.axle_config.anti_roll"):
+        load_vehicle(data)
+    data["front"] = "nowhere.yaml"
+    with pytest.raises(InputError, match="front: no axle file"):
+        load_vehicle(data)
+
+
+def test_cli_sweep_writes_the_car(tmp_path):
+    import subprocess
+    import sys
+
+    out = tmp_path / "roll.csv"
+    run = subprocess.run(
+        [sys.executable, "-m", "pin_susp", "sweep", str(FS), str(EXAMPLES / "vehicle_roll.yaml")]
+        + ["-o", str(out)],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+    )
+    assert run.returncode == 0, run.stderr
+    assert "suffixed _fl/_fr/_rl/_rr" in run.stdout
+    assert "rack held" not in run.stdout
+    header = next(line for line in out.read_text().splitlines() if not line.startswith("#"))
+    for column in ("camber_fl", "camber_to_ground_rr", "deriv_camber_wrt_roll_fl", "roll"):
+        assert column in header.split(",")
