@@ -24,6 +24,9 @@ where there is no rack, against the fixed-toe-link double wishbone) it prints:
 - the axle's roll sweep of 2 001 steps with every column against its corner's long
   sweep (bump + steer, 2 001 steps) with every column, per step, in alternation
   (target <= 1.3x; ``--axle-long`` runs this figure alone);
+- the example car (examples/vehicle_fs.yaml) rolled ±2° in 2 001 steps with every
+  column against its corner's bump + steer, per step, in alternation (target <= 3x;
+  ``--vehicle`` runs this figure alone, and only it: not yet in the full run);
 - the member forces under examples/loads.yaml's 3 load cases on the pushrod-rocker
   corner's 101-step sweep, as a share of the sweep's own time (target <= 30 %).
 
@@ -609,6 +612,53 @@ def show_loads(loads: dict) -> None:
     )
 
 
+def vehicle_roll(rounds: int, steps: int = 2001) -> dict:
+    """The example car (examples/vehicle_fs.yaml) rolled ±2° in ``steps`` steps with
+    every column, against its corner's bump + steer (examples/pushrod_rocker.yaml) of as
+    many steps with every column: per step, in alternation (issue 26's target <= 3x)."""
+    from pin_susp.subjects.vehicle import Vehicle
+
+    car = Vehicle(EXAMPLES / "vehicle_fs.yaml")
+    flat = np.zeros(steps)
+    roll = Sweep(
+        [
+            Target(None, None, flat, quantity="heave"),
+            Target(None, None, flat, quantity="pitch"),
+            Target(None, None, np.linspace(-2, 2, steps), quantity="roll"),
+            Target(None, None, flat, quantity="steering_wheel"),
+        ],
+        "roll",
+    )
+    corner = pin_susp.Corner(EXAMPLES / "pushrod_rocker.yaml")
+    reference = bump_steer(steps)
+    jobs = {
+        "corner solve": lambda: corner.solve_steps(reference),
+        "corner solve + every column": lambda: corner.run_sweep(reference),
+        "vehicle roll solve": lambda: car.solve_steps(roll),
+        "vehicle roll solve + every column": lambda: car.run_sweep(roll),
+    }
+    us = alternating(jobs, rounds, steps)
+    return {
+        "steps": steps,
+        "us_per_step": us,
+        "ratio": us["vehicle roll solve + every column"] / us["corner solve + every column"],
+        "ratio_solve": us["vehicle roll solve"] / us["corner solve"],
+    }
+
+
+def show_vehicle(figures: dict) -> None:
+    print(
+        f"\nvehicle_fs.yaml rolled ±2° in {figures['steps']} steps against pushrod_rocker.yaml's "
+        "bump + steer, per step, measured in alternation:"
+    )
+    for name, us in figures["us_per_step"].items():
+        print(f"  {name:<36}{us:7.1f} us")
+    print(
+        f"  vehicle / corner: solve + every column {figures['ratio']:.2f}x (target <= 3x), "
+        f"solve alone {figures['ratio_solve']:.2f}x"
+    )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=40, help="repetitions per measurement")
@@ -619,7 +669,13 @@ def main() -> None:
         action="store_true",
         help="only the axle's long roll sweep against its corner's (2 001 steps each)",
     )
+    parser.add_argument(
+        "--vehicle", action="store_true", help="only the car's roll sweep against its corner's"
+    )
     args = parser.parse_args()
+    if args.vehicle:
+        show_vehicle(vehicle_roll(max(3, args.repeat // 8), 201 if args.quick else 2001))
+        return
     if args.axle_long:
         show_axle_long(axle_long(max(3, args.repeat // 8), 201 if args.quick else 2001))
         return

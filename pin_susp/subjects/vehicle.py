@@ -272,6 +272,31 @@ class Vehicle(Assembly):
             out.append(q)
         return out
 
+    def label_corner(self, label: str, plain: dict, qs: list) -> tuple:
+        """A corner of its own for one label's rated spring and its configurations at
+        ``qs`` (chassis frame): solved at its wheel centre's height and the rack's travel,
+        every step at once where the sweep is long (the corner's own march; an axle's
+        label_corner solves one step after another)."""
+        from ..model.sweep import Sweep, Target
+        from .corner import Corner
+
+        g = self.corners[label]
+        corner = Corner(g, apply_setup=False, warn=False, visuals=False)
+        solved = [i for i, q in enumerate(qs) if q is not None]
+        poses = [None] * len(qs)
+        if not solved:
+            return corner, poses
+        p = self.prefix(label)
+        targets = [
+            Target("wheel_center", "z", plain[p + "wheel_center"][solved, 2] * 1e3, "absolute")
+        ]
+        if g.steering == "rack":
+            end = plain[p + rack.INBOARD][solved, 1] * 1e3
+            targets.append(Target(rack.INBOARD, "y", end, "absolute"))
+        for i, s in zip(solved, corner.solve_steps(Sweep(targets, "<corner>")), strict=True):
+            poses[i] = s.q if s.converged else None
+        return corner, poses
+
     def sweep_results(self, sweep, solutions: list, tangents=None, only=None):
         """Every column (docs/vehicle.md): the solver's, each corner's metric columns in
         the chassis frame (suffix ``_fl``…), their rates along heave, pitch and roll, the
