@@ -23,11 +23,12 @@ from pin_susp.subjects.vehicle import LABELS, Vehicle, load_vehicle
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 FS = EXAMPLES / "vehicle_fs.yaml"
+SALOON = EXAMPLES / "vehicle_saloon.yaml"  # MacPherson front, multilink rear
 
 
-@pytest.fixture(scope="module")
-def car():
-    return Vehicle(FS)
+@pytest.fixture(scope="module", params=[FS, SALOON], ids=["fs", "saloon"])
+def car(request):
+    return Vehicle(request.param)
 
 
 def body_sweep(heave, pitch, roll, steer=0.0, roads=None) -> Sweep:
@@ -158,9 +159,9 @@ def test_mirror_symmetry_in_roll(car):
 def test_steering_wheel_is_the_rack_through_the_c_factor(car):
     r = car.run_sweep(EXAMPLES / "vehicle_steer.yaml")
     np.testing.assert_allclose(r["steering_wheel_angle"], np.linspace(-90, 90, 21), atol=1e-9)
-    np.testing.assert_allclose(
-        np.abs(r["rack_displacement"]), np.abs(np.linspace(-90, 90, 21)) / 360 * 90, atol=1e-9
-    )
+    turns = np.linspace(-90, 90, 21) / 360
+    c = car.vehicle.c_factor
+    np.testing.assert_allclose(np.abs(r["rack_displacement"]), np.abs(turns) * c, atol=1e-9)
     # + turning left: each front wheel's spin axis turns anticlockwise seen from above
     for label, outboard in (("fl", 1.0), ("fr", -1.0)):
         axis = r[f"{label}_axle_outboard_x"] - r[f"{label}_axle_inboard_x"]
