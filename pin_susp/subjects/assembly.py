@@ -100,6 +100,7 @@ class Assembly(Composed, AnalysesSurface):
     elements: tuple = ()
     noun: str = "assembly"
     commands: tuple[str, ...] | None = None  # the commands that take it (None: every one)
+    reports: bool = True  # whether ``pin-susp sweep --plot`` draws its report
     tree: object
     urdf: str
     output_points: list[str]

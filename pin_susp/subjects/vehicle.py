@@ -166,6 +166,7 @@ class Vehicle(Assembly):
     labels = LABELS
     noun = "vehicle"
     commands = ("sweep",)  # the rest of docs/vehicle.md's "Not built yet"
+    reports = False
     summary_columns = tuple(
         "heave pitch roll steering_wheel_angle camber_fl camber_fr camber_rl camber_rr "
         "camber_to_ground_fl camber_to_ground_fr camber_to_ground_rl camber_to_ground_rr "

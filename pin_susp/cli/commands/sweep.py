@@ -39,6 +39,8 @@ STREAM_STEPS = 10_000
 
 
 def run(args) -> int:
+    from ...errors import InputError
+
     check_outputs(args, args.output, args.plot)  # before the numerics are imported
     if args.plot is not None:
         check_image(args.plot)
@@ -46,6 +48,10 @@ def run(args) -> int:
     from ...subjects.subject import load_subject
 
     subject = load_subject(args.geometry)  # a corner, or an axle: its columns per side
+    if args.plot is not None and not subject.reports:
+        raise InputError(
+            str(args.geometry), "--plot", f"a {subject.noun}'s report is not built yet"
+        )
     sweep = load_sweep(args.sweep)
     subject.check_sweep(sweep)  # target errors before any work
     if subject.streams and sweep.steps > STREAM_STEPS and args.plot is None:
