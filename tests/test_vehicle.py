@@ -184,8 +184,19 @@ def test_bad_files(tmp_path):
         load_vehicle(data)
     data["vehicle_config"]["cg"] = {"x": 0.5, "z": 280}
     data["front"] = str(EXAMPLES / "axle_front.yaml")  # a U-bar: not in a vehicle yet
-    with pytest.raises(InputError, match="front.axle_config.anti_roll"):
+    with pytest.raises(InputError, match="axle_front.yaml: axle_config.anti_roll: a vehicle's"):
         load_vehicle(data)
+    data["front"] = {"scope": "axle", "axle_config": {"axle_position": "front"}}
+    with pytest.raises(InputError, match=r"^<dict>: front\.hardpoints: missing key"):
+        load_vehicle(data)  # an inline axle's errors under its key in the vehicle file
+    data["front"] = str(EXAMPLES / "vehicle" / "fs_rear.yaml")
+    with pytest.raises(InputError, match="axle_position: rear, not front"):
+        load_vehicle(data)
+    data["front"] = str(EXAMPLES / "vehicle" / "fs_front.yaml")
+    data["vehicle_config"]["cg"] = {"x": 47, "z": 280}  # mm typed for a fraction
+    with pytest.raises(InputError, match="cg.x: 47 is not a fraction"):
+        load_vehicle(data)
+    data["vehicle_config"]["cg"] = {"x": 0.5, "z": 280}
     data["front"] = "nowhere.yaml"
     with pytest.raises(InputError, match="front: no axle file"):
         load_vehicle(data)

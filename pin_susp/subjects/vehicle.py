@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
+from ..errors import InputError
 from ..io.yamlio import Reader, load_yaml
 from ..maths.vectors import unit
 from ..model.geometry import Geometry, contact_patch, summary_repr
@@ -89,26 +90,10 @@ def load_vehicle(source) -> VehicleGeometry:
     here = Path(name).parent if not isinstance(source, dict) else Path(".")
     axles = {}
     for end in AXLES:
-        given = data[end]
-        if isinstance(given, str):
-            path = here / given
-            if not path.is_file():
-                r.fail(end, f"no axle file {given!r} (paths are relative to {name})")
-            axles[end] = load_axle(path)
-        elif isinstance(given, dict):
-            axles[end] = load_axle(given, name)
-        else:
-            r.fail(end, "expected an axle file's path or the axle inline (a mapping)")
-        a = axles[end]
-        for what, value in (("anti_roll", a.anti_roll), ("heave_link", a.heave_link)):
-            if value != "none":
-                r.fail(
-                    f"{end}.axle_config.{what}",
-                    f"a vehicle's axles have no {what.replace('_', '-')} yet (issue 26): "
-                    "give type: none, or sweep the axle on its own",
-                )
-    if axles["rear"].left.steering == "rack":
-        r.fail("rear.axle_config.steering", "rear steer (a rack on the rear axle) is not supported")
+        axles[end] = _axle(data[end], end, here, name, r)
+        position = axles[end].data.get("axle_config", {}).get("axle_position")
+        if position != end:
+            r.fail(f"{end}", f"its axle file says axle_position: {position}, not {end}")
     wheelbase = r.positive(config["wheelbase"], "vehicle_config.wheelbase")
     centres = {end: a.left.design_points()["wheel_center"][0] * 1e3 for end, a in axles.items()}
     drawn = centres["front"] - centres["rear"]
@@ -122,7 +107,13 @@ def load_vehicle(source) -> VehicleGeometry:
     if ("x" in cg) == ("x_mm" in cg):
         r.fail("vehicle_config.cg", "give exactly one of x (a fraction of the wheelbase) or x_mm")
     if "x" in cg:
-        x = centres["front"] - r.number(cg["x"], "vehicle_config.cg.x") * wheelbase
+        share = r.number(cg["x"], "vehicle_config.cg.x")
+        if not 0.0 <= share <= 1.0:
+            r.fail(
+                "vehicle_config.cg.x",
+                f"{share:g} is not a fraction of the wheelbase between 0 and 1 (x_mm: the CG's x)",
+            )
+        x = centres["front"] - share * wheelbase
     else:
         x = r.length(cg["x_mm"], "vehicle_config.cg.x_mm")
     z = r.positive(cg["z"], "vehicle_config.cg.z")
@@ -152,6 +143,43 @@ def load_vehicle(source) -> VehicleGeometry:
         sha,
         data,
     )
+
+
+def _axle(given, end: str, here: Path, name: str, r: Reader) -> AxleGeometry:
+    """The front or rear axle: a file relative to the vehicle's, or inline (its errors
+    then named in the vehicle file, under ``front.``/``rear.``). A bar or heave link
+    is refused before the axle is read (not in a vehicle yet)."""
+    if isinstance(given, str):
+        path = here / given
+        if not path.is_file():
+            r.fail(end, f"no axle file {given!r} (paths are relative to {name})")
+        raw, where, prefix = load_yaml(path)[0], str(path), ""
+    elif isinstance(given, dict):
+        raw, where, prefix = given, name, f"{end}."
+    else:
+        r.fail(end, "expected an axle file's path or the axle inline (a mapping)")
+    config = raw.get("axle_config") if isinstance(raw, dict) else None  # (load_axle: the rest)
+    for what in ("anti_roll", "heave_link"):
+        kind = config.get(what, {}).get("type", "none") if isinstance(config, dict) else "none"
+        if kind != "none":
+            raise InputError(
+                where,
+                f"{prefix}axle_config.{what}",
+                f"a vehicle's axles have no {what.replace('_', '-')} yet: give type: none, "
+                "or sweep the axle on its own",
+            )
+    if isinstance(config, dict) and end == "rear":
+        steering = config.get("steering", {})
+        if isinstance(steering, dict) and steering.get("type") == "rack":
+            raise InputError(
+                where, f"{prefix}axle_config.steering", "rear steer (a rear rack) is not supported"
+            )
+    try:
+        return load_axle(path if isinstance(given, str) else given)
+    except InputError as exc:
+        if prefix:  # inline: named in the vehicle file
+            raise InputError(name, f"{prefix}{exc.key}", exc.problem) from None
+        raise
 
 
 class Vehicle(Assembly):
@@ -228,6 +256,25 @@ class Vehicle(Assembly):
 
     def undetermined(self, targets) -> str:
         return "the targets do not fix the vehicle's pose at its design state"
+
+    def target_rows(self, targets: list, source: str = "<targets>") -> list:
+        """Assembly.target_rows, after the vehicle's own reading of what a target names:
+        a quantity of the body, a point on a corner labelled fl, fr, rl or rr."""
+        for i, t in enumerate(targets):
+            if t.quantity is not None and t.quantity not in self.quantities:
+                raise InputError(
+                    source,
+                    f"targets[{i}].quantity",
+                    f"{t.quantity} is not a vehicle's: {', '.join(self.quantities)}",
+                )
+            if t.quantity is None and t.side not in LABELS:
+                raise InputError(
+                    source,
+                    f"targets[{i}].side",
+                    f"a vehicle's point targets name their corner (side: {'|'.join(LABELS)}), "
+                    f"got {t.side}",
+                )
+        return super().target_rows(targets, source)
 
     def held_targets(self, targets: list) -> list:
         """Its sweep's targets, each corner's road height (0) where none is given, and the
