@@ -246,7 +246,7 @@ def summary(results, path) -> None:
 
 
 def sweep_summary(
-    results, digest: Digest, path, columns: tuple[str, ...] | None, suffixes: str = ""
+    results, digest: Digest, path, columns: tuple[str, ...] | None, suffixes: str = "_left/_right"
 ) -> None:
     """A sweep's printed summary: every metric column (``columns`` None), or those the
     subject names (Assembly.summary_columns: an axle's own and each side's main);
@@ -254,7 +254,7 @@ def sweep_summary(
     if columns is None:
         summary(digest, path)
     else:
-        columns_summary(results, digest, path, columns, suffixes or "_left/_right")
+        columns_summary(results, digest, path, columns, suffixes)
 
 
 def columns_summary(

@@ -485,9 +485,10 @@ class Assembly(Composed, AnalysesSurface):
         kind = self.results_class
         columns, units = kind.solver_columns(solutions)
         # A step that did not converge has no trustworthy pose: its cells stay empty.
-        qs = [s.q if s.converged else None for s in solutions]
+        solved = [s.q if s.converged else None for s in solutions]
         if tangents is None:
             tangents = [s.drive_tangent for s in solutions]
+        qs, tangents = self.measured_at(solved, tangents)
         points = self.label_motion(qs, tangents)
         for name, (values, column_unit) in self.metric_columns(points, only).items():
             columns[name], units[name] = values, column_unit
@@ -500,12 +501,25 @@ class Assembly(Composed, AnalysesSurface):
             for name, (values, column_unit) in rate_columns(corner, poses).items():
                 columns[name + self.suffix(label)] = values
                 units[name + self.suffix(label)] = column_unit
+        for name, (values, column_unit) in self.own_columns(sweep, solved, plain, columns).items():
+            columns[name], units[name] = values, column_unit
         for name, (values, column_unit) in point_columns(self.output_points, plain).items():
             if only is None or name in only:
                 columns[name], units[name] = values, column_unit
         meta = kind.solver_meta(solutions, (self.source, self.sha256), sweep, self)
         meta["notes"] = self.sweep_notes(sweep.targets)
         return kind(columns, units, meta)
+
+    def measured_at(self, qs: list, tangents: list) -> tuple[list, list | None]:
+        """The configurations its corners' columns and points are measured at, with their
+        tangents per driver: the solved ones (a vehicle's: its chassis frame)."""
+        return qs, tangents
+
+    def own_columns(self, sweep: Sweep, qs: list, plain: dict, columns: dict) -> dict:
+        """Its columns beyond its corners' and elements' (name → (values, unit)), from the
+        solved configurations ``qs``, the points as measured (``plain``, m) and the
+        columns so far: none (a vehicle's body)."""
+        return {}
 
     def run_sweep_chunks(self, sweep: Sweep | str | dict, rows: int = CHUNK, progress=None):
         """The sweep's Results ``rows`` steps at a time (each chunk's ``step_index``

@@ -230,7 +230,8 @@ class Vehicle(Assembly):
             label: (Linkage(g).spring_sense if g.spring == "torsion_bar" else 1.0)
             for label, g in self.corners.items()
         }
-        self.body_v = [self.model.joints[self.model.getJointId(j)].idx_v for j in JOINTS]
+        body = [self.model.joints[self.model.getJointId(j)] for j in JOINTS]
+        self.body_q, self.body_v = [j.idx_q for j in body], [j.idx_v for j in body]
 
     def __repr__(self) -> str:
         v = self.vehicle
@@ -316,7 +317,7 @@ class Vehicle(Assembly):
                 out.append(None)
                 continue
             q = np.array(q, dtype=float)
-            q[self.body_v] = 0.0
+            q[self.body_q] = 0.0
             out.append(q)
         return out
 
@@ -345,45 +346,24 @@ class Vehicle(Assembly):
             poses[i] = s.q if s.converged else None
         return corner, poses
 
-    def sweep_results(self, sweep, solutions: list, tangents=None, only=None):
-        """Every column (docs/vehicle.md): the solver's, each corner's metric columns in
-        the chassis frame (suffix ``_fl``…), their rates along heave, pitch and roll, the
-        body's pose, what the road sees, then every point in the chassis frame."""
-        from ..columns.metrics import point_columns
-        from ..solve.rates import rate_columns
+    def measured_at(self, qs: list, tangents: list) -> tuple[list, None]:
+        """Its chassis frame: each configuration with the body's joints at zero, the
+        tangents per driver solved there (the sweep's are along its own targets)."""
+        return self.chassis_configurations(qs), None
 
-        kind = self.results_class
-        columns, units = kind.solver_columns(solutions)
-        qs = [s.q if s.converged else None for s in solutions]
-        chassis = self.chassis_configurations(qs)
-        points = self.label_motion(chassis)
-        for name, (values, unit_) in self.metric_columns(points, only).items():
-            columns[name], units[name] = values, unit_
-        plain = {name: p["fl"].val for name, p in points.items()}
-        for label, g in self.corners.items():
-            if not g.rated_spring:
-                continue
-            corner, poses = self.label_corner(label, plain, chassis)
-            for name, (values, unit_) in rate_columns(corner, poses).items():
-                columns[name + self.suffix(label)], units[name + self.suffix(label)] = values, unit_
-        for name, (values, unit_) in self.body_columns(sweep, qs, plain, columns).items():
-            columns[name], units[name] = values, unit_
-        for name, (values, unit_) in point_columns(self.output_points, plain).items():
-            if only is None or name in only:
-                columns[name], units[name] = values, unit_
-        meta = kind.solver_meta(solutions, (self.source, self.sha256), sweep, self)
-        meta["notes"] = self.sweep_notes(sweep.targets)
-        return kind(columns, units, meta)
+    def own_columns(self, sweep, qs: list, plain: dict, columns: dict) -> dict:
+        """The body's pose, what the road sees and the rates along the body
+        (``body_columns``)."""
+        return self.body_columns(sweep, qs, plain, columns)
 
     def body_columns(self, sweep, qs: list, plain: dict, columns: dict) -> dict:
         """The body's heave, pitch, roll and steering-wheel angle; each corner's camber
         to ground; the wheelbase on the road per side; and the exact rates of each
         corner's camber, toe and wheel-centre height along heave, pitch and roll."""
-        n = len(qs)
-        pose = np.full((n, 3), np.nan)
-        for i, q in enumerate(qs):
-            if q is not None:
-                pose[i] = [q[self.model.joints[self.model.getJointId(j)].idx_q] for j in JOINTS]
+        pose = np.full((len(qs), 3), np.nan)
+        solved = [i for i, q in enumerate(qs) if q is not None]
+        if solved:
+            pose[solved] = np.array([qs[i] for i in solved])[:, self.body_q]
         heave, pitch, roll = pose.T
         out = {
             "heave": (heave * 1e3, "mm"),
@@ -398,7 +378,7 @@ class Vehicle(Assembly):
         if travel is not None and self.body.c_factor is not None:
             angle = self.body.steer_sense * travel * 1e3 / self.body.c_factor * 360.0
             out["steering_wheel_angle"] = (angle, "deg")
-        world, contact = {}, {}
+        contact = {}
         for label in LABELS:
             p = f"{label}_"
             w = {
@@ -414,7 +394,6 @@ class Vehicle(Assembly):
             contact[label] = contact_patch(
                 w["wheel_center"], spin["world"], self.corners[label].wheel.radius
             )
-            world[label] = w
         for side in ("left", "right"):
             f, r = ("fl", "rl") if side == "left" else ("fr", "rr")
             out[f"wheelbase_{side}"] = ((contact[f][:, 0] - contact[r][:, 0]) * 1e3, "mm")

@@ -45,13 +45,12 @@ def run(args) -> int:
     if args.plot is not None:
         check_image(args.plot)
     from ...model.sweep import load_sweep
-    from ...subjects.subject import load_subject
+    from ...subjects.subject import load_subject, subject_class
 
+    kind = subject_class(args.geometry) if args.plot is not None else None
+    if kind is not None and not kind.reports:  # before any work
+        raise InputError(str(args.geometry), "--plot", f"a {kind.noun}'s report is not built yet")
     subject = load_subject(args.geometry)  # a corner, or an axle: its columns per side
-    if args.plot is not None and not subject.reports:
-        raise InputError(
-            str(args.geometry), "--plot", f"a {subject.noun}'s report is not built yet"
-        )
     sweep = load_sweep(args.sweep)
     subject.check_sweep(sweep)  # target errors before any work
     if subject.streams and sweep.steps > STREAM_STEPS and args.plot is None:
