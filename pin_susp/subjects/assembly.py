@@ -521,6 +521,36 @@ class Assembly(Composed, AnalysesSurface):
         columns so far: none (a vehicle's body)."""
         return {}
 
+    # ------------------------------------------------------------ exported models
+
+    @property
+    def export_tree(self):
+        """The tree its URDF and MJCF are written from (docs/urdf.md): its model's own (a
+        vehicle's: its body floating, without the road and the body's joints)."""
+        return self.tree
+
+    @property
+    def export_urdf(self) -> str:
+        """The URDF ``pin-susp urdf`` writes and the Drake engine reads: its model's own."""
+        return self.urdf
+
+    def engine_steps(self, sweep: Sweep) -> list[list]:
+        """Every step's targets as the validation's engines take them (analyses/
+        pointwise.py), as its sweep holds them (the rack at design if not given): a
+        point's by its label's prefix, absolute (m); an axle's heave and roll."""
+        from ..analyses.pointwise import sweep_values, targets_at
+
+        targets = self.held_sweep(sweep).targets
+        design = self.design_positions
+        return [targets_at(targets, v, design) for v in sweep_values(targets, design)]
+
+    def road_columns(self, road: dict, points: dict, columns: dict) -> dict:
+        """Its columns an engine's points give beyond the metric columns (name → (values
+        (1,), unit)), from ``road`` (the points where the engine solved them, m),
+        ``points`` (a Dual per label, as its sweep measures them) and the metric
+        ``columns``: none (a vehicle's body: what the road sees)."""
+        return {}
+
     def run_sweep_chunks(self, sweep: Sweep | str | dict, rows: int = CHUNK, progress=None):
         """The sweep's Results ``rows`` steps at a time (each chunk's ``step_index``
         counts from the sweep's first step): the same values as run_sweep, in memory

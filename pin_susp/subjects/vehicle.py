@@ -40,6 +40,7 @@ from .axle_file import AxleGeometry, load_axle
 from .corner import Results
 from .elements import rack
 from .elements.body import JOINTS, BodyOnRoad
+from .vehicle_export import VehicleExport
 
 LABELS = ("fl", "fr", "rl", "rr")
 AXLES = {"front": ("fl", "fr"), "rear": ("rl", "rr")}
@@ -182,7 +183,7 @@ def _axle(given, end: str, here: Path, name: str, r: Reader) -> AxleGeometry:
         raise
 
 
-class Vehicle(Assembly):
+class Vehicle(VehicleExport, Assembly):
     """Four corners under one sprung body on the road, one Pinocchio model
     (docs/vehicle.md): ``Vehicle("examples/vehicle_fs.yaml")`` or a VehicleGeometry.
 
@@ -193,7 +194,7 @@ class Vehicle(Assembly):
 
     labels = LABELS
     noun = "vehicle"
-    commands = ("sweep",)  # the rest of docs/vehicle.md's "Not built yet"
+    commands = ("sweep", "urdf", "mjcf", "validate")  # the rest: docs/vehicle.md's "Not built yet"
     reports = False
     summary_columns = tuple(
         "heave pitch roll steering_wheel_angle camber_fl camber_fr camber_rl camber_rr "

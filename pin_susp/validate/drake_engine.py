@@ -1,6 +1,8 @@
 """The Drake engine (README, How it works): the exported URDF in Drake's own parser,
 the closures and targets as constraints of its InverseKinematics, solved by IPOPT;
-the URDF checked to be the subject's.
+the URDF checked to be the subject's. A floating root (a vehicle's body: the URDF's
+root link, which Drake puts on a floating joint) is held at each step's pose by
+bounds on that joint's positions.
 """
 
 from __future__ import annotations
@@ -12,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..analyses.pointwise import Along, as_target
+from ..analyses.pointwise import Along, BodyPose, as_target
 from ..errors import PinSuspError
 from ..model.urdf import NAMESPACE, read_closures, tree_to_urdf
 from .engines import Warnings, target_rows, with_contact_patches
@@ -97,10 +99,12 @@ class DrakeCorner:
 
         scope = scope_of(subject)
         root = next(b.name for b in scope.tree.bodies if b.parent is None)
+        floating = scope.tree.floating is not None
         self.plant = plant = MultibodyPlant(0.0)
         try:
             Parser(plant).AddModelsFromString(urdf_text, "urdf")
-            plant.WeldFrames(plant.world_frame(), plant.GetFrameByName(root))
+            if not floating:  # the root is the world; else Drake floats it
+                plant.WeldFrames(plant.world_frame(), plant.GetFrameByName(root))
             plant.Finalize()
         except (RuntimeError, ValueError) as exc:
             detail = " ".join(str(exc).replace("<literal-string>.urdf:", "line ").split())
@@ -109,7 +113,19 @@ class DrakeCorner:
         self.wrt = JacobianWrtVariable.kQDot
         self.context = plant.CreateDefaultContext()
         self.q_design = np.zeros(plant.num_positions())
+        # the floating root's positions (quaternion w x y z, then x y z) and the rest
+        self.base, self.moving = None, np.ones(plant.num_positions(), dtype=bool)
+        if floating:
+            body = plant.GetBodyByName(root)
+            self.root = body
+            if not body.is_floating_base_body():
+                raise PinSuspError(f"{source}: its root {root} does not float in Drake")
+            start = body.floating_positions_start()
+            self.base = slice(start, start + 7)
+            self.moving[self.base] = False
+            self.q_design[start] = 1.0  # the identity quaternion: the design place
         plant.SetPositions(self.context, self.q_design)
+        self.road = {}  # the points where the last solve put them
         for i in range(plant.num_frames()):
             f = plant.get_frame(FrameIndex(i))
             where = f.CalcPoseInWorld(self.context).translation()
@@ -177,14 +193,35 @@ class DrakeCorner:
             out.append(np.linalg.norm(d) if c.kind == "ball" else np.linalg.norm(d) - c.length)
         return np.array(out)
 
-    def program(self, targets):
+    def _placed(self, pose: BodyPose | None) -> np.ndarray:
+        """The design configuration with a floating root at ``pose`` (None: its design
+        place)."""
+        q = self.q_design.copy()
+        if pose is None or self.base is None:
+            if pose is not None:
+                raise PinSuspError("the URDF's root does not float: not this vehicle's")
+            return q
+        from pydrake.math import RigidTransform, RotationMatrix
+
+        self.plant.SetPositions(self.context, q)
+        self.plant.SetFreeBodyPose(
+            self.context,
+            self.root,
+            RigidTransform(RotationMatrix(np.asarray(pose.rotation)), pose.translation),
+        )
+        return self.plant.GetPositions(self.context).copy()
+
+    def program(self, targets, pose: BodyPose | None = None):
         """Drake's InverseKinematics of one step: the closures and the targets as its
         constraints (no cost: the system is square), joint limits left out as
-        pin_susp's solver has none."""
+        pin_susp's solver has none; a floating root's positions bounded to ``pose``."""
         from pydrake.math import RigidTransform, RotationMatrix
         from pydrake.multibody.inverse_kinematics import InverseKinematics
 
         ik = InverseKinematics(self.plant, with_joint_limits=False)
+        if self.base is not None:
+            held = self._placed(pose)[self.base]
+            ik.prog().AddBoundingBoxConstraint(held, held, ik.q()[self.base])
         for c in self.closures:
             if c.kind == "ball":
                 # anchor a, seen from b's link, is at anchor b
@@ -220,12 +257,14 @@ class DrakeCorner:
         plant has every closure and target within DRAKE_RESIDUAL at its answer."""
         from pydrake.solvers import IpoptSolver, SolverOptions
 
-        ik = self.program(targets)
+        pose = next((t for t in targets if isinstance(t, BodyPose)), None)
+        targets = [t for t in targets if t is not pose]
+        ik = self.program(targets, pose)
         solver = IpoptSolver()
         options = SolverOptions()
         for key, value in IPOPT_OPTIONS.items():
             options.SetOption(solver.solver_id(), key, value)
-        result = solver.Solve(ik.prog(), self.q_design, options)
+        result = solver.Solve(ik.prog(), self._placed(pose), options)
         q = result.GetSolution(ik.q())
         if not (result.is_success() and np.all(np.isfinite(q))):
             return None
@@ -233,6 +272,11 @@ class DrakeCorner:
         residual = np.r_[self._closure_residuals(), self._rows(targets)[0]]
         if not np.max(np.abs(residual), initial=0.0) < DRAKE_RESIDUAL:
             return None
+        self.road = {name: site.position(self).copy() for name, site in self.sites.items()}
+        if self.base is None:
+            return self.road
+        q[self.base] = self.q_design[self.base]  # the root back at its design place
+        self.plant.SetPositions(self.context, q)
         return {name: site.position(self).copy() for name, site in self.sites.items()}
 
     def rates(self, held, links, k: int) -> dict[str, np.ndarray]:
@@ -258,7 +302,8 @@ class DrakeCorner:
             if frozenset(pair) in link_row:
                 rhs[link_row[frozenset(pair)], j] = 1.0
                 known.append(j)
-        dq = np.linalg.lstsq(np.array(rows), rhs, rcond=None)[0]
+        dq = np.zeros((len(self.moving), k))  # a floating root stays still
+        dq[self.moving] = np.linalg.lstsq(np.array(rows)[:, self.moving], rhs, rcond=None)[0]
         out = {}
         for name, site in self.sites.items():
             out[name] = np.full((k, 3), np.nan)
@@ -299,7 +344,7 @@ def drake_points(subject, sweep, urdf_text: str | None = None, source: str = "th
     """Drake's points at every step (None where it did not converge), quietly, as the
     subject's motion gives them; ``urdf_text`` defaults to the subject's own export."""
     scope = scope_of(subject)
-    text = scope.subject.urdf if urdf_text is None else urdf_text
+    text = scope.subject.export_urdf if urdf_text is None else urdf_text
     return scope.as_motion(drake_run(scope, sweep, text, source)[0])
 
 
@@ -319,7 +364,7 @@ def drake_run(scope, sweep, urdf_text: str, source: str):
                 points.append(None)
                 continue
             rates = engine.rates(scope.held(at), scope.links, scope.drivers)
-            points.append(scope.duals(at, rates))
+            points.append(scope.duals(at, rates, engine.road))
     return points, counter
 
 

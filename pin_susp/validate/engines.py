@@ -26,7 +26,9 @@ def pointwise_run(scope, sweep) -> list[dict | None]:
     """The point-based formulation's points at every step, a Dual per label (the
     scope's form); None where it did not converge.
 
-    The rates: the tangent of its own equations, J·dx = e for the driver's row
+    Where the root floats (a vehicle's body), the points are solved in the body's frame,
+    the targets turned into it (Scope.fixed_root_targets), and placed on the road by the
+    step's pose. The rates: the tangent of its own equations, J·dx = e for the driver's row
     (the held target's, or the toe link's distance), solved in the least-squares
     sense (its rigid-part distances are redundant, the system is consistent);
     the points then move along dx (Richardson differences of the explicit point
@@ -35,6 +37,7 @@ def pointwise_run(scope, sweep) -> list[dict | None]:
     model = scope.pointwise()
     out = []
     for targets in scope.step_targets(sweep):
+        targets, pose = scope.fixed_root_targets(targets)  # a floating body's: its frame
         x, residual = model.solve(targets)
         if not residual < 1e-12:
             out.append(None)
@@ -57,7 +60,7 @@ def pointwise_run(scope, sweep) -> list[dict | None]:
             for name in points:
                 d1, d2 = at[1][name] - at[-1][name], at[2][name] - at[-2][name]
                 rates[name][j] = (8.0 * d1 - d2) / (12.0 * h)
-        out.append(scope.duals(points, rates))
+        out.append(scope.duals(points, rates, None if pose is None else pose.to_road(points)))
     return out
 
 

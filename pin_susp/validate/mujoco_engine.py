@@ -1,5 +1,7 @@
 """The MuJoCo engine (README, How it works): the exported MJCF in MuJoCo, solved to
-every step's targets by Newton on its own Jacobians, its warnings counted.
+every step's targets by Newton on its own Jacobians, its warnings counted. A floating
+root (a vehicle's body on its ``freejoint``) is placed at each step's pose by setting
+the freejoint's ``qpos``, and held there while the rest is solved.
 """
 
 from __future__ import annotations
@@ -8,6 +10,7 @@ from contextlib import contextmanager
 
 import numpy as np
 
+from ..analyses.pointwise import BodyPose
 from ..errors import PinSuspError
 from .engines import Warnings, target_rows, with_contact_patches
 from .scopes import scope_of
@@ -35,6 +38,34 @@ class MujocoCorner:
         self.sites = with_contact_patches(
             {name: _Site(self, name, source) for name in scope.sites}, scope
         )
+        m = self.model
+        free = [j for j in range(m.njnt) if m.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE]
+        # the floating root's qpos address (position, then quaternion w x y z) and the
+        # dofs that move in a solve: every one but the floating root's
+        self.base = int(m.jnt_qposadr[free[0]]) if free else None
+        self.moving = np.ones(m.nv, dtype=bool)
+        if free:
+            self.moving[m.jnt_dofadr[free[0]] : m.jnt_dofadr[free[0]] + 6] = False
+        self.source = source
+        self.road = {}  # the points where the last solve put them
+
+    def _place(self, pose: BodyPose | None) -> None:
+        """The floating root at ``pose`` (its qpos), or at its design place (None)."""
+        if self.base is None:
+            if pose is None:
+                return
+            raise PinSuspError(
+                f"{self.source}: its root does not float (no freejoint): it is not the MJCF "
+                "of this vehicle"
+            )
+        q = self.data.qpos
+        if pose is None:
+            q[self.base : self.base + 7] = self.model.qpos0[self.base : self.base + 7]
+            return
+        quat = np.zeros(4)
+        self.mj.mju_mat2Quat(quat, np.ascontiguousarray(pose.rotation).ravel())
+        q[self.base : self.base + 3] = pose.translation
+        q[self.base + 3 : self.base + 7] = quat
 
     def _rows(self, targets) -> tuple[list, list]:
         """Each target's residual and its row of d residual / dv (chain rule through
@@ -43,9 +74,15 @@ class MujocoCorner:
         return target_rows(self, p, targets)
 
     def solve(self, targets, iterations: int = 30) -> dict | None:
-        """Newton from the design state to the targets."""
+        """Newton from the design state to the targets; a floating root held at the
+        step's pose (its BodyPose). The points: where it solved them (``road``), and
+        returned with the root put back at its design place, the joints kept (a
+        vehicle's chassis frame)."""
         m, d, mj = self.model, self.data, self.mj
+        pose = next((t for t in targets if isinstance(t, BodyPose)), None)
+        targets = [t for t in targets if t is not pose]
         d.qpos[:] = m.qpos0
+        self._place(pose)
         for _ in range(iterations + 1):
             mj.mj_forward(m, d)
             eq = d.efc_type[: d.nefc] == mj.mjtConstraint.mjCNSTR_EQUALITY
@@ -54,20 +91,31 @@ class MujocoCorner:
             if not np.all(np.isfinite(r)):
                 return None  # diverged, or a NaN in the MJCF: lstsq would fail on it
             if np.max(np.abs(r)) < 1e-13:
-                return {name: s.position(self).copy() for name, s in self.sites.items()}
+                return self._points()
             jac = [d.efc_J.reshape(d.nefc, m.nv)[eq]] if d.nefc else []
             J = np.vstack(jac + rows)
             if not np.all(np.isfinite(J)):
                 return None
-            dv = np.linalg.lstsq(J, -r, rcond=None)[0]
+            dv = np.zeros(m.nv)
+            dv[self.moving] = np.linalg.lstsq(J[:, self.moving], -r, rcond=None)[0]
             mj.mj_integratePos(m, d.qpos, dv, 1.0)
         return None
+
+    def _points(self) -> dict:
+        """Every point where solved (kept as ``road``), then with a floating root put
+        back at its design place (the joints kept), as returned."""
+        self.road = {name: s.position(self).copy() for name, s in self.sites.items()}
+        if self.base is None:
+            return self.road
+        self._place(None)
+        self.mj.mj_forward(self.model, self.data)
+        return {name: s.position(self).copy() for name, s in self.sites.items()}
 
     def rates(self, held, k: int) -> dict[str, np.ndarray]:
         """At the solved pose: each point's rate along the first len(held) of k drivers,
         J·dv = e (equality rows and the held targets' rows, least squares), through
         the sites' Jacobians; NaN for a driver it cannot move (a toe link's length:
-        its links are rigid bodies closed by connects)."""
+        its links are rigid bodies closed by connects). A floating root stays still."""
         m, d, mj = self.model, self.data, self.mj
         mj.mj_forward(m, d)
         eq = d.efc_type[: d.nefc] == mj.mjtConstraint.mjCNSTR_EQUALITY
@@ -75,7 +123,8 @@ class MujocoCorner:
         J = np.vstack(jac + self._rows(held)[1])
         rhs = np.zeros((len(J), len(held)))
         rhs[len(J) - len(held) :] = np.eye(len(held))
-        dv = np.linalg.lstsq(J, rhs, rcond=None)[0]
+        dv = np.zeros((m.nv, len(held)))
+        dv[self.moving] = np.linalg.lstsq(J[:, self.moving], rhs, rcond=None)[0]
         out = {}
         for name, site in self.sites.items():
             out[name] = np.full((k, 3), np.nan)
@@ -153,7 +202,7 @@ def mujoco_run(scope, sweep, mjcf_text: str, source: str):
                     points.append(None)
                     continue
                 rates = engine.rates(scope.held(at), scope.drivers)
-                points.append(scope.duals(at, rates))
+                points.append(scope.duals(at, rates, engine.road))
         except (mujoco.FatalError, mujoco.UnexpectedError) as exc:
             detail = " ".join(str(exc).split())
             raise PinSuspError(f"{source}: MuJoCo failed on it: {detail}") from None
