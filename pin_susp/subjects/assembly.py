@@ -544,11 +544,18 @@ class Assembly(Composed, AnalysesSurface):
         design = self.design_positions
         return [targets_at(targets, v, design) for v in sweep_values(targets, design)]
 
+    def engine_moves(self, sweep: Sweep) -> list[dict]:
+        """Every step's targets with each of its body's quantities moved a little (a
+        vehicle's heave, pitch and roll: quantity → (h, the steps at −2h, −h, +h, +2h)),
+        for the engines' rates along them: none."""
+        return [{} for _ in range(sweep.steps)]
+
     def road_columns(self, road: dict, points: dict, columns: dict) -> dict:
         """Its columns an engine's points give beyond the metric columns (name → (values
         (1,), unit)), from ``road`` (the points where the engine solved them, m),
-        ``points`` (a Dual per label, as its sweep measures them) and the metric
-        ``columns``: none (a vehicle's body: what the road sees)."""
+        ``points`` (a Dual per label, as its sweep measures them; ``points.along``: the
+        wheel centres' rates along ``engine_moves``) and the metric ``columns``: none (a
+        vehicle's body: what the road sees, the rates along the body)."""
         return {}
 
     def run_sweep_chunks(self, sweep: Sweep | str | dict, rows: int = CHUNK, progress=None):

@@ -27,6 +27,7 @@ from ..model.tree import Tree
 from ..model.urdf import tree_to_urdf
 
 BODY = ("heave", "pitch", "roll")
+BODY_STEP = 1e-4  # m, rad: the body's step for the engines' rates along it (±h, ±2h)
 AXLE_PAIRS = (("fl", "fr"), ("rl", "rr"))  # each axle's left and right corner
 SIDE_PAIRS = {"left": ("fl", "rl"), "right": ("fr", "rr")}  # each side's front and rear
 Y = np.array([0.0, 1.0, 0.0])
@@ -75,42 +76,62 @@ class VehicleExport:
         there), then each contact patch's height on the road, the steering — as the
         chassis-frame travel of the rack's inboard end, seen from the road with the body
         placed — and any point target as pin_susp holds it (the road's frame)."""
+        targets = self.held_targets(sweep.targets)
+        return [self._engine_step(targets, row) for row in self.target_values(targets)]
+
+    def engine_moves(self, sweep) -> list[dict]:
+        """Every step's targets with one of the body's heave, pitch and roll moved by
+        −2h, −h, +h, +2h, the others held (h: BODY_STEP, m or rad): quantity → (h, those
+        four steps' targets), for the engines' rates along the body."""
+        targets = self.held_targets(sweep.targets)
+        index = {t.quantity: i for i, t in enumerate(targets)}
+        out = []
+        for row in self.target_values(targets):
+            moves = {}
+            for quantity in BODY:
+                shifted = []
+                for k in (-2, -1, 1, 2):
+                    moved = row.copy()
+                    moved[index[quantity]] += k * BODY_STEP
+                    shifted.append(self._engine_step(targets, moved))
+                moves[quantity] = (BODY_STEP, shifted)
+            out.append(moves)
+        return out
+
+    def _engine_step(self, targets: list, row: np.ndarray) -> list:
+        """One step's targets for the engines (``engine_steps``), its values ``row`` (SI)."""
         from ..analyses.pointwise import Along, BodyPose
 
-        targets = self.held_targets(sweep.targets)
-        values = self.target_values(targets)
-        first = self.labels[0]
-        inboard = None
-        if self.corners[first].steering == "rack":
-            inboard = self.prefix(first) + self.corners[first].steering_points[0]
-        steps = []
-        for row in values:
-            pose = dict(zip((t.quantity for t in targets), row, strict=True))
-            rotation, translation = self.body.placement(*(pose[q] for q in BODY))
-            step = [BodyPose(rotation, translation)]
-            for t, value in zip(targets, row, strict=True):
-                if t.quantity in BODY:
-                    continue
-                if t.quantity == "road_z":
-                    step.append(Along(f"{t.side}_contact_patch_center", Z, float(value)))
-                elif t.quantity == "steering_wheel":  # the rack's travel along chassis y
-                    along = rotation @ Y
-                    at = self.design_positions[inboard][1] + value + along @ translation
-                    step.append(Along(inboard, along, float(at)))
-                else:
-                    step.append(Along(self.point_of(t), t.unit_direction, float(value)))
-            steps.append(step)
-        return steps
+        pose = dict(zip((t.quantity for t in targets), row, strict=True))
+        rotation, translation = self.body.placement(*(pose[q] for q in BODY))
+        step = [BodyPose(rotation, translation)]
+        for t, value in zip(targets, row, strict=True):
+            if t.quantity in BODY:
+                continue
+            if t.quantity == "road_z":
+                step.append(Along(f"{t.side}_contact_patch_center", Z, float(value)))
+            elif t.quantity == "steering_wheel":  # the rack's travel along chassis y
+                first = self.labels[0]
+                inboard = self.prefix(first) + self.corners[first].steering_points[0]
+                along = rotation @ Y
+                at = self.design_positions[inboard][1] + value + along @ translation
+                step.append(Along(inboard, along, float(at)))
+            else:
+                step.append(Along(self.point_of(t), t.unit_direction, float(value)))
+        return step
 
     def road_columns(self, road: dict, points: dict, columns: dict) -> dict:
         """The body's columns an engine's points give (name → (values (1,), unit)), as
-        ``body_columns`` defines them: the rack's travel and the steering-wheel angle
+        ``body_columns`` defines them: its heave, pitch and roll (where the engine placed
+        it, read from its chassis points), the rack's travel and the steering-wheel angle
         (from the chassis-frame points), each corner's camber to ground, the wheelbase
         on the road per side and each contact patch's height (from ``road``: the points
-        where the engine solved them, the road's frame, m)."""
+        where the engine solved them, the road's frame, m), and the rates along the
+        body's heave, pitch and roll (from the engine's wheel-centre rates along them,
+        ``points.along``)."""
         first = self.labels[0]
         chassis = {name: p[first].val[0] for name, p in points.items()}
-        out = {}
+        out = self._pose_columns(road, chassis)
         end = self.prefix(first) + "trackrod_inboard"
         if end in chassis and self.corners[first].steering == "rack":
             travel = chassis[end][1] - self.design_positions[end][1]
@@ -134,4 +155,43 @@ class VehicleExport:
             out[f"wheelbase_{side}"] = (np.array([(contact[f][0] - contact[r][0]) * 1e3]), "mm")
         for label in self.labels:
             out[f"contact_patch_road_z_{label}"] = (np.array([contact[label][2] * 1e3]), "mm")
+        return out | self._rates_along_body(points.along, columns)
+
+    def _pose_columns(self, road: dict, chassis: dict) -> dict:
+        """The body's heave, pitch and roll where an engine placed it: the rigid motion
+        (least squares, Kabsch) that takes its chassis points from the chassis frame to
+        where it solved them, as ``BodyOnRoad.placement`` reads it."""
+        names = [n for n, (body, _) in self.export_tree.points.items() if body == "chassis"]
+        names = [n for n in names if n in road and n in chassis]
+        a = np.array([chassis[n] for n in names])
+        b = np.array([road[n] for n in names])
+        u, _, vt = np.linalg.svd((a - a.mean(0)).T @ (b - b.mean(0)))
+        flip = np.sign(np.linalg.det(vt.T @ u.T))
+        rotation = vt.T @ np.diag([1.0, 1.0, flip]) @ u.T
+        translation = b.mean(0) - rotation @ a.mean(0)
+        cg = self.body.cg
+        heave = (translation + rotation @ cg - cg)[2]
+        pitch = np.arcsin(-rotation[2, 0])
+        roll = np.arctan2(rotation[2, 1], rotation[2, 2])
+        return {
+            "heave": (np.array([heave * 1e3]), "mm"),
+            "pitch": (np.degrees([pitch]), "deg"),
+            "roll": (np.degrees([roll]), "deg"),
+        }
+
+    def _rates_along_body(self, along: dict, columns: dict) -> dict:
+        """``body_rates``' columns from an engine's chassis-frame wheel-centre rates along
+        the body (quantity → {label: m per m or rad}) and its own rates along each hub z."""
+        from .vehicle import DERIVED
+
+        out = {}
+        for quantity, rates in along.items():
+            scale, per = (1.0, "mm") if quantity == "heave" else (np.pi / 180.0 * 1e3, "deg")
+            for label, rate in rates.items():
+                rate = np.array([rate * scale])
+                out[f"deriv_wheel_center_z_wrt_{quantity}_{label}"] = (rate, f"mm/{per}")
+                for name in DERIVED:
+                    gain = columns.get(f"deriv_{name}_wrt_hub_z_{label}")
+                    if gain is not None:
+                        out[f"deriv_{name}_wrt_{quantity}_{label}"] = (gain[0] * rate, f"deg/{per}")
         return out

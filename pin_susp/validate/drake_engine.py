@@ -17,7 +17,7 @@ import numpy as np
 from ..analyses.pointwise import Along, BodyPose, as_target
 from ..errors import PinSuspError
 from ..model.urdf import NAMESPACE, read_closures, tree_to_urdf
-from .engines import Warnings, target_rows, with_contact_patches
+from .engines import Warnings, richardson, target_rows, with_contact_patches
 from .scopes import scope_of
 
 # ---------------------------------------------------------------- Drake
@@ -126,6 +126,7 @@ class DrakeCorner:
             self.q_design[start] = 1.0  # the identity quaternion: the design place
         plant.SetPositions(self.context, self.q_design)
         self.road = {}  # the points where the last solve put them
+        self.moved = {}  # its tangent along each of the body's quantities there (dq)
         for i in range(plant.num_frames()):
             f = plant.get_frame(FrameIndex(i))
             where = f.CalcPoseInWorld(self.context).translation()
@@ -252,13 +253,17 @@ class DrakeCorner:
                 ik.prog().AddConstraint(self._target_constraint(t), [0.0], [0.0], ik.q())
         return ik
 
-    def solve(self, targets) -> dict | None:
+    def solve(self, targets, moves: dict | None = None) -> dict | None:
         """IPOPT from the design configuration; None unless it succeeds and Drake's
-        plant has every closure and target within DRAKE_RESIDUAL at its answer."""
+        plant has every closure and target within DRAKE_RESIDUAL at its answer. A
+        floating root: its points where solved kept as ``road``, returned with the root
+        back at its design place (the joints kept); ``moves``: the step's targets with
+        the body moved (Scope.step_moves), for the tangent along each (``moved``)."""
         from pydrake.solvers import IpoptSolver, SolverOptions
 
         pose = next((t for t in targets if isinstance(t, BodyPose)), None)
         targets = [t for t in targets if t is not pose]
+        self.moved = {}
         ik = self.program(targets, pose)
         solver = IpoptSolver()
         options = SolverOptions()
@@ -273,17 +278,16 @@ class DrakeCorner:
         if not np.max(np.abs(residual), initial=0.0) < DRAKE_RESIDUAL:
             return None
         self.road = {name: site.position(self).copy() for name, site in self.sites.items()}
+        self.moved = self._moved(q, targets, moves or {})
         if self.base is None:
             return self.road
         q[self.base] = self.q_design[self.base]  # the root back at its design place
         self.plant.SetPositions(self.context, q)
         return {name: site.position(self).copy() for name, site in self.sites.items()}
 
-    def rates(self, held, links, k: int) -> dict[str, np.ndarray]:
-        """At the solved pose: each point's rate along the k drivers, J·dq = e: the
-        closures' rows (a ball's three, a distance's one along the link) and the held
-        targets' rows; a driver that is a link's length (``links``: its two points)
-        is a 1 on its distance closure's row. NaN for a link no closure joins."""
+    def _closure_rows(self) -> tuple[list, dict]:
+        """The closures' rows of d residual / dq at the context's pose (a ball's three, a
+        distance's one along the link), and each distance closure's row by its links."""
         rows, link_row = [], {}
         for c in self.closures:
             Ja, Jb = c.a.jacobian(self), c.b.jacobian(self)
@@ -293,6 +297,53 @@ class DrakeCorner:
                 d = c.a.position(self) - c.b.position(self)
                 link_row[c.links] = len(rows)
                 rows.append(d @ (Ja - Jb) / np.linalg.norm(d))
+        return rows, link_row
+
+    def _moved(self, q: np.ndarray, targets, moves: dict) -> dict:
+        """At the solved pose q: dq per unit of each of the body's quantities, the others
+        held — J·dq = −∂r/∂s, the change of the targets' residuals as the floating root
+        moves with the joints held (Richardson differences over the moved poses; the
+        closures' rows do not change)."""
+        if not moves:
+            return {}
+        closures = self._closure_rows()[0]
+        J = np.array(closures + self._rows(targets)[1])
+        out = {}
+        for quantity, (h, moved) in moves.items():
+            residuals = []
+            for step in moved:
+                pose = next(t for t in step if isinstance(t, BodyPose))
+                shifted = q.copy()
+                shifted[self.base] = self._placed(pose)[self.base]
+                self.plant.SetPositions(self.context, shifted)
+                p = _Positions(self)
+                errors = [as_target(t).error(p) for t in step if t is not pose]
+                residuals.append(np.r_[np.zeros(len(closures)), errors])
+            dq = np.zeros(len(q))
+            dq[self.moving] = np.linalg.lstsq(
+                J[:, self.moving], -richardson(residuals, h), rcond=None
+            )[0]
+            out[quantity] = dq
+        self.plant.SetPositions(self.context, q)
+        return out
+
+    def along(self, hubs: dict) -> dict:
+        """Each wheel centre's z rate along the body's quantities (``moved``), at the
+        context's pose (the chassis frame): quantity → {label: m per m or rad}."""
+        return {
+            quantity: {
+                label: float((self.sites[hub].jacobian(self) @ dq)[2])
+                for label, hub in hubs.items()
+            }
+            for quantity, dq in self.moved.items()
+        }
+
+    def rates(self, held, links, k: int) -> dict[str, np.ndarray]:
+        """At the solved pose: each point's rate along the k drivers, J·dq = e: the
+        closures' rows (a ball's three, a distance's one along the link) and the held
+        targets' rows; a driver that is a link's length (``links``: its two points)
+        is a 1 on its distance closure's row. NaN for a link no closure joins."""
+        rows, link_row = self._closure_rows()
         first = len(rows)
         rows += self._rows(held)[1]
         rhs = np.zeros((len(rows), k))
@@ -354,9 +405,9 @@ def drake_run(scope, sweep, urdf_text: str, source: str):
     with quiet_drake() as counter:
         engine = DrakeCorner(urdf_text, scope, source)
         points = []
-        for targets in scope.step_targets(sweep):
+        for targets, moves in zip(scope.step_targets(sweep), scope.step_moves(sweep), strict=True):
             try:
-                at = engine.solve(targets)
+                at = engine.solve(targets, moves)
             except RuntimeError as exc:
                 detail = " ".join(str(exc).split())
                 raise PinSuspError(f"{source}: Drake failed on it: {detail}") from None
@@ -364,7 +415,7 @@ def drake_run(scope, sweep, urdf_text: str, source: str):
                 points.append(None)
                 continue
             rates = engine.rates(scope.held(at), scope.links, scope.drivers)
-            points.append(scope.duals(at, rates, engine.road))
+            points.append(scope.duals(at, rates, engine.road, engine.along(scope.hubs)))
     return points, counter
 
 

@@ -10,9 +10,9 @@ from contextlib import contextmanager
 
 import numpy as np
 
-from ..analyses.pointwise import BodyPose
+from ..analyses.pointwise import BodyPose, as_target
 from ..errors import PinSuspError
-from .engines import Warnings, target_rows, with_contact_patches
+from .engines import Warnings, richardson, target_rows, with_contact_patches
 from .scopes import scope_of
 
 
@@ -48,6 +48,7 @@ class MujocoCorner:
             self.moving[m.jnt_dofadr[free[0]] : m.jnt_dofadr[free[0]] + 6] = False
         self.source = source
         self.road = {}  # the points where the last solve put them
+        self.moved = {}  # its tangent along each of the body's quantities there (dv)
 
     def _place(self, pose: BodyPose | None) -> None:
         """The floating root at ``pose`` (its qpos), or at its design place (None)."""
@@ -73,14 +74,16 @@ class MujocoCorner:
         p = {name: site.position(self) for name, site in self.sites.items()}
         return target_rows(self, p, targets)
 
-    def solve(self, targets, iterations: int = 30) -> dict | None:
+    def solve(self, targets, iterations: int = 30, moves: dict | None = None) -> dict | None:
         """Newton from the design state to the targets; a floating root held at the
         step's pose (its BodyPose). The points: where it solved them (``road``), and
         returned with the root put back at its design place, the joints kept (a
-        vehicle's chassis frame)."""
+        vehicle's chassis frame). ``moves``: the step's targets with the body moved
+        (Scope.step_moves), for the tangent along each (``moved``, ``along``)."""
         m, d, mj = self.model, self.data, self.mj
         pose = next((t for t in targets if isinstance(t, BodyPose)), None)
         targets = [t for t in targets if t is not pose]
+        self.moved = {}
         d.qpos[:] = m.qpos0
         self._place(pose)
         for _ in range(iterations + 1):
@@ -91,6 +94,7 @@ class MujocoCorner:
             if not np.all(np.isfinite(r)):
                 return None  # diverged, or a NaN in the MJCF: lstsq would fail on it
             if np.max(np.abs(r)) < 1e-13:
+                self.moved = self._moved(targets, moves or {})
                 return self._points()
             jac = [d.efc_J.reshape(d.nefc, m.nv)[eq]] if d.nefc else []
             J = np.vstack(jac + rows)
@@ -100,6 +104,49 @@ class MujocoCorner:
             dv[self.moving] = np.linalg.lstsq(J[:, self.moving], -r, rcond=None)[0]
             mj.mj_integratePos(m, d.qpos, dv, 1.0)
         return None
+
+    def _moved(self, targets, moves: dict) -> dict:
+        """At the solved pose: dv per unit of each of the body's quantities, the others
+        held — J·dv = −∂r/∂s, the change of the targets' residuals as the floating root
+        moves with the joints held (Richardson differences over the moved poses; the
+        closures' rows do not change)."""
+        if not moves:
+            return {}
+        m, d, mj = self.model, self.data, self.mj
+        eq = d.efc_type[: d.nefc] == mj.mjtConstraint.mjCNSTR_EQUALITY
+        jac = [d.efc_J.reshape(d.nefc, m.nv)[eq]] if d.nefc else []
+        J = np.vstack(jac + self._rows(targets)[1])
+        closures = int(np.count_nonzero(eq))
+        q = d.qpos.copy()
+        out = {}
+        for quantity, (h, moved) in moves.items():
+            residuals = []
+            for step in moved:
+                pose = next(t for t in step if isinstance(t, BodyPose))
+                self._place(pose)
+                mj.mj_kinematics(m, d)
+                p = {name: s.position(self) for name, s in self.sites.items()}
+                errors = [as_target(t).error(p) for t in step if t is not pose]
+                residuals.append(np.r_[np.zeros(closures), errors])
+            d.qpos[:] = q
+            dv = np.zeros(m.nv)
+            dv[self.moving] = np.linalg.lstsq(
+                J[:, self.moving], -richardson(residuals, h), rcond=None
+            )[0]
+            out[quantity] = dv
+        mj.mj_forward(m, d)
+        return out
+
+    def along(self, hubs: dict) -> dict:
+        """Each wheel centre's z rate along the body's quantities (``moved``), at the
+        current pose (the chassis frame): quantity → {label: m per m or rad}."""
+        return {
+            quantity: {
+                label: float((self.sites[hub].jacobian(self) @ dv)[2])
+                for label, hub in hubs.items()
+            }
+            for quantity, dv in self.moved.items()
+        }
 
     def _points(self) -> dict:
         """Every point where solved (kept as ``road``), then with a floating root put
@@ -196,13 +243,15 @@ def mujoco_run(scope, sweep, mjcf_text: str, source: str):
         try:
             engine = MujocoCorner(mjcf_text, scope, source)
             points = []
-            for targets in scope.step_targets(sweep):
-                at = engine.solve(targets)
+            steps = zip(scope.step_targets(sweep), scope.step_moves(sweep), strict=True)
+            for targets, moves in steps:
+                at = engine.solve(targets, moves=moves)
                 if at is None:
                     points.append(None)
                     continue
                 rates = engine.rates(scope.held(at), scope.drivers)
-                points.append(scope.duals(at, rates, engine.road))
+                along = engine.along(scope.hubs)
+                points.append(scope.duals(at, rates, engine.road, along))
         except (mujoco.FatalError, mujoco.UnexpectedError) as exc:
             detail = " ".join(str(exc).split())
             raise PinSuspError(f"{source}: MuJoCo failed on it: {detail}") from None

@@ -88,6 +88,11 @@ class Scope:
         exported root floats, the body's pose first (Assembly.engine_steps)."""
         return self.subject.engine_steps(sweep)
 
+    def step_moves(self, sweep) -> list[dict]:
+        """Every step's targets with the body's quantities moved (Assembly.engine_moves):
+        quantity → (h, the steps at −2h, −h, +h, +2h); none but a vehicle's."""
+        return self.subject.engine_moves(sweep)
+
     def fixed_root_targets(self, targets: list) -> tuple[list, object]:
         """One step's targets for an engine without a floating base (the point-based
         one): in the body's frame where they place a floating body, with its pose
@@ -102,10 +107,13 @@ class Scope:
         held += [Along(inner, Y, float(points[inner][1])) for inner in self.racks[:1]]
         return held
 
-    def duals(self, points: dict, rates: dict, road: dict | None = None) -> StepPoints:
+    def duals(
+        self, points: dict, rates: dict, road: dict | None = None, along: dict | None = None
+    ) -> StepPoints:
         """Each label's rates; for a rigid anti-roll bar none along a wheel's own height,
         as the sweep writes none (one wheel cannot move with the other held). ``road``:
-        the points where the engine solved them (default: ``points``)."""
+        the points where the engine solved them (default: ``points``); ``along``: each
+        wheel centre's rate along the body's quantities (``step_moves``)."""
         hub = np.array([np.nan if self.subject.anti_roll_rigid else 1.0])
         scale = {
             label: np.r_[hub, np.ones(len(columns) - 1)][:, None]
@@ -118,7 +126,7 @@ class Scope:
             }
             for name, p in points.items()
         }
-        return StepPoints(duals, points if road is None else road)
+        return StepPoints(duals, points if road is None else road, along or {})
 
     def as_motion(self, points_per_step: list) -> list:
         """Every step's points (a Dual per label) as the subject's motion gives them
@@ -168,11 +176,14 @@ class Scope:
 class StepPoints(dict):
     """An engine's points at one step: name → {label: Dual}, in the subject's frame as
     its sweep measures them (a vehicle's chassis frame); ``road``: name → (3,) m, where
-    the engine solved them (the road's frame; a corner's and an axle's the same)."""
+    the engine solved them (the road's frame; a corner's and an axle's the same);
+    ``along``: quantity → {label: its wheel centre's z rate along it, m per m or rad},
+    the body's quantities held by the engine's own tangent (a vehicle's; else none)."""
 
-    def __init__(self, points: dict, road: dict):
+    def __init__(self, points: dict, road: dict, along: dict | None = None):
         super().__init__(points)
         self.road = road
+        self.along = along or {}
 
 
 # the names the scopes had, one per kind of subject: now one Scope for every subject
