@@ -101,9 +101,8 @@ def solve_by_points(car, by_points, pose: np.ndarray) -> list[dict]:
 
 def columns_of(chassis: dict, world: dict) -> dict[str, float]:
     """camber, roadwheel_angle (docs/results.md, chassis frame), camber_to_ground
-    (docs/vehicle.md: the camber turned by the body's tilt of the spin axis, its
-    elevation in the world less its elevation in the chassis) and the wheelbase per side
-    (the world contact patches' x, front minus rear)."""
+    (docs/vehicle.md: the camber of the spin axis in the road's frame) and the
+    wheelbase per side (the world contact patches' x, front minus rear)."""
     out = {}
     for label in LABELS:
         s = 1.0 if label[1] == "l" else -1.0
@@ -113,8 +112,7 @@ def columns_of(chassis: dict, world: dict) -> dict[str, float]:
         camber = -np.degrees(np.arctan2(a[2], s * a[1]))
         out[f"camber_{label}"] = camber
         out[f"roadwheel_angle_{label}"] = np.degrees(np.arctan2(a[0], s * a[1]))
-        tilt = np.degrees(np.arcsin(w[2]) - np.arcsin(a[2]))
-        out[f"camber_to_ground_{label}"] = camber - tilt
+        out[f"camber_to_ground_{label}"] = -np.degrees(np.arctan2(w[2], s * w[1]))
     for side, (f, r) in (("left", ("fl", "rl")), ("right", ("fr", "rr"))):
         cp = "_contact_patch_center"
         out[f"wheelbase_{side}"] = world[f + cp][0] - world[r + cp][0]

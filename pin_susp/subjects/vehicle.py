@@ -40,6 +40,8 @@ from .axle_file import AxleGeometry, load_axle
 from .corner import Results
 from .elements import rack
 from .elements.body import JOINTS, BodyOnRoad
+from .elements.car_axle import AxleOfCar
+from .vehicle_columns import vehicle_columns
 
 LABELS = ("fl", "fr", "rl", "rr")
 AXLES = {"front": ("fl", "fr"), "rear": ("rl", "rr")}
@@ -62,9 +64,33 @@ class VehicleGeometry:
     brakes: dict
     drive: dict
     c_factor: float | None  # mm of rack per steering-wheel turn
+    front_bias: float | None = None  # brakes: the front axle's share of the braking force
+    brake_types: dict = field(default_factory=dict)  # front/rear → "outboard" | "inboard"
+    drive_split: dict | None = None  # front/rear → share of the drive (sum 1)
+    drive_types: dict = field(default_factory=dict)  # front/rear → "outboard" | "inboard"
     source: str = "<dict>"
     sha256: str | None = None
     data: dict = field(default_factory=dict, repr=False)
+
+    def brake_share(self, end: str) -> float | None:
+        """The share of the braking force on the front or rear axle (None: no bias given)."""
+        if self.front_bias is None:
+            return None
+        return self.front_bias if end == "front" else 1.0 - self.front_bias
+
+    def brake_reaction(self, end: str) -> str:
+        """Where an axle's brake torque reacts: "outboard" (the upright: the contact
+        patch's force) or "inboard" (the body: the force at the wheel centre)."""
+        return self.brake_types.get(end, "outboard")
+
+    def drive_share(self, end: str) -> float | None:
+        """The share of the drive on the front or rear axle (None: no drive given)."""
+        return None if self.drive_split is None else self.drive_split[end]
+
+    def drive_reaction(self, end: str) -> str:
+        """Where an axle's drive torque reacts: "inboard" (a body-mounted differential
+        or motor, the default) or "outboard" (hub motors, a live axle)."""
+        return self.drive_types.get(end, "inboard")
 
     def corner(self, label: str) -> Geometry:
         axle = self.front if label[0] == "f" else self.rear
@@ -129,6 +155,7 @@ def load_vehicle(source) -> VehicleGeometry:
         if not isinstance(value, dict):
             r.fail(f"vehicle_config.{key}", "expected a mapping")
         dicts[key] = dict(value)
+    brakes, drive = _brakes_and_drive(dicts["brakes"], dicts["drive"], r)
     return VehicleGeometry(
         str(data.get("name", Path(name).stem)),
         axles["front"],
@@ -139,10 +166,48 @@ def load_vehicle(source) -> VehicleGeometry:
         dicts["brakes"],
         dicts["drive"],
         c_factor,
+        *brakes,
+        *drive,
         name,
         sha,
         data,
     )
+
+
+def _brakes_and_drive(brakes: dict, drive: dict, r: Reader) -> tuple[tuple, tuple]:
+    """``vehicle_config.brakes`` (front_bias 0…1; front, rear: outboard | inboard) and
+    ``drive`` (front, rear: shares summing to 1; front_type, rear_type: outboard |
+    inboard), read for the anti columns and the attitude."""
+    r.mapping(brakes, "vehicle_config.brakes", optional=("front_bias", "front", "rear"))
+    r.mapping(drive, "vehicle_config.drive", optional=("front", "rear", "front_type", "rear_type"))
+    bias = None
+    if "front_bias" in brakes:
+        bias = r.number(brakes["front_bias"], "vehicle_config.brakes.front_bias")
+        if not 0.0 <= bias <= 1.0:
+            r.fail("vehicle_config.brakes.front_bias", f"{bias:g} is not a share between 0 and 1")
+    where = ("outboard", "inboard")
+    brake_types = {
+        e: r.choice(brakes[e], f"vehicle_config.brakes.{e}", where) for e in AXLES if e in brakes
+    }
+    split = None
+    if "front" in drive or "rear" in drive:
+        split = {}
+        for end in AXLES:
+            share = r.number(drive.get(end, 0.0), f"vehicle_config.drive.{end}")
+            if not 0.0 <= share <= 1.0:
+                r.fail(f"vehicle_config.drive.{end}", f"{share:g} is not a share between 0 and 1")
+            split[end] = share
+        if abs(split["front"] + split["rear"] - 1.0) > 1e-9:
+            r.fail(
+                "vehicle_config.drive",
+                f"front {split['front']:g} and rear {split['rear']:g} do not add up to 1",
+            )
+    drive_types = {}
+    for end in AXLES:
+        key = f"{end}_type"
+        if key in drive:
+            drive_types[end] = r.choice(drive[key], f"vehicle_config.drive.{key}", where)
+    return (bias, brake_types), (split, drive_types)
 
 
 def _axle(given, end: str, here: Path, name: str, r: Reader) -> AxleGeometry:
@@ -221,7 +286,8 @@ class Vehicle(Assembly):
             p = front.design_points()
             sense = 1.0 if p["trackrod_outboard"][0] > p["wheel_center"][0] else -1.0
         self.body = BodyOnRoad(vehicle.cg, vehicle.c_factor, sense)
-        self.shared = (self.body,)
+        ends = (AxleOfCar(end, labels) for end, labels in AXLES.items())
+        self.shared = (self.body, *ends)  # the body's rows; each axle's columns
         comment = f"generated by pin_susp {__version__}: a vehicle"
         self._compose(self.corners, (self.body,), xml_name(self.name, "vehicle"), comment)
         self._drivers()
@@ -385,22 +451,28 @@ class Vehicle(Assembly):
                 k: self.body.to_world(plain[p + k], heave, pitch, roll)
                 for k in ("wheel_center", "axle_inboard", "axle_outboard")
             }
-            spin = {"world": unit(w["axle_outboard"] - w["axle_inboard"])}
-            spin["chassis"] = unit(plain[p + "axle_outboard"] - plain[p + "axle_inboard"])
-            tilt = np.degrees(np.arcsin(spin["world"][:, 2]) - np.arcsin(spin["chassis"][:, 2]))
-            camber = columns.get(f"camber_{label}")
-            if camber is not None:
-                out[f"camber_to_ground_{label}"] = (camber - tilt, "deg")
+            spin = unit(w["axle_outboard"] - w["axle_inboard"])
+            s = self.corners[label].sign  # the corner's camber, of its spin axis on the road
+            ground = -np.degrees(np.arctan2(spin[:, 2], s * spin[:, 1]))
+            out[f"camber_to_ground_{label}"] = (ground, "deg")
             contact[label] = contact_patch(
-                w["wheel_center"], spin["world"], self.corners[label].wheel.radius
+                w["wheel_center"], spin, self.corners[label].wheel.radius
             )
         for side in ("left", "right"):
             f, r = ("fl", "rl") if side == "left" else ("fr", "rr")
             out[f"wheelbase_{side}"] = ((contact[f][:, 0] - contact[r][:, 0]) * 1e3, "mm")
         for label in LABELS:
             out[f"contact_patch_road_z_{label}"] = (contact[label][:, 2] * 1e3, "mm")
+        out |= vehicle_columns(self, plain, columns | {k: v[0] for k, v in out.items()})
         out |= self.body_rates(sweep, qs, columns)
         return out
+
+    def design_steer(self, label: str) -> float:
+        """A corner's steer angle at design (deg, + turning left), as its axle's
+        ``steer_angle`` columns measure it."""
+        d, g = self.design_positions, self.corners[label]
+        a = d[f"{label}_axle_outboard"] - d[f"{label}_axle_inboard"]
+        return -g.sign * np.degrees(np.arctan2(a[0], g.sign * a[1]))
 
     def body_rates(self, sweep, qs: list, columns: dict) -> dict:
         """d(column)/d(heave) per mm and d/d(pitch), d/d(roll) per deg, the other targets
