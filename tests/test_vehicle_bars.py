@@ -275,3 +275,21 @@ def test_the_example_car_writes_its_bars(tmp_path):
     assert {"fl_droplink_u_bar_x", "rear_arb_u_bar_axis_b_z", "arb_twist_rear"} <= set(
         header.split(",")
     )
+
+
+def test_the_vehicle_sees_its_axles_transmissions():
+    """Each link's transmission angle at design on a pivoted body (docs/geometry.md,
+    "Dead centres"), the pushrods', coilovers' and droplinks' on the rockers and the bar
+    arms: the vehicle's (its chassis on the road) are its axles' own, relabelled."""
+    from pin_susp.model.deadcentre import transmissions
+
+    got = {(t.link, t.body): t.angle for t in transmissions(Vehicle(FS).tree)}
+    count = 0
+    for end, labels in AXLES.items():
+        for t in transmissions(AxleModel(AXLE_FILES[end]).tree):
+            side = t.link.partition("_")[0]
+            label = dict(zip(("left", "right"), labels, strict=True))[side]
+            key = (label + t.link.removeprefix(side), label + t.body.removeprefix(side))
+            assert got[key] == pytest.approx(t.angle, abs=1e-9), key
+            count += 1
+    assert count == len(got) and any(body.endswith("_arb_arm") for _, body in got)

@@ -16,8 +16,10 @@ its contact patch on the road and the targets. A corner's columns are its own
 (metrics.py) in the chassis frame, with its exact rates along its own
 wheel-centre height (the body and the other wheels held) and the rack — so they
 equal that corner's own sweep at the same chassis-frame height and rack; the
-points are written in the chassis frame too. The body's pose and what is seen
-from the road (camber to ground, the wheelbase on the road) follow.
+points are written in the chassis frame too. Each axle's anti-roll bar and heave
+link (``AxleElements``: the axle's own elements, named by its corners' labels and
+its end) write theirs likewise, as that axle's own would. The body's pose and what
+is seen from the road (camber to ground, the wheelbase on the road) follow.
 """
 
 from __future__ import annotations
@@ -231,6 +233,10 @@ class Vehicle(Assembly):
     >>> car = pin_susp.Vehicle("examples/vehicle_fs.yaml")
     >>> results = car.run_sweep("examples/vehicle_roll.yaml")
     >>> results["roll"], results["camber_fl"], results["deriv_camber_wrt_roll_fl"]
+    >>> results["arb_twist_front"], results["deriv_arb_twist_wrt_hub_z_fl"]  # its bars
+
+    ``axle_elements``: ``front``/``rear`` → that axle's AxleElements (its bar, ``.bar``,
+    and heave link, ``.link``).
     """
 
     labels = LABELS
