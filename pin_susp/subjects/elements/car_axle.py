@@ -37,8 +37,9 @@ class AxleView:
             g = model.corners[label]
             self.corners[side] = replace(g, wheelbase=wheelbase)
             self.corner_points[side] = model.corner_points[label]
-            for name in model.corner_points[label]:
-                self.design_positions[f"{side}_{name}"] = d[f"{label}_{name}"]
+            for name, at in d.items():  # the corner's points and its bar's ends
+                if name.startswith(f"{label}_"):
+                    self.design_positions[side + name.removeprefix(label)] = at
             a = d[f"{label}_axle_outboard"] - d[f"{label}_axle_inboard"]
             self.design_steer[side] = -g.sign * np.degrees(np.arctan2(a[0], g.sign * a[1]))
         self.bar = AntiRollBar(None) if bar is None else bar
@@ -64,15 +65,18 @@ class AxleOfCar:
         """The axle's columns (wheel_pair.py) of this end's two corners, from every
         point's motion (``points``: name → {label: jet.Dual}) and each corner's
         columns (``sides``: label → its metric columns)."""
-        view = AxleView(model, self.labels, model.vehicle.wheelbase * 1e-3)
+        axle = getattr(model.vehicle, self.end)
+        bar = AntiRollBar(axle) if axle.anti_roll != "none" else None
+        view = AxleView(model, self.labels, model.vehicle.wheelbase * 1e-3, bar)
         left, right = self.labels
         by_side = {"left": sides[left], "right": sides[right]}
         plain, own = {}, {}
         for side, label in view.labels.items():
-            for name in view.corner_points[side]:
-                motion = points[f"{label}_{name}"]
-                plain[f"{side}_{name}"] = motion[label].val
-                own[f"{side}_{name}"] = {side: motion[label]}
+            for name, motion in points.items():  # the corner's points and its bar's ends
+                if name.startswith(f"{label}_"):
+                    key = side + name.removeprefix(label)
+                    plain[key] = motion[label].val
+                    own[key] = {s: motion[at] for s, at in view.labels.items()}
         out = pair_columns(view, plain, by_side) | roll_rates(view, own, by_side)
         if model.corners[left].steering != "rack":
             out.pop("ackermann", None)
