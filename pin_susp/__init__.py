@@ -23,7 +23,7 @@ Files, the CLI, the CSV, results and poses speak mm and degrees; inside, the
 model is in SI units (m, rad): a Geometry's ``hardpoints`` and a Corner's
 ``design_positions`` are in m (``hardpoints_mm`` reads them back in mm). The
 formats and columns are documented in docs/ (geometry.md, sweep.md, results.md,
-axle.md, loads.md, studies.md, urdf.md).
+axle.md, vehicle.md, loads.md, studies.md, urdf.md).
 """
 
 __version__ = "0.1.0"
@@ -58,6 +58,9 @@ _EXPORTS = {
     "Sweep": "model.sweep",
     "Target": "model.sweep",
     "load_sweep": "model.sweep",
+    "Vehicle": "subjects.vehicle",
+    "VehicleResults": "subjects.vehicle",
+    "load_vehicle": "subjects.vehicle",
 }
 
 if TYPE_CHECKING:  # for type checkers and IDEs; at run time __getattr__ below
@@ -71,6 +74,7 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time __getattr__ below
     from .solve.as_set import apply_setup
     from .subjects.axle import Axle, AxleModel, AxleResults, load_axle
     from .subjects.corner import Corner, Results
+    from .subjects.vehicle import Vehicle, VehicleResults, load_vehicle
 
 
 def __getattr__(name: str):
@@ -115,6 +119,8 @@ __all__ = [
     "SetupModel",
     "Sweep",
     "Target",
+    "Vehicle",
+    "VehicleResults",
     "load_axle",
     "load_cases",
     "member_forces",
@@ -124,4 +130,5 @@ __all__ = [
     "load_sweep",
     "setup_sheet",
     "solve_setup",
+    "load_vehicle",
 ]

@@ -2,14 +2,18 @@
 
 ``PointwiseCorner`` wraps pin_susp.analyses.pointwise — hardpoint coordinates as
 unknowns, rigid distances, scipy least_squares — which shares no kinematics
-with the Pinocchio path. The shim assembly and the metrics are written again
-here from the reference article and docs/results.md.
+with the Pinocchio path; ``PointwiseVehicle`` is the same machinery for a whole
+car, its points in the road's frame under a body pose given. The shim assembly
+and the metrics are written again here from the reference article and
+docs/results.md.
 """
 
 from __future__ import annotations
 
 import numpy as np
 from scipy.optimize import least_squares
+
+from pin_susp.analyses.pointwise import Along, PointwiseLinkage, labelled
 
 
 def _vec(v) -> np.ndarray:
@@ -151,3 +155,111 @@ class PointwiseAxle:
                 values.append(v * 1e-3 + m.design[f"{t.side}_{t.point}"] @ t.unit_direction)
         x, residual = m.solve(m.targets(targets, values))
         return {k: v * 1e3 for k, v in m.points(x).items()}, residual
+
+
+def body_rotation(pitch: float, roll: float) -> np.ndarray:
+    """R_y(pitch)·R_x(roll) (rad): + pitch nose down (+x goes to −z), + roll right side
+    down (+y, the left, goes to +z), ISO 8855."""
+    c, s = np.cos(pitch), np.sin(pitch)
+    ry = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+    c, s = np.cos(roll), np.sin(roll)
+    rx = np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+    return ry @ rx
+
+
+def _cross(v: np.ndarray) -> np.ndarray:
+    """[v]×: the matrix of w ↦ v × w."""
+    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+
+
+class PointwiseVehicle(PointwiseLinkage):
+    """A whole car with no Pinocchio: every moving hardpoint of its four corners in the
+    road's (world) frame, and the rack's travel, as unknowns (SI units).
+
+    ``corners``: label (fl, fr, rl, rr) → Geometry; ``cg`` (3,), m, chassis frame. The
+    chassis points are placed in the world by the body's pose (:meth:`place`):
+    w = c + h·ẑ + R_y(θ)·R_x(φ)·(p − c). Each corner's parts, links and lines are
+    pin_susp.analyses.pointwise's (:func:`labelled`, names prefixed ``fl_`` ...); the
+    rack slides along the body's y; the derived wheel points are computed in the world,
+    so ``<c>_contact_patch_center`` is the wheel's lowest point on the road's vertical.
+    Rows: the rigid distances, the lines, each contact patch at its road height, the
+    rack's travel."""
+
+    def __init__(self, corners: dict, cg):
+        self.rack_dir = np.array([0.0, 1.0, 0.0])  # the body's y in the world
+        super().__init__(*labelled(corners)[:4])
+        self.labels = tuple(corners)
+        self.chassis = dict(self.hp)  # every hardpoint at design, chassis frame
+        self.cg = np.asarray(cg, dtype=float)
+        self.place(0.0, 0.0, 0.0)
+
+    def place(self, heave: float, pitch: float, roll: float) -> None:
+        """Put the chassis (its fixed points, the rack at design) at the body's pose (m,
+        rad): the moving points then come from the unknowns."""
+        self.pose = (heave, pitch, roll)
+        self.R = body_rotation(pitch, roll)
+        self.shift = self.cg + np.array([0.0, 0.0, heave])
+        self.hp = {n: self.shift + self.R @ (p - self.cg) for n, p in self.chassis.items()}
+        self.rack_dir = self.R @ np.array([0.0, 1.0, 0.0])
+
+    def to_chassis(self, w: np.ndarray) -> np.ndarray:
+        """A world point back in the chassis frame at the current pose."""
+        return self.cg + self.R.T @ (w - self.shift)
+
+    def points(self, x: np.ndarray) -> dict[str, np.ndarray]:
+        out = super().points(x)
+        for inner in self.racks:  # along the body's y, not the world's
+            out[inner] = self.hp[inner] + x[self.rack] * self.rack_dir
+        return out
+
+    def _add(self, row: np.ndarray, name: str, gradient: np.ndarray) -> None:
+        if name in self.racks:
+            row[self.rack] += gradient @ self.rack_dir
+        else:
+            super()._add(row, name, gradient)
+
+    def jacobian(self, x: np.ndarray, targets) -> np.ndarray:
+        """The distance and target rows as PointwiseLinkage writes them, then each line
+        row (p − a) × û, û = unit(b − a), analytic: d/dp = −[û]×, d/db = [p − a]×·D,
+        d/da = [û]× − [p − a]×·D, D = (I − ûûᵀ)/|b − a| (no planes here)."""
+        lines, self.lines = self.lines, []
+        try:
+            J = super().jacobian(x, targets)
+        finally:
+            self.lines = lines
+        p = self.points(x)
+        rows = []
+        for point, a, b in lines:
+            v = p[b] - p[a]
+            u, d = v / np.linalg.norm(v), p[point] - p[a]
+            D = (np.eye(3) - np.outer(u, u)) / np.linalg.norm(v)
+            block = np.zeros((3, len(x)))
+            for name, g in (
+                (point, -_cross(u)),
+                (b, _cross(d) @ D),
+                (a, _cross(u) - _cross(d) @ D),
+            ):
+                for i in range(3):
+                    self._add(block[i], name, g[i])
+            rows.append(block)
+        return np.vstack([J, *rows])
+
+    def guess(self) -> np.ndarray:
+        """The design state carried by the current pose (the wheels still in the body)."""
+        x = np.zeros_like(self.x0)
+        for name, c in self.column.items():
+            x[c : c + 3] = self.hp[name]
+        return x
+
+    def solve_pose(self, heave, pitch, roll, road_z=None, rack=0.0, x0=None):
+        """The car at the body's pose (m, rad), each corner's contact patch at its road
+        height (``road_z``: label → m, default 0), the rack ``rack`` (m) from design
+        along the body's y; returns x and max |residual| (m)."""
+        self.place(heave, pitch, roll)
+        road_z = road_z or {}
+        z = np.array([0.0, 0.0, 1.0])
+        targets = [Along(f"{c}_contact_patch_center", z, road_z.get(c, 0.0)) for c in self.labels]
+        if self.racks:
+            inner = self.racks[0]
+            targets.append(Along(inner, self.rack_dir, self.hp[inner] @ self.rack_dir + rack))
+        return self.solve(targets, self.guess() if x0 is None else x0)

@@ -168,6 +168,9 @@ PUBLIC = {
     "Sweep": "model.sweep",
     "Target": "model.sweep",
     "load_sweep": "model.sweep",
+    "Vehicle": "subjects.vehicle",
+    "VehicleResults": "subjects.vehicle",
+    "load_vehicle": "subjects.vehicle",
 }
 
 

@@ -18,6 +18,7 @@ from scipy.spatial.transform import Rotation
 
 import pin_susp
 from pin_susp.errors import InputError
+from pin_susp.io.yamlio import load_yaml
 from pin_susp.model.sweep import Sweep, Target, load_sweep
 from pin_susp.subjects.vehicle import LABELS, Vehicle, load_vehicle
 
@@ -183,8 +184,12 @@ def test_bad_files(tmp_path):
     with pytest.raises(InputError, match="cg: give exactly one of x"):
         load_vehicle(data)
     data["vehicle_config"]["cg"] = {"x": 0.5, "z": 280}
-    data["front"] = str(EXAMPLES / "axle_front.yaml")  # a U-bar: not in a vehicle yet
-    with pytest.raises(InputError, match="axle_front.yaml: axle_config.anti_roll: a vehicle's"):
+    rigid = load_yaml(EXAMPLES / "vehicle" / "fs_front.yaml")[0]
+    rigid["axle_config"]["anti_roll"]["stiffness"] = "rigid"  # it would lock the body's roll
+    data["front"] = rigid
+    with pytest.raises(
+        InputError, match=r"^<dict>: front\.axle_config\.anti_roll\.stiffness: a rigid"
+    ):
         load_vehicle(data)
     data["front"] = {"scope": "axle", "axle_config": {"axle_position": "front"}}
     with pytest.raises(InputError, match=r"^<dict>: front\.hardpoints: missing key"):

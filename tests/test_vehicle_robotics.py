@@ -23,11 +23,12 @@ import yaml
 import yourdfpy
 from conftest import EXAMPLES
 
-from pin_susp.analyses.pointwise import BodyPose, OnRoad
 from pin_susp.cli import main
 from pin_susp.model.sweep import load_sweep
+from pin_susp.model.tree import BodyPose
 from pin_susp.subjects.vehicle import LABELS, Vehicle
 from pin_susp.validate import validate
+from pin_susp.validate.floating import OnRoad
 
 NS = {"pin_susp": "https://github.com/pin-susp/pin_susp/urdf"}
 CARS = {"fs": EXAMPLES / "vehicle_fs.yaml", "saloon": EXAMPLES / "vehicle_saloon.yaml"}

@@ -96,8 +96,12 @@ def _words(name: str) -> str:
 
 def transmissions(tree) -> list[Transmission]:
     """Every link's end on a body that turns about a fixed axis (a revolute joint on
-    the chassis), with its transmission angle at design."""
-    root = next(b.name for b in tree.bodies if b.parent is None)
+    the chassis — the root, or a vehicle's body on the road), with its transmission
+    angle at design."""
+    names = [b.name for b in tree.bodies]
+    root = (
+        "chassis" if "chassis" in names else next(b.name for b in tree.bodies if b.parent is None)
+    )
     pivoted = {
         b.name: b.joint
         for b in tree.bodies

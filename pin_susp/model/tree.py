@@ -187,6 +187,21 @@ class FloatingBase:
     road: str = "road"
 
 
+@dataclass(frozen=True)
+class BodyPose:
+    """Where a floating root (``FloatingBase``) is placed: its frame in the road's,
+    w = R·p + t — a vehicle's body at a step's heave, pitch and roll (docs/vehicle.md),
+    first among that step's targets for the validation's engines (their floating base
+    held there; validate/floating.py for an engine whose root is fixed)."""
+
+    rotation: np.ndarray
+    translation: np.ndarray
+
+    def to_road(self, points: dict) -> dict:
+        """Points in the body's frame (name → (3,) m) in the road's."""
+        return {n: self.rotation @ p + self.translation for n, p in points.items()}
+
+
 @dataclass
 class Tree:
     name: str

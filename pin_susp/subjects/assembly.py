@@ -534,15 +534,12 @@ class Assembly(Composed, AnalysesSurface):
         """The URDF ``pin-susp urdf`` writes and the Drake engine reads: its model's own."""
         return self.urdf
 
-    def engine_steps(self, sweep: Sweep) -> list[list]:
-        """Every step's targets as the validation's engines take them (analyses/
-        pointwise.py), as its sweep holds them (the rack at design if not given): a
-        point's by its label's prefix, absolute (m); an axle's heave and roll."""
-        from ..analyses.pointwise import sweep_values, targets_at
-
-        targets = self.held_sweep(sweep).targets
-        design = self.design_positions
-        return [targets_at(targets, v, design) for v in sweep_values(targets, design)]
+    def engine_steps(self, sweep: Sweep) -> list[list] | None:
+        """Every step's targets as the validation's engines take them where its sweep's
+        own are not (validate/scopes.py reads those: a point's, an axle's heave and
+        roll): a vehicle's, its body's pose first (a BodyPose) and each target a
+        (point, unit direction, value m) in the road's frame. None: its sweep's."""
+        return None
 
     def engine_moves(self, sweep: Sweep) -> list[dict]:
         """Every step's targets with each of its body's quantities moved a little (a

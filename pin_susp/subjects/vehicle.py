@@ -16,8 +16,10 @@ its contact patch on the road and the targets. A corner's columns are its own
 (metrics.py) in the chassis frame, with its exact rates along its own
 wheel-centre height (the body and the other wheels held) and the rack — so they
 equal that corner's own sweep at the same chassis-frame height and rack; the
-points are written in the chassis frame too. The body's pose and what is seen
-from the road (camber to ground, the wheelbase on the road) follow.
+points are written in the chassis frame too. Each axle's anti-roll bar and heave
+link (``AxleElements``: the axle's own elements, named by its corners' labels and
+its end) write theirs likewise, as that axle's own would. The body's pose and what
+is seen from the road (camber to ground, the wheelbase on the road) follow.
 """
 
 from __future__ import annotations
@@ -38,8 +40,10 @@ from ..solve.linkage import RACK_HELD, Linkage
 from .assembly import Assembly
 from .axle_file import AxleGeometry, load_axle
 from .corner import Results
-from .elements import rack
+from .elements import elements_of, rack
 from .elements.body import JOINTS, BodyOnRoad
+from .elements.car_axle import AxleOfCar
+from .vehicle_columns import vehicle_columns
 from .vehicle_export import VehicleExport
 
 LABELS = ("fl", "fr", "rl", "rr")
@@ -47,6 +51,11 @@ AXLES = {"front": ("fl", "fr"), "rear": ("rl", "rr")}
 CONFIG_KEYS = ("wheelbase", "cg", "masses", "brakes", "drive", "steering")
 WHEELBASE_CHECK = 1.0  # mm: vehicle_config.wheelbase against the axles' wheel centres
 DERIVED = ("camber", "roadwheel_angle")  # the corner columns rated along heave, pitch, roll
+RIGID_BAR = (
+    "a rigid anti-roll bar locks its axle's roll, so on the road the body could not roll "
+    "as a vehicle's sweep sets it (heave, pitch, roll and each road height): give the bar "
+    "its stiffness (N·m/deg) in a vehicle, or sweep the axle on its own"
+)
 
 
 @dataclass(frozen=True)
@@ -63,9 +72,33 @@ class VehicleGeometry:
     brakes: dict
     drive: dict
     c_factor: float | None  # mm of rack per steering-wheel turn
+    front_bias: float | None = None  # brakes: the front axle's share of the braking force
+    brake_types: dict = field(default_factory=dict)  # front/rear → "outboard" | "inboard"
+    drive_split: dict | None = None  # front/rear → share of the drive (sum 1)
+    drive_types: dict = field(default_factory=dict)  # front/rear → "outboard" | "inboard"
     source: str = "<dict>"
     sha256: str | None = None
     data: dict = field(default_factory=dict, repr=False)
+
+    def brake_share(self, end: str) -> float | None:
+        """The share of the braking force on the front or rear axle (None: no bias given)."""
+        if self.front_bias is None:
+            return None
+        return self.front_bias if end == "front" else 1.0 - self.front_bias
+
+    def brake_reaction(self, end: str) -> str:
+        """Where an axle's brake torque reacts: "outboard" (the upright: the contact
+        patch's force) or "inboard" (the body: the force at the wheel centre)."""
+        return self.brake_types.get(end, "outboard")
+
+    def drive_share(self, end: str) -> float | None:
+        """The share of the drive on the front or rear axle (None: no drive given)."""
+        return None if self.drive_split is None else self.drive_split[end]
+
+    def drive_reaction(self, end: str) -> str:
+        """Where an axle's drive torque reacts: "inboard" (a body-mounted differential
+        or motor, the default) or "outboard" (hub motors, a live axle)."""
+        return self.drive_types.get(end, "inboard")
 
     def corner(self, label: str) -> Geometry:
         axle = self.front if label[0] == "f" else self.rear
@@ -130,6 +163,7 @@ def load_vehicle(source) -> VehicleGeometry:
         if not isinstance(value, dict):
             r.fail(f"vehicle_config.{key}", "expected a mapping")
         dicts[key] = dict(value)
+    brakes, drive = _brakes_and_drive(dicts["brakes"], dicts["drive"], r)
     return VehicleGeometry(
         str(data.get("name", Path(name).stem)),
         axles["front"],
@@ -140,16 +174,54 @@ def load_vehicle(source) -> VehicleGeometry:
         dicts["brakes"],
         dicts["drive"],
         c_factor,
+        *brakes,
+        *drive,
         name,
         sha,
         data,
     )
 
 
+def _brakes_and_drive(brakes: dict, drive: dict, r: Reader) -> tuple[tuple, tuple]:
+    """``vehicle_config.brakes`` (front_bias 0…1; front, rear: outboard | inboard) and
+    ``drive`` (front, rear: shares summing to 1; front_type, rear_type: outboard |
+    inboard), read for the anti columns and the attitude."""
+    r.mapping(brakes, "vehicle_config.brakes", optional=("front_bias", "front", "rear"))
+    r.mapping(drive, "vehicle_config.drive", optional=("front", "rear", "front_type", "rear_type"))
+    bias = None
+    if "front_bias" in brakes:
+        bias = r.number(brakes["front_bias"], "vehicle_config.brakes.front_bias")
+        if not 0.0 <= bias <= 1.0:
+            r.fail("vehicle_config.brakes.front_bias", f"{bias:g} is not a share between 0 and 1")
+    where = ("outboard", "inboard")
+    brake_types = {
+        e: r.choice(brakes[e], f"vehicle_config.brakes.{e}", where) for e in AXLES if e in brakes
+    }
+    split = None
+    if "front" in drive or "rear" in drive:
+        split = {}
+        for end in AXLES:
+            share = r.number(drive.get(end, 0.0), f"vehicle_config.drive.{end}")
+            if not 0.0 <= share <= 1.0:
+                r.fail(f"vehicle_config.drive.{end}", f"{share:g} is not a share between 0 and 1")
+            split[end] = share
+        if abs(split["front"] + split["rear"] - 1.0) > 1e-9:
+            r.fail(
+                "vehicle_config.drive",
+                f"front {split['front']:g} and rear {split['rear']:g} do not add up to 1",
+            )
+    drive_types = {}
+    for end in AXLES:
+        key = f"{end}_type"
+        if key in drive:
+            drive_types[end] = r.choice(drive[key], f"vehicle_config.drive.{key}", where)
+    return (bias, brake_types), (split, drive_types)
+
+
 def _axle(given, end: str, here: Path, name: str, r: Reader) -> AxleGeometry:
     """The front or rear axle: a file relative to the vehicle's, or inline (its errors
-    then named in the vehicle file, under ``front.``/``rear.``). A bar or heave link
-    is refused before the axle is read (not in a vehicle yet)."""
+    then named in the vehicle file, under ``front.``/``rear.``). A rear rack is refused
+    before the axle is read, a rigid anti-roll bar after (RIGID_BAR)."""
     if isinstance(given, str):
         path = here / given
         if not path.is_file():
@@ -160,15 +232,6 @@ def _axle(given, end: str, here: Path, name: str, r: Reader) -> AxleGeometry:
     else:
         r.fail(end, "expected an axle file's path or the axle inline (a mapping)")
     config = raw.get("axle_config") if isinstance(raw, dict) else None  # (load_axle: the rest)
-    for what in ("anti_roll", "heave_link"):
-        kind = config.get(what, {}).get("type", "none") if isinstance(config, dict) else "none"
-        if kind != "none":
-            raise InputError(
-                where,
-                f"{prefix}axle_config.{what}",
-                f"a vehicle's axles have no {what.replace('_', '-')} yet: give type: none, "
-                "or sweep the axle on its own",
-            )
     if isinstance(config, dict) and end == "rear":
         steering = config.get("steering", {})
         if isinstance(steering, dict) and steering.get("type") == "rack":
@@ -176,11 +239,57 @@ def _axle(given, end: str, here: Path, name: str, r: Reader) -> AxleGeometry:
                 where, f"{prefix}axle_config.steering", "rear steer (a rear rack) is not supported"
             )
     try:
-        return load_axle(path if isinstance(given, str) else given)
+        axle = load_axle(path if isinstance(given, str) else given)
     except InputError as exc:
         if prefix:  # inline: named in the vehicle file
             raise InputError(name, f"{prefix}{exc.key}", exc.problem) from None
         raise
+    if axle.anti_roll_rigid:
+        raise InputError(where, f"{prefix}axle_config.anti_roll.stiffness", RIGID_BAR)
+    return axle
+
+
+def axle_key(vehicle: VehicleGeometry, end: str, key: str) -> tuple[str, str]:
+    """Where an axle's ``key`` is: (its file, the key), or for an axle inline the vehicle
+    file and the key under ``front.``/``rear.``."""
+    if isinstance(vehicle.data.get(end), dict):
+        return vehicle.source, f"{end}.{key}"
+    return getattr(vehicle, end).source, key
+
+
+class AxleElements:
+    """One axle's shared elements in a vehicle — its anti-roll bar and heave link
+    (elements_of), named by its corners' labels and its end (``fl_arb_arm``,
+    ``front_arb_u_bar_axis_a``, ``front_t_bar``) — as one of the vehicle's shared
+    elements: their parts added to the tree, their columns (``arb_twist_front``,
+    ``arb_arm_angle_fl``, ``heave_link_length_front``, ``deriv_arb_twist_wrt_hub_z_fl``)
+    among the vehicle's, each element's own (an axle's pair of corners writes an
+    axle's, wheel_pair.py)."""
+
+    quantities = ()  # no sweep target is its row
+
+    def __init__(self, axle: AxleGeometry, end: str):
+        self.end = end
+        self.bar, self.link = elements_of(axle, AXLES[end], f"{end}_")
+
+    def add_to(self, bodies, points, closures, visuals, materials) -> None:
+        for element in (self.bar, self.link):
+            element.add_to(bodies, points, closures, visuals, materials)
+
+    def check_targets(self, targets, source: str) -> None:
+        """Nothing: a rigid bar, which would lock the body's roll, is refused in the file."""
+
+    def columns_of(self, model, points: dict, sides: dict) -> dict:
+        """The bar's and the heave link's columns and the bar's twist rate per corner's
+        own hub z, from every point's motion (``points``: name → {label: jet.Dual},
+        measured in the chassis frame)."""
+        if self.bar.kind == "none" and self.link.kind == "none":
+            return {}
+        first = self.bar.labels[0]
+        plain = {name: p[first].val for name, p in points.items()}
+        d = {k: v[None] for k, v in model.design_positions.items()}
+        out = self.bar.columns(model, plain, d) | self.link.columns(model, plain, d)
+        return out | self.bar.rate_columns(model, points)
 
 
 class Vehicle(VehicleExport, Assembly):
@@ -190,6 +299,10 @@ class Vehicle(VehicleExport, Assembly):
     >>> car = pin_susp.Vehicle("examples/vehicle_fs.yaml")
     >>> results = car.run_sweep("examples/vehicle_roll.yaml")
     >>> results["roll"], results["camber_fl"], results["deriv_camber_wrt_roll_fl"]
+    >>> results["arb_twist_front"], results["deriv_arb_twist_wrt_hub_z_fl"]  # its bars
+
+    ``axle_elements``: ``front``/``rear`` → that axle's AxleElements (its bar, ``.bar``,
+    and heave link, ``.link``).
     """
 
     labels = LABELS
@@ -200,7 +313,8 @@ class Vehicle(VehicleExport, Assembly):
         "heave pitch roll steering_wheel_angle camber_fl camber_fr camber_rl camber_rr "
         "camber_to_ground_fl camber_to_ground_fr camber_to_ground_rl camber_to_ground_rr "
         "roadwheel_angle_fl roadwheel_angle_fr roadwheel_angle_rl roadwheel_angle_rr "
-        "wheel_travel_fl wheel_travel_rl wheelbase_left wheelbase_right".split()
+        "wheel_travel_fl wheel_travel_rl wheelbase_left wheelbase_right arb_twist_front "
+        "arb_twist_rear heave_link_length_front heave_link_length_rear".split()
     )
     held_joints = JOINTS  # a corner's rates: its own height with the body still
     needs = (
@@ -222,17 +336,50 @@ class Vehicle(VehicleExport, Assembly):
             p = front.design_points()
             sense = 1.0 if p["trackrod_outboard"][0] > p["wheel_center"][0] else -1.0
         self.body = BodyOnRoad(vehicle.cg, vehicle.c_factor, sense)
-        self.shared = (self.body,)
+        # each axle's bar and heave link, named by its corners' labels and its end
+        self.axle_elements = {end: AxleElements(getattr(vehicle, end), end) for end in AXLES}
+        self.elements = tuple(e for a in self.axle_elements.values() for e in (a.bar, a.link))
+        ends = (AxleOfCar(end, labels) for end, labels in AXLES.items())
+        self.shared = (self.body, *self.axle_elements.values(), *ends)  # each axle's columns
         comment = f"generated by pin_susp {__version__}: a vehicle"
-        self._compose(self.corners, (self.body,), xml_name(self.name, "vehicle"), comment)
+        self._compose(self.corners, self.shared, xml_name(self.name, "vehicle"), comment)
         self._drivers()
         self.kin.update(self.q_design)
+        self._check_determined()
         self.spring_senses = {
             label: (Linkage(g).spring_sense if g.spring == "torsion_bar" else 1.0)
             for label, g in self.corners.items()
         }
         body = [self.model.joints[self.model.getJointId(j)] for j in JOINTS]
         self.body_q, self.body_v = [j.idx_q for j in body], [j.idx_v for j in body]
+
+    def _check_determined(self) -> None:
+        """Each wheel's height, the rack and the body's joints must fix the pose at design
+        (the closures with them of full rank, as an axle's: AxleModel._check_determined):
+        else a part turns freely — a droplink square to its bar arm's motion (at dead
+        centre), a bar axis along a droplink. The error names the axle file whose parts
+        the free motion turns."""
+        _, s, vt = np.linalg.svd(self.drive_rows_at_design())
+        null = np.concatenate([s <= 1e-9 * s[0], np.ones(len(vt) - len(s), dtype=bool)])
+        if not null.any():
+            return
+        free = np.abs(vt[null]).max(axis=0)  # how far each freedom moves in its null space
+        moved = [
+            name
+            for joint, name in zip(self.model.joints[1:], self.model.names[1:], strict=True)
+            if np.any(free[joint.idx_v : joint.idx_v + joint.nv] > 1e-6 * free.max())
+        ]
+        own = {e: (*(f"{label}_" for label in labels), f"{e}_") for e, labels in AXLES.items()}
+        ends = [e for e in AXLES if any(n.startswith(own[e]) for n in moved)]
+        end = ends[0] if ends else "front"
+        source, key = axle_key(self.vehicle, end, "hardpoints")
+        raise InputError(
+            source,
+            key,
+            f"the wheels, the rack and the body do not fix the vehicle's {end} axle at "
+            "design: a part turns freely (a droplink square to its bar arm's motion — at "
+            f"dead centre — or in line with the bar's axis?): {', '.join(moved)}",
+        )
 
     def __repr__(self) -> str:
         v = self.vehicle
@@ -386,22 +533,28 @@ class Vehicle(VehicleExport, Assembly):
                 k: self.body.to_world(plain[p + k], heave, pitch, roll)
                 for k in ("wheel_center", "axle_inboard", "axle_outboard")
             }
-            spin = {"world": unit(w["axle_outboard"] - w["axle_inboard"])}
-            spin["chassis"] = unit(plain[p + "axle_outboard"] - plain[p + "axle_inboard"])
-            tilt = np.degrees(np.arcsin(spin["world"][:, 2]) - np.arcsin(spin["chassis"][:, 2]))
-            camber = columns.get(f"camber_{label}")
-            if camber is not None:
-                out[f"camber_to_ground_{label}"] = (camber - tilt, "deg")
+            spin = unit(w["axle_outboard"] - w["axle_inboard"])
+            s = self.corners[label].sign  # the corner's camber, of its spin axis on the road
+            ground = -np.degrees(np.arctan2(spin[:, 2], s * spin[:, 1]))
+            out[f"camber_to_ground_{label}"] = (ground, "deg")
             contact[label] = contact_patch(
-                w["wheel_center"], spin["world"], self.corners[label].wheel.radius
+                w["wheel_center"], spin, self.corners[label].wheel.radius
             )
         for side in ("left", "right"):
             f, r = ("fl", "rl") if side == "left" else ("fr", "rr")
             out[f"wheelbase_{side}"] = ((contact[f][:, 0] - contact[r][:, 0]) * 1e3, "mm")
         for label in LABELS:
             out[f"contact_patch_road_z_{label}"] = (contact[label][:, 2] * 1e3, "mm")
+        out |= vehicle_columns(self, plain, columns | {k: v[0] for k, v in out.items()})
         out |= self.body_rates(sweep, qs, columns)
         return out
+
+    def design_steer(self, label: str) -> float:
+        """A corner's steer angle at design (deg, + turning left), as its axle's
+        ``steer_angle`` columns measure it."""
+        d, g = self.design_positions, self.corners[label]
+        a = d[f"{label}_axle_outboard"] - d[f"{label}_axle_inboard"]
+        return -g.sign * np.degrees(np.arctan2(a[0], g.sign * a[1]))
 
     def body_rates(self, sweep, qs: list, columns: dict) -> dict:
         """d(column)/d(heave) per mm and d/d(pitch), d/d(roll) per deg, the other targets

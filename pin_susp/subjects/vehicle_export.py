@@ -23,11 +23,13 @@ from .. import __version__
 from ..io.yamlio import Reader
 from ..maths.vectors import unit
 from ..model.geometry import contact_patch
-from ..model.tree import Tree
+from ..model.tree import BodyPose, Tree
 from ..model.urdf import tree_to_urdf
+from .vehicle_columns import vehicle_columns
 
 BODY = ("heave", "pitch", "roll")
 BODY_STEP = 1e-4  # m, rad: the body's step for the engines' rates along it (±h, ±2h)
+DERIVED = ("camber", "roadwheel_angle")  # the corner columns rated along the body: vehicle.py's
 AXLE_PAIRS = (("fl", "fr"), ("rl", "rr"))  # each axle's left and right corner
 SIDE_PAIRS = {"left": ("fl", "rl"), "right": ("fr", "rr")}  # each side's front and rear
 Y = np.array([0.0, 1.0, 0.0])
@@ -71,11 +73,12 @@ class VehicleExport:
         return mass / 12.0 * np.diag(across.sum() - across)
 
     def engine_steps(self, sweep) -> list[list]:
-        """Every step's targets as the engines take them (analyses/pointwise.py), in the
-        road's frame: first the body's pose (a BodyPose: its floating base placed
-        there), then each contact patch's height on the road, the steering — as the
-        chassis-frame travel of the rack's inboard end, seen from the road with the body
-        placed — and any point target as pin_susp holds it (the road's frame)."""
+        """Every step's targets as the engines take them (validate/), in the road's
+        frame: first the body's pose (a BodyPose: its floating base placed there), then
+        each contact patch's height on the road, the steering — as the chassis-frame
+        travel of the rack's inboard end, seen from the road with the body placed — and
+        any point target as pin_susp holds it (the road's frame), each a (point, unit
+        direction, value m)."""
         targets = self.held_targets(sweep.targets)
         return [self._engine_step(targets, row) for row in self.target_values(targets)]
 
@@ -99,9 +102,8 @@ class VehicleExport:
         return out
 
     def _engine_step(self, targets: list, row: np.ndarray) -> list:
-        """One step's targets for the engines (``engine_steps``), its values ``row`` (SI)."""
-        from ..analyses.pointwise import Along, BodyPose
-
+        """One step's targets for the engines (``engine_steps``), its values ``row`` (SI):
+        the BodyPose, then each a (point, unit direction, value m) in the road's frame."""
         pose = dict(zip((t.quantity for t in targets), row, strict=True))
         rotation, translation = self.body.placement(*(pose[q] for q in BODY))
         step = [BodyPose(rotation, translation)]
@@ -109,15 +111,15 @@ class VehicleExport:
             if t.quantity in BODY:
                 continue
             if t.quantity == "road_z":
-                step.append(Along(f"{t.side}_contact_patch_center", Z, float(value)))
+                step.append((f"{t.side}_contact_patch_center", Z, float(value)))
             elif t.quantity == "steering_wheel":  # the rack's travel along chassis y
                 first = self.labels[0]
                 inboard = self.prefix(first) + self.corners[first].steering_points[0]
                 along = rotation @ Y
                 at = self.design_positions[inboard][1] + value + along @ translation
-                step.append(Along(inboard, along, float(at)))
+                step.append((inboard, along, float(at)))
             else:
-                step.append(Along(self.point_of(t), t.unit_direction, float(value)))
+                step.append((self.point_of(t), t.unit_direction, float(value)))
         return step
 
     def road_columns(self, road: dict, points: dict, columns: dict) -> dict:
@@ -126,9 +128,10 @@ class VehicleExport:
         it, read from its chassis points), the rack's travel and the steering-wheel angle
         (from the chassis-frame points), each corner's camber to ground, the wheelbase
         on the road per side and each contact patch's height (from ``road``: the points
-        where the engine solved them, the road's frame, m), and the rates along the
-        body's heave, pitch and roll (from the engine's wheel-centre rates along them,
-        ``points.along``)."""
+        where the engine solved them, the road's frame, m), the whole car's columns
+        (vehicle_columns: the roll axis, the pitch centre, the anti %, the turning
+        radius) and the rates along the body's heave, pitch and roll (from the engine's
+        wheel-centre rates along them, ``points.along``)."""
         first = self.labels[0]
         chassis = {name: p[first].val[0] for name, p in points.items()}
         out = self._pose_columns(road, chassis)
@@ -142,19 +145,20 @@ class VehicleExport:
         contact = {}
         for label in self.labels:
             p = self.prefix(label)
-            spin = {}
-            for frame, at in (("road", road), ("chassis", chassis)):
-                spin[frame] = unit(at[p + "axle_outboard"] - at[p + "axle_inboard"])
-            tilt = np.degrees(np.arcsin(spin["road"][2]) - np.arcsin(spin["chassis"][2]))
-            camber = columns.get(f"camber_{label}")
-            if camber is not None:
-                out[f"camber_to_ground_{label}"] = (camber[0] - tilt, "deg")
+            spin = unit(road[p + "axle_outboard"] - road[p + "axle_inboard"])  # on the road
+            s = self.corners[label].sign  # the corner's camber, of its spin axis on the road
+            ground = -np.degrees(np.arctan2(spin[2], s * spin[1]))
+            out[f"camber_to_ground_{label}"] = (np.array([ground]), "deg")
             radius = self.corners[label].wheel.radius
-            contact[label] = contact_patch(road[p + "wheel_center"], spin["road"], radius)
+            contact[label] = contact_patch(road[p + "wheel_center"], spin, radius)
         for side, (f, r) in SIDE_PAIRS.items():
             out[f"wheelbase_{side}"] = (np.array([(contact[f][0] - contact[r][0]) * 1e3]), "mm")
         for label in self.labels:
             out[f"contact_patch_road_z_{label}"] = (np.array([contact[label][2] * 1e3]), "mm")
+        # the whole car's (the roll axis, the pitch centre, the anti %, the turning radius):
+        # vehicle_columns of the engine's chassis-frame points and its columns
+        values = {k: v[0] for k, v in (columns | out).items()}
+        out |= vehicle_columns(self, {n: at[None] for n, at in chassis.items()}, values)
         return out | self._rates_along_body(points.along, columns)
 
     def _pose_columns(self, road: dict, chassis: dict) -> dict:
@@ -182,8 +186,6 @@ class VehicleExport:
     def _rates_along_body(self, along: dict, columns: dict) -> dict:
         """``body_rates``' columns from an engine's chassis-frame wheel-centre rates along
         the body (quantity → {label: m per m or rad}) and its own rates along each hub z."""
-        from .vehicle import DERIVED
-
         out = {}
         for quantity, rates in along.items():
             scale, per = (1.0, "mm") if quantity == "heave" else (np.pi / 180.0 * 1e3, "deg")

@@ -14,8 +14,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..analyses.pointwise import Along, BodyPose, as_target
+from ..analyses.pointwise import Along, as_target
 from ..errors import PinSuspError
+from ..model.tree import BodyPose
 from ..model.urdf import NAMESPACE, read_closures, tree_to_urdf
 from .engines import Warnings, richardson, target_rows, with_contact_patches
 from .scopes import scope_of

@@ -10,8 +10,9 @@ from contextlib import contextmanager
 
 import numpy as np
 
-from ..analyses.pointwise import BodyPose, as_target
+from ..analyses.pointwise import as_target
 from ..errors import PinSuspError
+from ..model.tree import BodyPose
 from .engines import Warnings, richardson, target_rows, with_contact_patches
 from .scopes import scope_of
 

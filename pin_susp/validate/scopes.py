@@ -11,10 +11,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..analyses.pointwise import Along, PointwiseLinkage, Y, Z, in_body_frame, labelled
+from ..analyses.pointwise import Along, PointwiseLinkage, Y, Z, labelled, sweep_values, targets_at
 from ..columns.metrics import METRICS
 from ..maths.jet import Dual
 from ..maths.jet import value as plain
+from .floating import in_body_frame
 
 RATE_METRICS = {m.name for m in METRICS if m.rates}
 
@@ -86,7 +87,12 @@ class Scope:
         """Every step's targets, as its sweep holds them (the rack at design if not
         given): a point's by its label's prefix, its values absolute (m, rad); where the
         exported root floats, the body's pose first (Assembly.engine_steps)."""
-        return self.subject.engine_steps(sweep)
+        steps = self.subject.engine_steps(sweep)
+        if steps is not None:
+            return steps
+        targets = self.subject.held_sweep(sweep).targets
+        design = self.subject.design_positions
+        return [targets_at(targets, v, design) for v in sweep_values(targets, design)]
 
     def step_moves(self, sweep) -> list[dict]:
         """Every step's targets with the body's quantities moved (Assembly.engine_moves):
@@ -96,7 +102,7 @@ class Scope:
     def fixed_root_targets(self, targets: list) -> tuple[list, object]:
         """One step's targets for an engine without a floating base (the point-based
         one): in the body's frame where they place a floating body, with its pose
-        (pointwise.in_body_frame); else as they are, and None."""
+        (floating.in_body_frame); else as they are, and None."""
         radii = {prefix: radius for prefix, (radius, _) in self.wheels.items()}
         return in_body_frame(targets, radii)
 

@@ -16,7 +16,9 @@ As one of an Assembly's ``shared`` elements (the axle's pair of corners,
 that are its rows: none, or heave and roll), ``check_targets(targets, source)`` and
 ``columns_of(model, points, sides)`` (its columns among the results').
 
-``elements_of(axle)`` lists an axle's elements in the order they add to the tree.
+``elements_of(axle)`` lists an axle's elements in the order they add to the tree,
+named by its corners' labels and a prefix of their own: an axle's ``left``/``right``
+and none; a vehicle's front axle's ``fl``/``fr`` and ``front_`` (docs/vehicle.md).
 """
 
 from __future__ import annotations
@@ -25,7 +27,9 @@ from .anti_roll_bar import AntiRollBar
 from .heave_link import HeaveLink
 
 
-def elements_of(axle) -> list:
+def elements_of(axle, labels: tuple[str, str] = ("left", "right"), prefix: str = "") -> list:
     """An AxleGeometry's elements that add to its tree, in their order: the anti-roll
-    bar (its material and centre points even with none) and the heave link."""
-    return [AntiRollBar(axle), HeaveLink(axle)]
+    bar (its material and centre points even with none) and the heave link; ``labels``:
+    its two corners' (its left side's first), ``prefix``: that of the elements' own
+    names (a bar's centre points and body) and, as a suffix, of their own columns."""
+    return [AntiRollBar(axle, labels, prefix), HeaveLink(axle, labels, prefix)]

@@ -3,6 +3,12 @@ axis, or one rigid bar (``stiffness: rigid``) — or a T-bar, the crossbar on it
 pivot; a rigid droplink per side from the rocker (or the body ``anti_roll.mount``
 names) to the bar. Its columns: the arms' angles and the bar's twist, the twist's
 rate per side's hub z, and its part in the roll stiffness.
+
+Its names are its two corners' labels and its own prefix: an axle's, ``left`` and
+``right`` and none (``left_arb_arm``, ``left_droplink_u_bar``, ``arb_u_bar_axis_a``,
+``t_bar``; columns ``arb_arm_angle_left``, ``arb_twist``); a vehicle's front axle's,
+``fl`` and ``fr`` and ``front_`` (``fl_arb_arm``, ``front_arb_u_bar_axis_a``,
+``front_t_bar``; columns ``arb_arm_angle_fl``, ``arb_twist_front``: docs/vehicle.md).
 """
 
 from __future__ import annotations
@@ -23,15 +29,29 @@ def mount_body(g, mount: str) -> str:
     return {"arm": g.mechanism.WHEEL_BODY}.get(mount, mount)
 
 
+def own_suffix(prefix: str) -> str:
+    """The suffix of an element's own columns for the prefix of its own names:
+    ``"front_"`` → ``"_front"``; none for none."""
+    return f"_{prefix.removesuffix('_')}" if prefix else ""
+
+
 class AntiRollBar:
     """An axle's anti-roll bar (``axle_config.anti_roll``), or none (``kind``; ``spec``,
-    the AxleGeometry, None: two corners without an axle file)."""
+    the AxleGeometry, None: two corners without an axle file). ``labels``: its two
+    corners' labels, the axle's left side's first; ``prefix``: that of its own names
+    (its centre points, a T-bar's or a rigid bar's body), whose suffix its own columns
+    take (``own_suffix``)."""
 
-    def __init__(self, spec=None):
+    def __init__(self, spec=None, labels: tuple[str, str] = SIDES, prefix: str = ""):
         self.axle = spec
         self.kind = spec.anti_roll if spec else "none"
         self.rigid = bool(spec) and spec.anti_roll_rigid
-        self.center = spec.center if spec else {}
+        self.labels, self.prefix, self.suffix = tuple(labels), prefix, own_suffix(prefix)
+        self.sides = dict(zip(self.labels, SIDES, strict=True))  # label → the axle's side
+        # its centre points by their names in the model (the prefix's)
+        self.center = {prefix + k: p for k, p in spec.center.items()} if spec else {}
+        self.u_axis = tuple(prefix + n for n in U_AXIS)
+        self.pivot = f"{prefix}arb_t_bar_pivot"
 
     quantities = ()  # no sweep target is its row
 
@@ -55,64 +75,73 @@ class AntiRollBar:
     def add_to(self, bodies, points, closures, visuals, materials) -> None:
         """The bar's material and centre points (its axis or pivot), its bodies and
         joints, a droplink closure per side, its shapes."""
-        a = self.axle
+        a, first, second = self.axle, *self.labels
         materials.setdefault("bar", (0.85, 0.75, 0.15, 1.0))
-        for name, p in a.center.items():
+        for name, p in self.center.items():
             points[name] = ("chassis", p)
         if self.kind == "u_bar":
-            axis = U_AXIS
-            for side in SIDES if not self.rigid else ("left",):
-                arm = "arb_bar" if self.rigid else f"{side}_arb_arm"
-                bodies.append(Body(arm, "chassis", pivot(f"{arm}_pivot", *axis, a.center)))
-            for side in SIDES:
-                arm = "arb_bar" if self.rigid else f"{side}_arb_arm"
-                end = a.side_points[side]["droplink_u_bar"]
-                self._droplink(side, "droplink_u_bar", arm, axis, points, closures)
-                foot = axis_foot(a.center[axis[0]], a.center[axis[1]], end)
+            axis = self.u_axis
+            for label in self.labels if not self.rigid else (first,):
+                arm = self._arm(label)
+                bodies.append(Body(arm, "chassis", pivot(f"{arm}_pivot", *axis, self.center)))
+            for label in self.labels:
+                arm = self._arm(label)
+                end = a.side_points[self.sides[label]]["droplink_u_bar"]
+                self._droplink(label, "droplink_u_bar", arm, axis, points, closures)
+                foot = axis_foot(self.center[axis[0]], self.center[axis[1]], end)
                 visuals.append(Visual(arm, "rod", "bar", foot, end, ROD))
                 visuals.append(Visual(arm, "ball", "bar", end, radius=BALL))
             visuals.append(
-                Visual("chassis", "rod", "bar", a.center[axis[0]], a.center[axis[1]], 1.5 * ROD)
+                Visual(
+                    "chassis", "rod", "bar", self.center[axis[0]], self.center[axis[1]], 1.5 * ROD
+                )
             )
         if self.kind == "t_bar":
-            hub = a.center["arb_t_bar_pivot"]
-            ends = {side: a.side_points[side]["droplink_t_bar"] for side in SIDES}
-            middle = 0.5 * (ends["left"] + ends["right"])
+            body = f"{self.prefix}t_bar"
+            hub = self.center[self.pivot]
+            ends = {
+                label: a.side_points[self.sides[label]]["droplink_t_bar"] for label in self.labels
+            }
+            middle = 0.5 * (ends[first] + ends[second])
             # the crossbar's midpoint stays in y = 0: the stem pitches about chassis y and
             # the crossbar twists about the stem (a universal joint: exactly the ball with
             # the midpoint held in the plane); a rigid bar only pitches
             y, stem = np.array([0.0, 1.0, 0.0]), unit(middle - hub)
             joint = (
-                Joint("t_bar_pivot", "revolute", hub, y)
+                Joint(f"{body}_pivot", "revolute", hub, y)
                 if self.rigid
-                else Joint("t_bar_pivot", "universal", hub, y, ("arb_t_bar_pivot",), stem)
+                else Joint(f"{body}_pivot", "universal", hub, y, (self.pivot,), stem)
             )
-            bodies.append(Body("t_bar", "chassis", joint))
-            for side in SIDES:
-                other = f"{'right' if side == 'left' else 'left'}_droplink_t_bar"
-                guard = ("arb_t_bar_pivot", other)
-                self._droplink(side, "droplink_t_bar", "t_bar", guard, points, closures)
-                visuals.append(Visual("t_bar", "ball", "bar", ends[side], radius=BALL))
-            visuals.append(Visual("t_bar", "rod", "bar", ends["left"], ends["right"], 1.5 * ROD))
-            visuals.append(Visual("t_bar", "rod", "bar", hub, middle, 1.5 * ROD))
+            bodies.append(Body(body, "chassis", joint))
+            for label in self.labels:
+                other = f"{second if label == first else first}_droplink_t_bar"
+                guard = (self.pivot, other)
+                self._droplink(label, "droplink_t_bar", body, guard, points, closures)
+                visuals.append(Visual(body, "ball", "bar", ends[label], radius=BALL))
+            visuals.append(Visual(body, "rod", "bar", ends[first], ends[second], 1.5 * ROD))
+            visuals.append(Visual(body, "rod", "bar", hub, middle, 1.5 * ROD))
 
-    def _droplink(self, side: str, lower: str, bar: str, guard, points, closures) -> None:
+    def _arm(self, label: str) -> str:
+        """The body a U-bar's side turns: its own arm, or the one rigid bar."""
+        return f"{self.prefix}arb_bar" if self.rigid else f"{label}_arb_arm"
+
+    def _droplink(self, label: str, lower: str, bar: str, guard, points, closures) -> None:
         """One side's rigid droplink: from the rocker (or the body ``anti_roll.mount``
         names) to the point ``lower`` on the bar's body; its assembly is kept by the sign
         of the volume of the two ``guard`` points and its ends."""
-        a = self.axle
+        a, side = self.axle, self.sides[label]
         sp = a.side_points[side]
         upper = "droplink_rocker" if "droplink_rocker" in sp else "droplink_lower"
         if upper == "droplink_rocker":
-            carrier = f"{side}_rocker"
+            carrier = f"{label}_rocker"
         else:  # no rocker: the body anti_roll.mount names
-            carrier = f"{side}_{mount_body(a.corner(side), a.anti_roll_mount)}"
-        points[f"{side}_{lower}"] = (bar, sp[lower])
-        points[f"{side}_{upper}"] = (carrier, sp[upper])
-        ends = (f"{side}_{upper}", f"{side}_{lower}")
+            carrier = f"{label}_{mount_body(a.corner(side), a.anti_roll_mount)}"
+        points[f"{label}_{lower}"] = (bar, sp[lower])
+        points[f"{label}_{upper}"] = (carrier, sp[upper])
+        ends = (f"{label}_{upper}", f"{label}_{lower}")
         closures.append(
             Closure(
-                f"{side}_droplink",
+                f"{label}_droplink",
                 "distance",
                 tuple((n, points[n][1]) for n in ends),
                 ends,
@@ -121,47 +150,51 @@ class AntiRollBar:
         )
 
     def columns(self, model, p: dict, d: dict) -> dict:
-        """A U-bar's ``arb_arm_angle_left``/``_right`` and ``arb_twist`` (deg), a
-        T-bar's ``arb_twist``."""
+        """A U-bar's ``arb_arm_angle_<label>`` per corner and ``arb_twist`` (deg, the
+        first corner's arm's angle less the second's), a T-bar's ``arb_twist``; the
+        twist with its own suffix (``arb_twist_front``)."""
         out = {}
         if self.kind == "u_bar":
-            axis = (self.center[U_AXIS[0]], self.center[U_AXIS[1]])
+            axis = (self.center[self.u_axis[0]], self.center[self.u_axis[1]])
             angles = {}
-            for side in SIDES:
-                name = f"{side}_droplink_u_bar"
-                angles[side] = turn(axis, d[name], p[name])
-                out[f"arb_arm_angle_{side}"] = (angles[side], "deg")
-            out["arb_twist"] = (angles["left"] - angles["right"], "deg")
+            for label in self.labels:
+                name = f"{label}_droplink_u_bar"
+                angles[label] = turn(axis, d[name], p[name])
+                out[f"arb_arm_angle_{label}"] = (angles[label], "deg")
+            first, second = self.labels
+            out[f"arb_twist{self.suffix}"] = (angles[first] - angles[second], "deg")
         if self.kind == "t_bar":
-            ends = (p["left_droplink_t_bar"], p["right_droplink_t_bar"])
-            out["arb_twist"] = (np.degrees(self.t_bar_twist(model, *ends)), "deg")
+            ends = (p[f"{label}_droplink_t_bar"] for label in self.labels)
+            out[f"arb_twist{self.suffix}"] = (np.degrees(self.t_bar_twist(model, *ends)), "deg")
         return out
 
     def rate_columns(self, model, points: dict) -> dict:
-        """``deriv_arb_twist_wrt_hub_z_left``/``_right`` (deg/mm): the twist's rate
-        along each side's own hub z (``points``: name → {side: jet.Dual})."""
+        """``deriv_arb_twist_wrt_hub_z_<label>`` per corner (deg/mm): the twist's rate
+        along each corner's own hub z (``points``: name → {label: jet.Dual})."""
         out = {}
-        for side in SIDES if self.kind != "none" else ():
-            sign = 1.0 if side == "left" else -1.0
+        for label in self.labels if self.kind != "none" else ():
+            sign = 1.0 if label == self.labels[0] else -1.0
             if self.kind == "u_bar":
-                axis = (self.center[U_AXIS[0]], self.center[U_AXIS[1]])
-                rate = turn_rate(axis, points[f"{side}_droplink_u_bar"][side], sign)
+                axis = (self.center[self.u_axis[0]], self.center[self.u_axis[1]])
+                rate = turn_rate(axis, points[f"{label}_droplink_u_bar"][label], sign)
             else:
-                ends = [points[f"{s}_droplink_t_bar"][side] for s in SIDES]
+                ends = [points[f"{s}_droplink_t_bar"][label] for s in self.labels]
                 rate = np.degrees(self.t_bar_twist(model, *ends).der[0]) * 1e-3
-            out[f"deriv_arb_twist_wrt_hub_z_{side}"] = (rate, "deg/mm")
+            out[f"deriv_arb_twist_wrt_hub_z_{label}"] = (rate, "deg/mm")
         return out
 
     def t_bar_twist(self, model, left, right):
         """The T-bar crossbar's twist (rad) about its stem from design, from its two ends
-        (arrays (n, 3) or jet.Duals; right-hand rule about the design stem pivot →
-        crossbar midpoint). The bar turns on a universal joint — a pitch θ of the stem
-        about chassis y, then the twist about the stem — so undoing θ (read from the
-        stem, which only pitches) leaves the crossbar turned by the twist alone."""
+        (the first corner's, then the second's: arrays (n, 3) or jet.Duals; right-hand
+        rule about the design stem pivot → crossbar midpoint). The bar turns on a
+        universal joint — a pitch θ of the stem about chassis y, then the twist about
+        the stem — so undoing θ (read from the stem, which only pitches) leaves the
+        crossbar turned by the twist alone."""
         d = model.design_positions
-        hub = self.center["arb_t_bar_pivot"]
-        s0 = 0.5 * (d["left_droplink_t_bar"] + d["right_droplink_t_bar"]) - hub
-        c0 = d["left_droplink_t_bar"] - d["right_droplink_t_bar"]
+        first, second = (d[f"{label}_droplink_t_bar"] for label in self.labels)
+        hub = self.center[self.pivot]
+        s0 = 0.5 * (first + second) - hub
+        c0 = first - second
         sx, sz = (
             0.5 * (left[..., 0] + right[..., 0]) - hub[0],
             0.5 * (left[..., 2] + right[..., 2]) - hub[2],
@@ -182,14 +215,17 @@ class AntiRollBar:
 
     def roll_term(self, rates: dict, per_rad: dict) -> tuple | None:
         """The bar's part in the roll stiffness, ``(k·(dθ/dφ)², arb_wheel_rate)``, from
-        its twist rates (``rate_columns``'s) and each side's hub z per radian of roll;
-        None without a bar."""
+        its twist rates (``rate_columns``'s) and each corner's hub z per radian of roll
+        (by label); None without a bar."""
         if self.kind == "none":
             return None
+        first, second = self.labels
         k = self.axle.anti_roll_stiffness * 180.0 / np.pi  # N·m/rad
-        twist = {s: np.radians(rates[f"deriv_arb_twist_wrt_hub_z_{s}"][0]) * 1e3 for s in SIDES}
-        term = k * (twist["left"] * per_rad["left"] + twist["right"] * per_rad["right"]) ** 2
-        wheel = (0.5 * k * (twist["left"] - twist["right"]) ** 2 * 1e-3, "N/mm")
+        twist = {
+            s: np.radians(rates[f"deriv_arb_twist_wrt_hub_z_{s}"][0]) * 1e3 for s in self.labels
+        }
+        term = k * (twist[first] * per_rad[first] + twist[second] * per_rad[second]) ** 2
+        wheel = (0.5 * k * (twist[first] - twist[second]) ** 2 * 1e-3, "N/mm")
         return term, wheel
 
 
