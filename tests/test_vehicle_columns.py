@@ -5,7 +5,7 @@ vehicle file's numbers read here with yaml:
 - anti-dive, anti-lift and anti-squat from side-view instant centres built by hand:
   the double wishbone's two wishbone planes, the MacPherson's lower-arm plane and the
   plane through the top mount normal to the strut, the multilink's side-view pole of
-  the upright's velocities (central differences of a tiny heave);
+  the upright's velocities (five-point central differences over 0.3 mm of heave);
 - the pitch centre where the two axles' lines CP → SVIC meet (numpy's solve);
 - the roll axis through the axles' roll centres, and the roll centres themselves from
   the front-view instant centres built the same ways;
