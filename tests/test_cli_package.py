@@ -45,6 +45,7 @@ REQUIRED = {
     "plot": ("r.csv", "-o", "o.png"),
     "draw": ("g.yaml", "-o", "o.png"),
     "study": ("s.yaml", "-o", "out"),
+    "attitude": ("v.yaml", "a.yaml", "-o", "o.csv"),
 }
 
 

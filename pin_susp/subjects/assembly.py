@@ -101,6 +101,7 @@ class Assembly(Composed, AnalysesSurface):
     noun: str = "assembly"
     commands: tuple[str, ...] | None = None  # the commands that take it (None: every one)
     reports: bool = True  # whether ``pin-susp sweep --plot`` draws its report
+    on_road: bool = False  # a body on the road: ``pin-susp attitude`` takes it (a vehicle)
     tree: object
     urdf: str
     output_points: list[str]

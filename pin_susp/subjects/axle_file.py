@@ -54,6 +54,7 @@ AXLE_KEYS = (
     "inertia",
     "actuation",
     "spring",
+    "strut",
     "anti_roll",
     "heave_link",
     "left_setup",
@@ -221,7 +222,9 @@ def load_axle(source, warn_as: str | None = None) -> AxleGeometry:
             optional=("camber_shim", "trackrod_length_delta", "pushrod_length_delta"),
         )
         corner_config = {
-            k: config[k] for k in ("steering", "wheel", "axle_position", "inertia") if k in config
+            k: config[k]
+            for k in ("steering", "wheel", "axle_position", "inertia", "strut")
+            if k in config
         }
         corner_config |= {k: vehicle[k] for k in VEHICLE_KEYS if k in vehicle}
         if "camber_shim" in setup:

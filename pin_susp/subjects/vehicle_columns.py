@@ -46,7 +46,7 @@ def vehicle_columns(car, plain: dict, columns: dict) -> dict:
     if len(sv) == 2:
         out |= pitch_centre(sv)
     out |= anti_columns(car, cp, wc, columns)
-    out |= turning_radius(car, cp, columns)
+    out |= turning_radius(car, columns)
     return out
 
 
@@ -104,7 +104,7 @@ def anti_columns(car, cp: dict, wc: dict, columns: dict) -> dict:
     return out
 
 
-def turning_radius(car, cp: dict, columns: dict) -> dict:
+def turning_radius(car, columns: dict) -> dict:
     """``turning_radius`` (m, + turning left): the step's wheelbase on the road (the
     mean of left and right) over the tangent of the front wheels' mean steer angle from
     design; blank with the rack at centre."""
@@ -114,7 +114,7 @@ def turning_radius(car, cp: dict, columns: dict) -> dict:
         return {}
     design = [car.design_steer(c) for c in ENDS["front"]]
     delta = np.radians(0.5 * (steer[0] - design[0] + steer[1] - design[1]))
-    base = 0.5 * ((cp["fl"][:, 0] - cp["rl"][:, 0]) + (cp["fr"][:, 0] - cp["rr"][:, 0]))
+    base = 0.5 * (columns["wheelbase_left"] + columns["wheelbase_right"])  # on the road
     with np.errstate(divide="ignore", invalid="ignore"):
         radius = base * 1e-3 / np.tan(delta)
     radius[np.abs(travel) < STRAIGHT * 1e3] = np.nan

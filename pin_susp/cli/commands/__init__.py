@@ -49,6 +49,10 @@ COMMANDS = {
         "pin_susp.cli.commands.loads",
         "member and joint forces at every step under load cases",
     ),
+    "attitude": (
+        "pin_susp.cli.commands.attitude",
+        "a vehicle's attitude, wheel loads and load transfer (TLLTD) under steady g",
+    ),
     "study": (
         "pin_susp.cli.commands.study",
         "many variants of a geometry on Dask: DOE, tolerance Monte Carlo, optimisation",

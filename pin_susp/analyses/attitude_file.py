@@ -1,0 +1,112 @@
+"""The attitude's inputs (docs/vehicle.md, "Attitude"): an accelerations file — a list
+of steady (ax, ay) in g, or a grid of them — and what the attitude needs of a vehicle
+file beyond its sweep's: ``vehicle_config.masses`` and the tyres' rates, each problem
+one message naming the file and the key.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..io.yamlio import Reader, load_yaml
+
+ENDS = {"front": ("fl", "fr"), "rear": ("rl", "rr")}
+
+
+@dataclass(frozen=True)
+class Accelerations:
+    """A list of steady accelerations (ax, ay), g: ISO 8855, ax + forward, ay + left."""
+
+    ax: np.ndarray
+    ay: np.ndarray
+    source: str = "<dict>"
+    sha256: str | None = None
+
+    def __len__(self) -> int:
+        return len(self.ax)
+
+
+def load_accelerations(source) -> Accelerations:
+    """Read an accelerations file (docs/vehicle.md): ``accelerations:`` a list of
+    ``{ax, ay}`` in g, and/or ``grid: {ax: {start, stop, steps}, ay: {...}}`` (every
+    pair, ay the faster). Errors name the file and the key."""
+    data, name, sha = load_yaml(source)
+    r = Reader(name)
+    r.mapping(data, "", optional=("version", "name", "accelerations", "grid"))
+    if "accelerations" not in data and "grid" not in data:
+        r.fail("accelerations", "give a list of {ax, ay} (g), or a grid of them")
+    ax, ay = [], []
+    given = data.get("accelerations", [])
+    if not isinstance(given, list):
+        r.fail("accelerations", "expected a list of {ax, ay} (g)")
+    for i, a in enumerate(given):
+        key = f"accelerations[{i}]"
+        r.mapping(a, key, optional=("ax", "ay"))
+        ax.append(_g(r, a.get("ax", 0.0), f"{key}.ax"))
+        ay.append(_g(r, a.get("ay", 0.0), f"{key}.ay"))
+    if "grid" in data:
+        grid = r.mapping(data["grid"], "grid", required=("ax", "ay"))
+        axes = []
+        for axis in ("ax", "ay"):
+            key = f"grid.{axis}"
+            spec = r.mapping(grid[axis], key, required=("start", "stop", "steps"))
+            steps = spec["steps"]
+            if isinstance(steps, bool) or not isinstance(steps, int) or not 1 <= steps <= 1000:
+                r.fail(f"{key}.steps", f"expected a whole number from 1 to 1000, got {steps!r}")
+            start = _g(r, spec["start"], f"{key}.start")
+            stop = _g(r, spec["stop"], f"{key}.stop")
+            axes.append(np.linspace(start, stop, steps))
+        X, Y = np.meshgrid(*axes, indexing="ij")
+        ax += list(X.ravel())
+        ay += list(Y.ravel())
+    if not ax:
+        r.fail("accelerations", "the list is empty")
+    return Accelerations(np.array(ax, dtype=float), np.array(ay, dtype=float), name, sha)
+
+
+def _g(r: Reader, value, key: str) -> float:
+    """An acceleration in g: a number within ±5 g."""
+    v = r.number(value, key)
+    if abs(v) > 5.0:
+        r.fail(key, f"{v:g} g is beyond any car's grip (within ±5 g)")
+    return v
+
+
+def masses_of(v) -> dict:
+    m = v.masses
+    r = Reader(v.source)
+    key = "vehicle_config.masses"
+    r.mapping(
+        m,
+        key,
+        required=("sprung",),
+        optional=("unsprung_front", "unsprung_rear", "sprung_roll_inertia"),
+    )
+    sprung = r.positive(m["sprung"], f"{key}.sprung")
+    out = {"sprung": sprung, "unsprung": {}}
+    for end, labels in ENDS.items():
+        value = m.get(f"unsprung_{end}")
+        if value is None:
+            r.fail(f"{key}.unsprung_{end}", "the attitude needs each corner's unsprung mass (kg)")
+        value = r.number(value, f"{key}.unsprung_{end}")
+        if value < 0:
+            r.fail(f"{key}.unsprung_{end}", f"{value:g} kg is negative")
+        for c in labels:
+            out["unsprung"][c] = value
+    out["total"] = sprung + sum(out["unsprung"].values())
+    inertia = m.get("sprung_roll_inertia")
+    out["roll_inertia"] = (
+        None if inertia is None else r.positive(inertia, f"{key}.sprung_roll_inertia")
+    )
+    return out
+
+
+def tyre_rates_of(v) -> np.ndarray | None:
+    """``vehicle_config.tyres``: ``{vertical: N/mm}`` or per axle ``{front: {vertical},
+    rear: {vertical}}``; N/m per corner, None for rigid tyres."""
+    t = v.tyres
+    if t is None:
+        return None
+    return np.array([t[c[0]] for c in ("fl", "fr", "rl", "rr")]) * 1e3
