@@ -24,6 +24,8 @@ is seen from the road (camber to ground, the wheelbase on the road) follow.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from .. import __version__
@@ -126,7 +128,18 @@ class Vehicle(Assembly):
         if not isinstance(vehicle, VehicleGeometry):
             vehicle = load_vehicle(vehicle)
         self.vehicle, self.name, self.source = vehicle, vehicle.name, vehicle.source
-        self.corners = {label: apply_setup(vehicle.corner(label)) for label in LABELS}
+        # each corner as set, the car's wheelbase, CG and brakes in place of any its
+        # axle file gives (its anti columns: the whole car's, vehicle_columns.py)
+        self.corners = {
+            label: replace(
+                apply_setup(vehicle.corner(label)),
+                wheelbase=None,
+                cg_position=None,
+                front_brake_bias=None,
+                driven_axle=None,
+            )
+            for label in LABELS
+        }
         front = self.corners["fl"]
         sense = 1.0
         if front.steering == "rack":  # the rack's travel left steers left where the
