@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 from scipy.spatial.transform import Rotation
 
 import pin_susp
@@ -235,3 +236,29 @@ def test_cli_sweep_writes_the_car(tmp_path):
         assert run.returncode == 2 and "not built yet" in run.stderr, refused
         assert run.stderr.count("\n") == 1 and "Traceback" not in run.stderr
     assert not (tmp_path / "car.urdf").exists()
+
+
+def test_misspelt_scope_and_the_wrong_kinds_quantities_say_so(tmp_path):
+    """A misspelt scope is named as such (not taken for an axle's); a vehicle's pitch
+    on an axle and an axle's roll on a corner name whose quantities they are; the
+    steering wheel given twice is named."""
+    from pin_susp.errors import InputError
+    from pin_susp.model.geometry import load_geometry
+    from pin_susp.model.sweep import load_sweep
+    from pin_susp.subjects.axle import AxleModel
+
+    data = yaml.safe_load((EXAMPLES / "vehicle_fs.yaml").read_text())
+    data["scope"] = "vehicel"
+    with pytest.raises(InputError, match="scope: expected one of corner, axle, vehicle"):
+        load_geometry(data)
+    axle = AxleModel(EXAMPLES / "vehicle" / "fs_front.yaml")
+    with pytest.raises(InputError, match="pitch is a vehicle's quantity: this geometry is an axle"):
+        axle.run_sweep(EXAMPLES / "vehicle_pitch.yaml")
+    twice = {
+        "version": 1,
+        "steps": 2,
+        "targets": [{"quantity": q, "start": 0, "stop": 0} for q in ("heave", "pitch", "roll")]
+        + [{"quantity": "steering_wheel", "start": 0, "stop": 10}] * 2,
+    }
+    with pytest.raises(InputError, match=r"targets\[4\]: repeats targets\[3\] \(steering_wheel\)"):
+        Vehicle(EXAMPLES / "vehicle_fs.yaml").run_sweep(load_sweep(twice))
