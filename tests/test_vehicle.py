@@ -262,3 +262,22 @@ def test_misspelt_scope_and_the_wrong_kinds_quantities_say_so(tmp_path):
     }
     with pytest.raises(InputError, match=r"targets\[4\]: repeats targets\[3\] \(steering_wheel\)"):
         Vehicle(EXAMPLES / "vehicle_fs.yaml").run_sweep(load_sweep(twice))
+
+
+def test_a_wheel_off_the_road_at_design_is_an_error(tmp_path):
+    """A wheel centre too low for its tyre (its contact patch below z = 0 at design)
+    is named in its axle file, with how far: every sweep would start by moving it."""
+    from pin_susp.errors import InputError
+
+    for name in ("vehicle_fs.yaml", "vehicle/fs_front.yaml", "vehicle/fs_rear.yaml"):
+        (tmp_path / name).parent.mkdir(exist_ok=True)
+        (tmp_path / name).write_text((EXAMPLES / name).read_text())
+    front = tmp_path / "vehicle" / "fs_front.yaml"
+    data = yaml.safe_load(front.read_text())
+    for key in ("axle_inboard", "axle_outboard"):
+        data["hardpoints"]["left"][key]["z"] -= 3.0
+    front.write_text(yaml.safe_dump(data))
+    with pytest.raises(InputError) as got:
+        Vehicle(tmp_path / "vehicle_fs.yaml")
+    assert got.value.source == str(front) and got.value.key == "hardpoints"
+    assert "the fl contact patch is 3 mm below the road" in got.value.problem
