@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 from scipy.spatial.transform import Rotation
 
 import pin_susp
@@ -235,3 +236,48 @@ def test_cli_sweep_writes_the_car(tmp_path):
         assert run.returncode == 2 and "not built yet" in run.stderr, refused
         assert run.stderr.count("\n") == 1 and "Traceback" not in run.stderr
     assert not (tmp_path / "car.png").exists()
+
+
+def test_misspelt_scope_and_the_wrong_kinds_quantities_say_so(tmp_path):
+    """A misspelt scope is named as such (not taken for an axle's); a vehicle's pitch
+    on an axle and an axle's roll on a corner name whose quantities they are; the
+    steering wheel given twice is named."""
+    from pin_susp.errors import InputError
+    from pin_susp.model.geometry import load_geometry
+    from pin_susp.model.sweep import load_sweep
+    from pin_susp.subjects.axle import AxleModel
+
+    data = yaml.safe_load((EXAMPLES / "vehicle_fs.yaml").read_text())
+    data["scope"] = "vehicel"
+    with pytest.raises(InputError, match="scope: expected one of corner, axle, vehicle"):
+        load_geometry(data)
+    axle = AxleModel(EXAMPLES / "vehicle" / "fs_front.yaml")
+    with pytest.raises(InputError, match="pitch is a vehicle's quantity: this geometry is an axle"):
+        axle.run_sweep(EXAMPLES / "vehicle_pitch.yaml")
+    twice = {
+        "version": 1,
+        "steps": 2,
+        "targets": [{"quantity": q, "start": 0, "stop": 0} for q in ("heave", "pitch", "roll")]
+        + [{"quantity": "steering_wheel", "start": 0, "stop": 10}] * 2,
+    }
+    with pytest.raises(InputError, match=r"targets\[4\]: repeats targets\[3\] \(steering_wheel\)"):
+        Vehicle(EXAMPLES / "vehicle_fs.yaml").run_sweep(load_sweep(twice))
+
+
+def test_a_wheel_off_the_road_at_design_is_an_error(tmp_path):
+    """A wheel centre too low for its tyre (its contact patch below z = 0 at design)
+    is named in its axle file, with how far: every sweep would start by moving it."""
+    from pin_susp.errors import InputError
+
+    for name in ("vehicle_fs.yaml", "vehicle/fs_front.yaml", "vehicle/fs_rear.yaml"):
+        (tmp_path / name).parent.mkdir(exist_ok=True)
+        (tmp_path / name).write_text((EXAMPLES / name).read_text())
+    front = tmp_path / "vehicle" / "fs_front.yaml"
+    data = yaml.safe_load(front.read_text())
+    for key in ("axle_inboard", "axle_outboard"):
+        data["hardpoints"]["left"][key]["z"] -= 3.0
+    front.write_text(yaml.safe_dump(data))
+    with pytest.raises(InputError) as got:
+        Vehicle(tmp_path / "vehicle_fs.yaml")
+    assert got.value.source == str(front) and got.value.key == "hardpoints"
+    assert "the fl contact patch is 3 mm below the road" in got.value.problem

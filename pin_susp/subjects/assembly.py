@@ -31,6 +31,9 @@ CHUNK = 10_000  # steps solved and written at a time by a streamed sweep
 Z = np.array([0.0, 0.0, 1.0])
 
 
+VEHICLE_QUANTITIES = ("pitch", "road_z", "steering_wheel")  # a body on the road's alone
+
+
 class Assembly(Composed, AnalysesSurface):
     """The surface :class:`~pin_susp.subjects.corner.Corner` and
     :class:`~pin_susp.subjects.axle.AxleModel` share.
@@ -102,6 +105,12 @@ class Assembly(Composed, AnalysesSurface):
     commands: tuple[str, ...] | None = None  # the commands that take it (None: every one)
     reports: bool = True  # whether ``pin-susp sweep --plot`` draws its report
     on_road: bool = False  # a body on the road: ``pin-susp attitude`` takes it (a vehicle)
+
+    @property
+    def article(self) -> str:
+        """ "an" before its noun (an axle), else "a"."""
+        return "an" if self.noun[0] in "aeiou" else "a"
+
     tree: object
     urdf: str
     output_points: list[str]
@@ -181,10 +190,13 @@ class Assembly(Composed, AnalysesSurface):
                 seen[what] = i
             if t.quantity is not None:
                 if t.quantity not in quantities:
+                    owner = "a vehicle's" if t.quantity in VEHICLE_QUANTITIES else "an axle's"
+                    takes = ", ".join(quantities) if quantities else "no quantity, only points"
                     raise InputError(
                         source,
                         f"targets[{i}].quantity",
-                        f"{t.quantity} is an axle's quantity: this geometry is one corner",
+                        f"{t.quantity} is {owner} quantity: this geometry is {self.article} "
+                        f"{self.noun} (it takes {takes})",
                     )
                 rows.append(quantities[t.quantity].row(self, i, t, source))
                 continue
@@ -520,40 +532,6 @@ class Assembly(Composed, AnalysesSurface):
         """Its columns beyond its corners' and elements' (name → (values, unit)), from the
         solved configurations ``qs``, the points as measured (``plain``, m) and the
         columns so far: none (a vehicle's body)."""
-        return {}
-
-    # ------------------------------------------------------------ exported models
-
-    @property
-    def export_tree(self):
-        """The tree its URDF and MJCF are written from (docs/urdf.md): its model's own (a
-        vehicle's: its body floating, without the road and the body's joints)."""
-        return self.tree
-
-    @property
-    def export_urdf(self) -> str:
-        """The URDF ``pin-susp urdf`` writes and the Drake engine reads: its model's own."""
-        return self.urdf
-
-    def engine_steps(self, sweep: Sweep) -> list[list] | None:
-        """Every step's targets as the validation's engines take them where its sweep's
-        own are not (validate/scopes.py reads those: a point's, an axle's heave and
-        roll): a vehicle's, its body's pose first (a BodyPose) and each target a
-        (point, unit direction, value m) in the road's frame. None: its sweep's."""
-        return None
-
-    def engine_moves(self, sweep: Sweep) -> list[dict]:
-        """Every step's targets with each of its body's quantities moved a little (a
-        vehicle's heave, pitch and roll: quantity → (h, the steps at −2h, −h, +h, +2h)),
-        for the engines' rates along them: none."""
-        return [{} for _ in range(sweep.steps)]
-
-    def road_columns(self, road: dict, points: dict, columns: dict) -> dict:
-        """Its columns an engine's points give beyond the metric columns (name → (values
-        (1,), unit)), from ``road`` (the points where the engine solved them, m),
-        ``points`` (a Dual per label, as its sweep measures them; ``points.along``: the
-        wheel centres' rates along ``engine_moves``) and the metric ``columns``: none (a
-        vehicle's body: what the road sees, the rates along the body)."""
         return {}
 
     def run_sweep_chunks(self, sweep: Sweep | str | dict, rows: int = CHUNK, progress=None):

@@ -24,6 +24,8 @@ is seen from the road (camber to ground, the wheelbase on the road) follow.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from .. import __version__
@@ -53,6 +55,7 @@ from .vehicle_file import (  # noqa: F401 (the vehicle file's names, importable 
 )
 
 DERIVED = ("camber", "roadwheel_angle")  # the corner columns rated along heave, pitch, roll
+ON_ROAD = 1.0  # mm: a contact patch's height at design, at most
 
 
 class AxleElements:
@@ -133,7 +136,18 @@ class Vehicle(VehicleExport, Assembly):
         if not isinstance(vehicle, VehicleGeometry):
             vehicle = load_vehicle(vehicle)
         self.vehicle, self.name, self.source = vehicle, vehicle.name, vehicle.source
-        self.corners = {label: apply_setup(vehicle.corner(label)) for label in LABELS}
+        # each corner as set, the car's wheelbase, CG and brakes in place of any its
+        # axle file gives (its anti columns: the whole car's, vehicle_columns.py)
+        self.corners = {
+            label: replace(
+                apply_setup(vehicle.corner(label)),
+                wheelbase=None,
+                cg_position=None,
+                front_brake_bias=None,
+                driven_axle=None,
+            )
+            for label in LABELS
+        }
         front = self.corners["fl"]
         sense = 1.0
         if front.steering == "rack":  # the rack's travel left steers left where the
@@ -151,12 +165,31 @@ class Vehicle(VehicleExport, Assembly):
         self._drivers()
         self.kin.update(self.q_design)
         self._check_determined()
+        self._check_on_road()
         self.spring_senses = {
             label: (Linkage(g).spring_sense if g.spring == "torsion_bar" else 1.0)
             for label, g in self.corners.items()
         }
         body = [self.model.joints[self.model.getJointId(j)] for j in JOINTS]
         self.body_q, self.body_v = [j.idx_q for j in body], [j.idx_v for j in body]
+
+    def _check_on_road(self) -> None:
+        """Each contact patch on the road (z = 0) at design, to ON_ROAD: else the
+        wheel centres' heights and the tyres' sizes disagree (or the origin is not on
+        the ground), and every sweep would start by moving the wheels to the road."""
+        for end, labels in AXLES.items():
+            for label in labels:
+                z = self.design_positions[f"{label}_contact_patch_center"][2] * 1e3
+                if abs(z) > ON_ROAD:
+                    where, key = axle_key(self.vehicle, end, "hardpoints")
+                    raise InputError(
+                        where,
+                        key,
+                        f"the {label} contact patch is {abs(z):.4g} mm "
+                        f"{'above' if z > 0 else 'below'} the road (z = 0) at design: its "
+                        "wheel centre's height and its tyre's radius disagree, or the "
+                        "origin is not on the ground (ISO 8855: z = 0 on the road)",
+                    )
 
     def _check_determined(self) -> None:
         """Each wheel's height, the rack and the body's joints must fix the pose at design

@@ -70,6 +70,13 @@ class BodyOnRoad:
                     f"a vehicle's sweep gives the body's {name} exactly once "
                     f"(got {len(given)}): heave, pitch and roll fix the body on the road",
                 )
+        steering = [i for i, t in enumerate(targets) if t.quantity == "steering_wheel"]
+        if len(steering) > 1:
+            raise InputError(
+                source,
+                f"targets[{steering[1]}]",
+                f"repeats targets[{steering[0]}] (steering_wheel)",
+            )
         seen = set()
         for i, t in enumerate(targets):
             if t.quantity == "road_z":
