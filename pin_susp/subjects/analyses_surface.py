@@ -1,5 +1,6 @@
 """What the analyses ask every subject (README, How it works): the defaults of an
-Assembly's answers to setup, drawings and hardpoint sensitivities, for a corner; an
+Assembly's answers to its exported model and the validation's engines, setup,
+drawings and hardpoint sensitivities, for a corner; an
 axle's own answers are in axle_file.AxleAssembly. Kept apart from assembly.py, whose
 job is the subject's targets, sweep and columns.
 """
@@ -15,6 +16,40 @@ class AnalysesSurface:
     """The analyses' questions to an :class:`~pin_susp.subjects.assembly.Assembly`, with a
     corner's answers as the defaults (``labels``, ``corners``, ``source`` and
     ``solve_sweep`` are the Assembly's)."""
+
+    # -- the exported model and the validation's engines (urdf, mjcf, validate) ---
+
+    @property
+    def export_tree(self):
+        """The tree its URDF and MJCF are written from (docs/urdf.md): its model's own (a
+        vehicle's: its body floating, without the road and the body's joints)."""
+        return self.tree
+
+    @property
+    def export_urdf(self) -> str:
+        """The URDF ``pin-susp urdf`` writes and the Drake engine reads: its model's own."""
+        return self.urdf
+
+    def engine_steps(self, sweep) -> list[list] | None:
+        """Every step's targets as the validation's engines take them where its sweep's
+        own are not (validate/scopes.py reads those: a point's, an axle's heave and
+        roll): a vehicle's, its body's pose first (a BodyPose) and each target a
+        (point, unit direction, value m) in the road's frame. None: its sweep's."""
+        return None
+
+    def engine_moves(self, sweep) -> list[dict]:
+        """Every step's targets with each of its body's quantities moved a little (a
+        vehicle's heave, pitch and roll: quantity → (h, the steps at −2h, −h, +h, +2h)),
+        for the engines' rates along them: none."""
+        return [{} for _ in range(sweep.steps)]
+
+    def road_columns(self, road: dict, points: dict, columns: dict) -> dict:
+        """Its columns an engine's points give beyond the metric columns (name → (values
+        (1,), unit)), from ``road`` (the points where the engine solved them, m),
+        ``points`` (a Dual per label, as its sweep measures them; ``points.along``: the
+        wheel centres' rates along ``engine_moves``) and the metric ``columns``: none (a
+        vehicle's body: what the road sees, the rates along the body)."""
+        return {}
 
     # -- setup and sensitivity (setup.py, sensitivity.py, their commands) ----------
 

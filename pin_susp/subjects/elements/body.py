@@ -23,11 +23,12 @@ import numpy as np
 
 from ...constraints import JointTarget, PointTarget
 from ...errors import InputError
-from ...model.tree import Body, Joint
+from ...model.tree import Body, FloatingBase, Joint, Tree
 from . import rack
 
 JOINTS = ("body_heave", "body_pitch", "body_roll")
 ROAD = "road"
+CG = "cg"  # the exported model's frame at the CG, on the body (its sprung mass)
 Z = np.array([0.0, 0.0, 1.0])
 
 
@@ -128,3 +129,28 @@ class BodyOnRoad:
         c, s = np.cos(pitch), np.sin(pitch)
         x, z = c * x + s * z, -s * x + c * z  # R_y
         return np.stack([x, y, z + heave], axis=1) + self.cg
+
+    def placement(self, heave: float, pitch: float, roll: float) -> tuple:
+        """The body's frame in the road's at its pose (m, rad): (R, t), w = R·p + t, with
+        R = R_y(θ)·R_x(φ) and t = c + h·ẑ − R·c (``to_world``'s)."""
+        c, s = np.cos(roll), np.sin(roll)
+        rx = np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+        c, s = np.cos(pitch), np.sin(pitch)
+        ry = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+        rotation = ry @ rx
+        return rotation, self.cg + heave * Z - rotation @ self.cg
+
+    def exported(self, tree: Tree, mass: float | None = None, inertia=None) -> Tree:
+        """The tree as the URDF and MJCF export it (docs/urdf.md): without the road and
+        the body's three joints — the chassis its root, floating (``Tree.floating``: a
+        robotics tool's free-flyer, MuJoCo's freejoint) — and a point ``cg`` on it at the
+        CG that carries the sprung ``mass`` (kg, None: none given) and ``inertia``."""
+        ours = {ROAD, JOINTS[0], JOINTS[1]}
+        bodies = [
+            replace(b, parent=None, joint=None) if b.name == "chassis" else b
+            for b in tree.bodies
+            if b.name not in ours
+        ]
+        points = dict(tree.points) | {CG: ("chassis", self.cg.copy())}
+        base = FloatingBase(CG, self.cg.copy(), mass, inertia)
+        return replace(tree, bodies=bodies, points=points, floating=base)
