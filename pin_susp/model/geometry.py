@@ -362,10 +362,8 @@ def parse_geometry(data: dict, r: Reader, sha: str | None) -> Geometry:
     variants, read from data they hold, warn (or not) for themselves."""
     from . import mechanisms
 
-    if isinstance(data, dict) and "scope" in data:  # a misspelt scope named as such
-        r.choice(data["scope"], "scope", ("corner", "axle", "vehicle"))
     for scope, (_, keys, needs) in OTHER_SCOPES.items() if isinstance(data, dict) else ():
-        declared = data.get("scope")
+        declared = r.choice(data.get("scope", "corner"), "scope", (*SCOPES, "vehicle"))
         for key in (k for k in keys if k in data and declared != scope):
             r.fail("scope", needs.format(key=key))
     r.mapping(data, "", required=("hardpoints",), optional=CORNER_KEYS)
