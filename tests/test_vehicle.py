@@ -260,7 +260,7 @@ def test_misspelt_scope_and_the_wrong_kinds_quantities_say_so(tmp_path):
         "targets": [{"quantity": q, "start": 0, "stop": 0} for q in ("heave", "pitch", "roll")]
         + [{"quantity": "steering_wheel", "start": 0, "stop": 10}] * 2,
     }
-    with pytest.raises(InputError, match=r"targets\[4\]: repeats targets\[3\] \(steering_wheel\)"):
+    with pytest.raises(InputError, match=r"targets\[4\]: repeats targets\[3\]'s steering"):
         Vehicle(EXAMPLES / "vehicle_fs.yaml").run_sweep(load_sweep(twice))
 
 
@@ -281,3 +281,29 @@ def test_a_wheel_off_the_road_at_design_is_an_error(tmp_path):
         Vehicle(tmp_path / "vehicle_fs.yaml")
     assert got.value.source == str(front) and got.value.key == "hardpoints"
     assert "the fl contact patch is 3 mm below the road" in got.value.problem
+
+
+def test_the_rack_is_held_and_moved_in_the_chassis_frame():
+    """Without a steering target the rack stays at design while the body rolls (it is
+    held by its joint, not by its end's position on the road); a rack target as on an
+    axle (trackrod_inboard along y) and the vehicle's rack quantity move it by exactly
+    their travel, rolled or not."""
+    from pin_susp.model.sweep import load_sweep
+
+    car = Vehicle(EXAMPLES / "vehicle_fs.yaml")
+    body = [
+        {"quantity": "heave", "start": 0, "stop": 0},
+        {"quantity": "pitch", "start": 0, "stop": 0},
+        {"quantity": "roll", "start": -2, "stop": 2},
+    ]
+    held = car.run_sweep(load_sweep({"version": 1, "steps": 5, "targets": body}))
+    assert held.meta["notes"] and np.abs(held["rack_displacement"]).max() < 1e-9
+    # the rack's end on the road moves with the roll: a hold in the road frame would not
+    assert np.ptp(held["fl_trackrod_inboard_z"]) == 0.0  # (chassis frame: it stays)
+    on_axle = {"point": "trackrod_inboard", "side": "fl", "direction": {"axis": "y"}}
+    for target, expected in (
+        (on_axle | {"start": 5, "stop": 5}, [5.0] * 5),
+        ({"quantity": "rack", "start": -5, "stop": 5}, np.linspace(-5, 5, 5)),
+    ):
+        r = car.run_sweep(load_sweep({"version": 1, "steps": 5, "targets": [*body, target]}))
+        np.testing.assert_allclose(r["rack_displacement"], expected, rtol=0, atol=1e-9)

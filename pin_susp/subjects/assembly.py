@@ -31,7 +31,7 @@ CHUNK = 10_000  # steps solved and written at a time by a streamed sweep
 Z = np.array([0.0, 0.0, 1.0])
 
 
-VEHICLE_QUANTITIES = ("pitch", "road_z", "steering_wheel")  # a body on the road's alone
+VEHICLE_QUANTITIES = ("pitch", "road_z", "steering_wheel", "rack")  # a body on the road's alone
 
 
 class Assembly(Composed, AnalysesSurface):

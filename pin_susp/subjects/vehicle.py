@@ -265,11 +265,34 @@ class Vehicle(VehicleExport, Assembly):
 
     def held_targets(self, targets: list) -> list:
         """Its sweep's targets, each corner's road height (0) where none is given, and the
-        rack held at design where no steering target is (Composed.held_targets)."""
-        targets = self._on_flat_road(targets)
-        if any(t.quantity == "steering_wheel" for t in targets):
+        rack held at design where no steering target is (Composed.held_targets). The rack
+        is held, or moved by a rack target as on an axle (``trackrod_inboard`` along y),
+        by its joint: its travel in the chassis frame, not its end's in the road's,
+        which the body's roll would move."""
+        from ..model.sweep import Target
+
+        targets = [self._rack_of(t) for t in self._on_flat_road(targets)]
+        if any(t.quantity in ("steering_wheel", "rack") for t in targets):
             return targets
-        return super().held_targets(targets)
+        held = super().held_targets(targets)
+        if len(held) > len(targets):  # the rack held at design
+            steps = len(targets[0].values)
+            held[-1] = Target(None, None, np.zeros(steps), quantity="rack")
+        return held
+
+    def _rack_of(self, t):
+        """A rack target as on an axle (``trackrod_inboard`` along y on fl or fr) as the
+        rack's travel from design, mm: the vehicle's ``rack`` quantity."""
+        from ..model.sweep import Target
+
+        if t.quantity is not None or t.point != rack.INBOARD or t.side not in AXLES["front"]:
+            return t
+        if not np.allclose(t.unit_direction, (0.0, 1.0, 0.0)):
+            return t
+        travel = np.asarray(t.values, dtype=float)
+        if t.mode == "absolute":
+            travel = travel - self.design_positions[f"{t.side}_{rack.INBOARD}"][1] * 1e3
+        return Target(None, None, travel, quantity="rack")
 
     def _on_flat_road(self, targets) -> list:
         """The targets with road_z 0 under each corner none names."""

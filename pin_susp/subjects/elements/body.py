@@ -37,7 +37,7 @@ class BodyOnRoad:
     rack per steering-wheel turn (None: no steering-wheel target); ``steer_sense``:
     +1 where the rack's travel to the left (+y) turns the car left."""
 
-    quantities = ("heave", "pitch", "roll", "road_z", "steering_wheel")
+    quantities = ("heave", "pitch", "roll", "road_z", "steering_wheel", "rack")
 
     def __init__(self, cg: np.ndarray, c_factor: float | None, steer_sense: float = 1.0):
         self.cg = np.asarray(cg, dtype=float)
@@ -70,12 +70,13 @@ class BodyOnRoad:
                     f"a vehicle's sweep gives the body's {name} exactly once "
                     f"(got {len(given)}): heave, pitch and roll fix the body on the road",
                 )
-        steering = [i for i, t in enumerate(targets) if t.quantity == "steering_wheel"]
+        steering = [i for i, t in enumerate(targets) if t.quantity in ("steering_wheel", "rack")]
         if len(steering) > 1:
             raise InputError(
                 source,
                 f"targets[{steering[1]}]",
-                f"repeats targets[{steering[0]}] (steering_wheel)",
+                f"repeats targets[{steering[0]}]'s steering (the steering wheel or the rack: "
+                "one of them, once)",
             )
         seen = set()
         for i, t in enumerate(targets):
@@ -97,7 +98,9 @@ class BodyOnRoad:
                 )
             return PointTarget(model.points[f"{t.side}_contact_patch_center"], Z)
         if not model.model.existJointName(rack.JOINT):
-            raise InputError(source, f"targets[{i}]", "steering_wheel: this vehicle has no rack")
+            raise InputError(source, f"targets[{i}]", f"{t.quantity}: this vehicle has no rack")
+        if t.quantity == "rack":  # its travel in the chassis frame: the rack's joint
+            return JointTarget(model.model, rack.JOINT)
         if self.c_factor is None:
             raise InputError(
                 source,
@@ -107,10 +110,10 @@ class BodyOnRoad:
         return JointTarget(model.model, rack.JOINT)
 
     def value(self, t) -> np.ndarray:
-        """A quantity target's values in SI: heave and road_z m, pitch and roll rad, the
-        steering wheel as the rack's travel (m)."""
+        """A quantity target's values in SI: heave, road_z and the rack's travel m, pitch
+        and roll rad, the steering wheel as the rack's travel (m)."""
         v = np.asarray(t.values, dtype=float)
-        if t.quantity in ("heave", "road_z"):
+        if t.quantity in ("heave", "road_z", "rack"):
             return v * 1e-3
         if t.quantity in ("pitch", "roll"):
             return np.radians(v)
