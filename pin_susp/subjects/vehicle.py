@@ -50,6 +50,7 @@ from .vehicle_file import (  # noqa: F401 (the vehicle file's names, importable 
     axle_key,
     load_vehicle,
 )
+from .vehicle_views import VehicleViews
 
 DERIVED = ("camber", "roadwheel_angle")  # the corner columns rated along heave, pitch, roll
 
@@ -89,7 +90,7 @@ class AxleElements:
         return out | self.bar.rate_columns(model, points)
 
 
-class Vehicle(Assembly):
+class Vehicle(VehicleViews, Assembly):
     """Four corners under one sprung body on the road, one Pinocchio model
     (docs/vehicle.md): ``Vehicle("examples/vehicle_fs.yaml")`` or a VehicleGeometry.
 
@@ -104,7 +105,12 @@ class Vehicle(Assembly):
 
     labels = LABELS
     noun = "vehicle"
-    commands = ("sweep", "attitude")  # the rest of docs/vehicle.md's "Not built yet"
+    commands = (
+        "sweep",
+        "attitude",
+        "view",
+        "draw",
+    )  # the rest of docs/vehicle.md's "Not built yet"
     reports = False
     on_road = True
     summary_columns = tuple(
@@ -177,6 +183,18 @@ class Vehicle(Assembly):
             "design: a part turns freely (a droplink square to its bar arm's motion — at "
             f"dead centre — or in line with the bar's axis?): {', '.join(moved)}",
         )
+
+    def with_corners(self, corners: dict):
+        """The same car on other corners' Geometries, by label (the 3D view's ghost, as
+        drawn): each axle's file with those corners, its bar and heave link kept."""
+        from dataclasses import replace
+
+        v = self.vehicle
+        axles = {
+            end: replace(getattr(v, end), left=corners[a], right=corners[b])
+            for end, (a, b) in AXLES.items()
+        }
+        return Vehicle(replace(v, **axles))
 
     def __repr__(self) -> str:
         v = self.vehicle
