@@ -111,6 +111,28 @@ class AnalysesSurface:
     # only at its design state
     drawn_at_steps: bool = False
 
+    # -- the 3D view and the drawings at rest (scene.py, drawing.py) ---------------
+
+    def design_results(self):
+        """Its results (every column) at its design state, one row: a corner's and an
+        axle's at ``q_design``, no sweep solved (a vehicle's on the road: its own)."""
+        from ..model.sweep import Sweep
+        from ..solve.solver import Solution
+
+        return self.sweep_results(Sweep([]), [Solution(self.q_design, True, 0, 0.0)])
+
+    @property
+    def q_rest(self):
+        """The configuration its view shows and its drawing draws at design: its
+        ``q_design`` (a vehicle's: its body on the road at heave, pitch and roll 0)."""
+        return self.q_design
+
+    def marker_places(self, results) -> dict:
+        """Where each of its markers (``markers``) is at every step of its results: name
+        → (n, 3) m in the world's frame (the road's, for a body on it), NaN where blank.
+        A corner has none."""
+        return {}
+
     # -- hardpoint sensitivities (sensitivity.py, its command) ---------------------
 
     # the points its shared elements add (an axle's bar and heave link), no corner's

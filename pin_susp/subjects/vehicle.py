@@ -53,6 +53,7 @@ from .vehicle_file import (  # noqa: F401 (the vehicle file's names, importable 
     axle_key,
     load_vehicle,
 )
+from .vehicle_views import VehicleViews
 
 DERIVED = ("camber", "roadwheel_angle")  # the corner columns rated along heave, pitch, roll
 ON_ROAD = 1.0  # mm: a contact patch's height at design, at most
@@ -93,7 +94,7 @@ class AxleElements:
         return out | self.bar.rate_columns(model, points)
 
 
-class Vehicle(VehicleExport, Assembly):
+class Vehicle(VehicleExport, VehicleViews, Assembly):
     """Four corners under one sprung body on the road, one Pinocchio model
     (docs/vehicle.md): ``Vehicle("examples/vehicle_fs.yaml")`` or a VehicleGeometry.
 
@@ -114,6 +115,8 @@ class Vehicle(VehicleExport, Assembly):
         "urdf",
         "mjcf",
         "validate",
+        "view",
+        "draw",
     )  # docs/vehicle.md: the rest not yet
     reports = False
     on_road = True
@@ -218,6 +221,18 @@ class Vehicle(VehicleExport, Assembly):
             "design: a part turns freely (a droplink square to its bar arm's motion — at "
             f"dead centre — or in line with the bar's axis?): {', '.join(moved)}",
         )
+
+    def with_corners(self, corners: dict):
+        """The same car on other corners' Geometries, by label (the 3D view's ghost, as
+        drawn): each axle's file with those corners, its bar and heave link kept."""
+        from dataclasses import replace
+
+        v = self.vehicle
+        axles = {
+            end: replace(getattr(v, end), left=corners[a], right=corners[b])
+            for end, (a, b) in AXLES.items()
+        }
+        return Vehicle(replace(v, **axles))
 
     def __repr__(self) -> str:
         v = self.vehicle
