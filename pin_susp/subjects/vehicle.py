@@ -224,11 +224,19 @@ class Vehicle(Assembly):
 
     def held_targets(self, targets: list) -> list:
         """Its sweep's targets, each corner's road height (0) where none is given, and the
-        rack held at design where no steering target is (Composed.held_targets)."""
+        rack held at design where no steering target is (Composed.held_targets): held in
+        the body, its slide at zero as a centred steering wheel holds it — not its inboard
+        end's y in the road's frame, which would slide the rack in the body (and steer) as
+        the body rolls or pitches, and put the rack's force on the road."""
+        from ..model.sweep import Target
+
         targets = self._on_flat_road(targets)
         if any(t.quantity == "steering_wheel" for t in targets):
             return targets
-        return super().held_targets(targets)
+        held = super().held_targets(targets)
+        if len(held) > len(targets):  # the rack's: its slide, in the body
+            held[-1] = Target(None, None, np.zeros(len(held[-1].values)), quantity="steering_wheel")
+        return held
 
     def _on_flat_road(self, targets) -> list:
         """The targets with road_z 0 under each corner none names."""

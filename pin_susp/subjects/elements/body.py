@@ -90,7 +90,7 @@ class BodyOnRoad:
             return PointTarget(model.points[f"{t.side}_contact_patch_center"], Z)
         if not model.model.existJointName(rack.JOINT):
             raise InputError(source, f"targets[{i}]", "steering_wheel: this vehicle has no rack")
-        if self.c_factor is None:
+        if self.c_factor is None and np.any(np.asarray(t.values) != 0.0):
             raise InputError(
                 source,
                 f"targets[{i}]",
@@ -106,6 +106,8 @@ class BodyOnRoad:
             return v * 1e-3
         if t.quantity in ("pitch", "roll"):
             return np.radians(v)
+        if self.c_factor is None:  # the wheel centred (row: any other is refused)
+            return np.zeros_like(v)
         return self.steer_sense * v / 360.0 * self.c_factor * 1e-3
 
     def columns_of(self, model, points: dict, sides: dict) -> dict:
