@@ -158,6 +158,24 @@ def test_mirror_symmetry_in_roll(car):
             )
 
 
+def test_rack_held_without_a_steering_target_is_held_in_the_body(car):
+    """No steering target: the rack stays at design in the body (rack_displacement 0) as
+    the body rolls and pitches, the same steps as a centred steering wheel's. (It used to
+    hold the rack's inboard end in the road's frame: the rack slid about 1 mm at 2° of
+    roll, its left and right rolls not mirrored, and the rack's force went to the road.)"""
+    roll = np.linspace(-2, 2, 5)
+    held = body_sweep(np.full(5, 3.0), np.full(5, 0.4), roll)
+    held = Sweep([t for t in held.targets if t.quantity != "steering_wheel"], "<test>")
+    r = car.run_sweep(held)
+    assert r.meta["notes"] == ["rack held at design (the sweep gives no rack target)"]
+    np.testing.assert_allclose(r["rack_displacement"], 0.0, atol=1e-9)
+    centred = car.run_sweep(body_sweep(np.full(5, 3.0), np.full(5, 0.4), roll))
+    for label in LABELS:
+        for column in ("roadwheel_angle", "camber_to_ground"):
+            name = f"{column}_{label}"
+            np.testing.assert_allclose(r[name], centred[name], rtol=0, atol=1e-9)
+
+
 def test_steering_wheel_is_the_rack_through_the_c_factor(car):
     r = car.run_sweep(EXAMPLES / "vehicle_steer.yaml")
     np.testing.assert_allclose(r["steering_wheel_angle"], np.linspace(-90, 90, 21), atol=1e-9)

@@ -437,8 +437,7 @@ class Vehicle(VehicleExport, VehicleViews, Assembly):
                 continue
             if bar.kind != "u_bar":
                 raise InputError(
-                    self.source,
-                    f"{end}.axle_config.anti_roll.type",
+                    *axle_key(self.vehicle, end, "axle_config.anti_roll.type"),
                     "the attitude takes U-bars so far (a T-bar's twist in its potential "
                     "is not built yet)",
                 )

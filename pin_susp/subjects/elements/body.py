@@ -117,6 +117,8 @@ class BodyOnRoad:
             return v * 1e-3
         if t.quantity in ("pitch", "roll"):
             return np.radians(v)
+        if self.c_factor is None:  # the wheel centred (row: any other is refused)
+            return np.zeros_like(v)
         return self.steer_sense * v / 360.0 * self.c_factor * 1e-3
 
     def columns_of(self, model, points: dict, sides: dict) -> dict:
