@@ -104,7 +104,7 @@ class Vehicle(Assembly):
 
     labels = LABELS
     noun = "vehicle"
-    commands = ("sweep", "attitude")  # the rest of docs/vehicle.md's "Not built yet"
+    commands = ("sweep", "attitude", "loads")  # the rest of docs/vehicle.md's "Not built yet"
     reports = False
     on_road = True
     summary_columns = tuple(
@@ -372,6 +372,23 @@ class Vehicle(Assembly):
 
             out.append((bar.axle.anti_roll_stiffness * 180.0 / np.pi, twist))
         return out
+
+    @property
+    def shared_springs(self) -> tuple:
+        """Each axle's anti-roll bar (the joints whose turn twists it, its stiffness in
+        N·m/deg, its torque's name: ``arb_front``), as an axle's (AxleModel.shared_springs):
+        the loads' statics share each axle's wheel loads between its springs and its bar."""
+        out = []
+        for end, elements in self.axle_elements.items():
+            bar = elements.bar
+            if bar.kind == "none":
+                continue
+            if bar.kind == "u_bar":
+                joints = tuple(f"{c}_arb_arm_pivot" for c in bar.labels)
+            else:
+                joints = (f"{end}_t_bar_pivot_b",)
+            out.append((joints, bar.axle.anti_roll_stiffness, f"arb_{end}"))
+        return tuple(out)
 
     def design_steer(self, label: str) -> float:
         """A corner's steer angle at design (deg, + turning left), as its axle's

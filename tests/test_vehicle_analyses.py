@@ -1,0 +1,318 @@
+"""Loads, setup and hardpoint sensitivities on a vehicle (docs/vehicle.md): per corner,
+each written back into, or named by, its axle's file.
+
+Checked against computations of their own:
+
+- loads: each corner's member forces at a vehicle step against its axle's own loads
+  (that axle file's AxleModel, a different model, solved at the same chassis-frame
+  wheel-centre heights and rack under the same case) and, on a car without bars,
+  against each corner's own (a Corner); a steady acceleration's case against the
+  attitude: on a car without bars each spring's force at the attitude's equilibrium
+  is the force its length gives there (preload + rate · compression), and on every
+  car the body's heave force is the sprung mass's weight and inertia along the
+  chassis's z (scipy's rotations), its pitch and roll torques nought under pure
+  braking.
+"""
+
+from __future__ import annotations
+
+import copy
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from scipy.spatial.transform import Rotation
+
+import pin_susp
+from pin_susp.analyses.attitude import Attitude
+from pin_susp.analyses.load_case import (
+    AccelerationCase,
+    AxleLoadCase,
+    CornersLoadCase,
+    LoadCase,
+    load_cases,
+)
+from pin_susp.analyses.loads import member_forces
+from pin_susp.cli import main
+from pin_susp.errors import InputError
+from pin_susp.io.yamlio import load_yaml
+from pin_susp.model.sweep import Sweep, Target
+from pin_susp.subjects.axle import AxleModel
+from pin_susp.subjects.vehicle import AXLES, LABELS, Vehicle
+
+EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+FS = EXAMPLES / "vehicle_fs.yaml"
+G = 9.80665
+SIDE = {"fl": "left", "fr": "right", "rl": "left", "rr": "right"}
+BAR_POINTS = ("droplink_rocker", "droplink_u_bar")
+
+
+def body_sweep(heave, pitch, roll, steer=0.0, roads=None) -> Sweep:
+    n = max(len(np.atleast_1d(v)) for v in (heave, pitch, roll, steer, *(roads or {}).values()))
+    full = lambda v: np.broadcast_to(np.asarray(v, dtype=float), (n,)).copy()  # noqa: E731
+    targets = [
+        Target(None, None, full(heave), quantity="heave"),
+        Target(None, None, full(pitch), quantity="pitch"),
+        Target(None, None, full(roll), quantity="roll"),
+        Target(None, None, full(steer), quantity="steering_wheel"),
+    ]
+    for label, z in (roads or {}).items():
+        targets.append(Target(None, None, full(z), side=label, quantity="road_z"))
+    return Sweep(targets, "<test>")
+
+
+def axle_data(end: str) -> dict:
+    return copy.deepcopy(load_yaml(EXAMPLES / "vehicle" / f"fs_{end}.yaml")[0])
+
+
+def without_bars(tmp_path: Path) -> Path:
+    """The example car with no anti-roll bars, its files written under tmp_path."""
+    data = copy.deepcopy(load_yaml(FS)[0])
+    for end in AXLES:
+        axle = axle_data(end)
+        axle["axle_config"]["anti_roll"] = {"type": "none"}
+        for name in BAR_POINTS:
+            del axle["hardpoints"]["left"][name]
+        del axle["hardpoints"]["center"]
+        (tmp_path / f"{end}.yaml").write_text(yaml.safe_dump(axle))
+        data[end] = f"{end}.yaml"
+    path = tmp_path / "car.yaml"
+    path.write_text(yaml.safe_dump(data))
+    return path
+
+
+@pytest.fixture(scope="module")
+def fs():
+    return Vehicle(FS)
+
+
+@pytest.fixture(scope="module")
+def bare(tmp_path_factory):
+    return Vehicle(without_bars(tmp_path_factory.mktemp("bare")))
+
+
+def random_case(seed: int) -> CornersLoadCase:
+    """Loads on every wheel at once: a force at the contact patch and at the wheel
+    centre and a moment, each its own."""
+    rng = np.random.default_rng(seed)
+    wheels = {
+        label: LoadCase(
+            "mixed",
+            rng.normal(0.0, 700.0, 3) + [0.0, 0.0, 1500.0],
+            rng.normal(0.0, 150.0, 3),
+            rng.normal(0.0, 40.0, 3),
+        )
+        for label in LABELS
+    }
+    return CornersLoadCase("mixed", wheels)
+
+
+SWEEP = body_sweep(np.linspace(-8, 8, 5), 0.6, np.linspace(-1.5, 1.5, 5), 20.0, {"rr": 3.0})
+FORCES = ("force_", "load_", "torque_")
+
+
+def forces_of(columns) -> list[str]:
+    return [n for n in columns if n.startswith(FORCES) and n != "load_case"]
+
+
+# ---------------------------------------------------------------- loads
+
+
+def test_each_corners_forces_are_its_axles_own(fs):
+    """Every member, joint and bar of each corner under a case on all four wheels at
+    once, rolled, pitched, steered and warped, equals its axle's own loads (that axle
+    file's model) at the same chassis-frame wheel heights and rack, to 1e-6 N."""
+    case = random_case(1)
+    forces = member_forces(fs, SWEEP, [case])
+    assert forces["solver_converged"].all()
+    compared = 0
+    for end, (first, second) in AXLES.items():
+        model = AxleModel(getattr(fs.vehicle, end))
+        targets = [
+            Target("wheel_center", "z", forces[f"{label}_wheel_center_z"], "absolute", side=side)
+            for label, side in ((first, "left"), (second, "right"))
+        ]
+        if model.model.existJointName("rack_slide"):
+            rack = forces[f"{first}_trackrod_inboard_y"]
+            targets.append(Target("trackrod_inboard", "y", rack, "absolute", side="left"))
+        own = member_forces(
+            model, Sweep(targets, "<own>"), [AxleLoadCase("mixed", case.wheel(first),
+                                                            case.wheel(second))]
+        )  # fmt: skip
+        assert own["solver_converged"].all()
+        for name in forces_of(own.columns):
+            if name == "torque_arb":
+                mine = f"torque_arb_{end}"
+            elif name == "force_rack":
+                mine = name
+            else:
+                stem, side = name.rsplit("_", 1)
+                label = first if side == "left" else second
+                mine = f"{stem.replace('load_arb_', f'load_{end}_arb_')}_{label}"
+            np.testing.assert_allclose(
+                forces[mine], own[name], rtol=0, atol=1e-6, err_msg=f"{mine} / {name}"
+            )
+            compared += 1
+        assert np.abs(own["torque_arb"]).max() > 1.0  # the bar takes its share
+    assert compared > 150
+
+
+def test_without_bars_each_corner_is_a_corner_of_its_own(bare):
+    """On a car without anti-roll bars each corner's forces are its own corner's (a
+    Corner of its Geometry, solved at the same chassis-frame wheel-centre height and
+    rack); the rear, on toe links, its toe link's."""
+    case = random_case(2)
+    forces = member_forces(bare, SWEEP, [case])
+    for label in LABELS:
+        g = bare.vehicle.corner(label)
+        corner = pin_susp.Corner(g, warn=False)
+        targets = [Target("wheel_center", "z", forces[f"{label}_wheel_center_z"], "absolute")]
+        if g.steering == "rack":
+            rack = forces[f"{label}_trackrod_inboard_y"]
+            targets.append(Target("trackrod_inboard", "y", rack, "absolute"))
+        own = member_forces(corner, Sweep(targets, "<own>"), [case.wheel(label)])
+        names = [n for n in forces_of(own.columns) if n != "force_rack"]
+        assert "force_spring" in names and len(names) > 30
+        for name in names:
+            np.testing.assert_allclose(
+                forces[f"{name}_{label}"], own[name], rtol=0, atol=1e-6, err_msg=name
+            )
+
+
+def attitude_sweep(car, s: dict, i: int) -> Sweep:
+    """The attitude's equilibrium ``i`` as a one-step sweep: its heave, pitch, roll and
+    each contact patch's road height (the rack held at design, as the attitude's)."""
+    u = s["u"][i]
+    targets = [
+        Target(None, None, [u[0] * 1e3], quantity="heave"),
+        Target(None, None, [np.degrees(u[1])], quantity="pitch"),
+        Target(None, None, [np.degrees(u[2])], quantity="roll"),
+    ]
+    targets += [
+        Target(None, None, [u[3 + k] * 1e3], side=c, quantity="road_z")
+        for k, c in enumerate(car.labels)
+    ]
+    return Sweep(targets, "<attitude>")
+
+
+STEADY = [(0.0, 1.2), (-1.2, 0.0), (0.6, 0.9), (-0.8, -1.0)]  # g: ax, ay
+
+
+def chassis_z(pitch_deg, roll_deg) -> np.ndarray:
+    """The chassis's z axis in the road's frame (scipy: pitch about y, then roll)."""
+    return Rotation.from_euler("YX", np.radians([pitch_deg, roll_deg])).apply([0.0, 0.0, 1.0])
+
+
+def test_the_springs_hold_the_attitudes_accelerations_on_a_car_without_bars(bare):
+    """A case {ax, ay} at the attitude's own equilibrium: with no bar each corner's
+    spring alone holds its wheel, so its force must be the one its length gives there,
+    the attitude's preload + rate · (design length − length), to 1e-6 N. The body's
+    heave force is the sprung mass's weight and inertia, m·g·(ax, ay, 1), along the
+    chassis's z."""
+    att = Attitude(bare)
+    ax, ay = np.array(STEADY).T
+    s = att.equilibria(ax, ay)
+    assert s["converged"].all()
+    sprung = bare.vehicle.masses["sprung"]
+    for i, (x, y) in enumerate(STEADY):
+        f = member_forces(bare, attitude_sweep(bare, s, i), [AccelerationCase("a", x, y)])
+        for k, c in enumerate(bare.labels):
+            ends = [
+                np.array([f[f"{c}_strut_{e}_{a}"][0] for a in "xyz"]) for e in ("top", "bottom")
+            ]
+            length = np.linalg.norm(ends[0] - ends[1]) * 1e-3
+            spring = att.preload[k] + att.k[k] * (att.length0[k] - length)
+            assert f[f"force_spring_{c}"][0] == pytest.approx(spring, abs=1e-6), (x, y, c)
+            assert abs(spring - att.preload[k]) > 20.0 or (x, y) == (0.0, 0.0)
+        weight = sprung * G * np.array([x, y, 1.0]) @ chassis_z(f["pitch"][0], f["roll"][0])
+        assert f["force_body_heave"][0] == pytest.approx(weight, abs=1e-6)
+
+
+def test_a_steady_acceleration_balances_the_body(fs):
+    """On the example car (bars front and rear): at every step of a roll sweep the
+    body's heave force under {ax, ay} is the sprung mass's m·g·(ax, ay, 1) along the
+    chassis's z (the tyres' forces add up to the car's m·a, the unsprung masses take
+    their own); under pure braking at its equilibrium (outboard brakes) the wheels put
+    no pitch or roll torque on the body about its CG."""
+    cases = [AccelerationCase(f"{x} {y}", x, y) for x, y in STEADY]
+    roll = body_sweep(5.0, 0.4, np.linspace(-2.0, 2.0, 5))
+    f = member_forces(fs, roll, cases)
+    sprung = fs.vehicle.masses["sprung"]
+    for x, y in STEADY:
+        rows = f["load_case"] == f"{x} {y}"
+        z = np.array([chassis_z(p, r) for p, r in zip(f["pitch"][rows], f["roll"][rows],
+                                                        strict=True)])  # fmt: skip
+        expected = sprung * G * z @ np.array([x, y, 1.0])
+        np.testing.assert_allclose(f["force_body_heave"][rows], expected, rtol=0, atol=1e-6)
+    att = Attitude(fs)
+    s = att.equilibria(np.array([-1.2]), np.array([0.0]))
+    braked = member_forces(fs, attitude_sweep(fs, s, 0), [AccelerationCase("brake", -1.2, 0)])
+    assert abs(braked["pitch"][0]) > 0.5  # it dives
+    for name in ("torque_body_pitch", "torque_body_roll"):
+        assert abs(braked[name][0]) < 1e-6, name
+    assert braked["force_spring_fl"][0] > 1.3 * braked["force_spring_rl"][0]  # weight forward
+
+
+def test_a_vehicles_load_cases_name_its_corners(tmp_path):
+    path = tmp_path / "cases.yaml"
+    labels = LABELS
+    path.write_text(
+        "cases:\n  - {name: bump, fl: {contact_patch: {fx: 0, fy: 0, fz: 2000}}}\n"
+        "  - {name: turn, ay: 1.2}\n"
+    )
+    bump, turn = load_cases(path, labels=labels, accelerations=True)
+    assert list(bump.wheel("fl").contact_patch) == [0.0, 0.0, 2000.0]
+    assert not bump.wheel("rr").contact_patch.any()
+    assert (turn.ax, turn.ay) == (0.0, 1.2)
+    for text, key, words in [
+        ("cases: [{name: a, ax: 1}]", "cases[0].ax", "unknown key"),  # not on the road
+        ("cases: [{name: a, left: {}}]", "cases[0].left", "known keys here: ax, ay,"),
+        ("cases: [{name: a, contact_patch: {fx: 0, fy: 0, fz: 1}}]", "cases[0].contact_patch",
+         "fl:, fr:, rl: and rr: blocks"),
+        ("cases: [{name: a}]", "cases[0]", "fl:, fr:, rl: or rr: block"),
+        ("cases: [{name: a, ax: 1, fl: {}}]", "cases[0].fl", "not both"),
+        ("cases: [{name: a, ay: 40}]", "cases[0].ay", "beyond 10 g"),
+    ]:  # fmt: skip
+        path.write_text(text)
+        with pytest.raises(InputError) as info:
+            load_cases(path, labels=labels, accelerations=key != "cases[0].ax")
+        assert info.value.key == key and words in info.value.problem, text
+    with pytest.raises(InputError) as info:  # an axle's cases take no acceleration
+        path.write_text("cases: [{name: a, ax: 1}]")
+        load_cases(path, axle=True)
+    assert info.value.key == "cases[0].ax"
+
+
+def test_loads_of_a_vehicle_through_the_cli(tmp_path, capsys):
+    """`pin-susp loads VEHICLE SWEEP --cases`: a row per step and case, every corner's
+    forces and the body's; the summary leaves out what a case does not load."""
+    out = tmp_path / "forces.csv"
+    cases = EXAMPLES / "vehicle_loads.yaml"
+    argv = ["loads", str(FS), str(EXAMPLES / "vehicle_roll.yaml"), "--cases", str(cases)]
+    assert main([*argv, "-o", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert printed.startswith(f"wrote {out}: 21 steps x 5 load cases\n")
+    lines = [line for line in out.read_text().splitlines() if not line.startswith("#")]
+    header = lines[0].split(",")
+    for name in ("force_spring_fl", "force_toe_link_rr", "torque_arb_front", "force_body_heave",
+                 "load_lower_ball_joint_z_rl", "camber_fl"):  # fmt: skip
+        assert name in header, name
+    assert len(lines) == 1 + 21 * 5
+    bump = [line for line in printed.splitlines() if "3g bump fl" in line]
+    assert any(line.split()[0] == "force_spring_fl" for line in bump)
+    assert not any(line.split()[0].endswith(("_rl", "_rr")) for line in bump)
+    # a steady acceleration needs the attitude's inputs; --plot is not built for a car
+    data = copy.deepcopy(load_yaml(FS)[0])
+    del data["vehicle_config"]["masses"]
+    data["front"], data["rear"] = (str(EXAMPLES / "vehicle" / f"fs_{e}.yaml") for e in AXLES)
+    car = tmp_path / "car.yaml"
+    car.write_text(yaml.safe_dump(data))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert main(["loads", str(car), *argv[2:], "-o", str(out)]) == 2
+    assert "masses" in capsys.readouterr().err
+    assert main([*argv, "-o", str(out), "--plot", str(tmp_path / "f.png")]) == 2
+    assert "report is not built yet" in capsys.readouterr().err
+    assert not (tmp_path / "f.png").exists()
