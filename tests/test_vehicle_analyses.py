@@ -316,3 +316,164 @@ def test_loads_of_a_vehicle_through_the_cli(tmp_path, capsys):
     assert main([*argv, "-o", str(out), "--plot", str(tmp_path / "f.png")]) == 2
     assert "report is not built yet" in capsys.readouterr().err
     assert not (tmp_path / "f.png").exists()
+
+
+# ---------------------------------------------------------------- setup
+
+
+def with_own_right(tmp_path: Path, inline: bool = False) -> Path:
+    """The example car with its front axle's right corner drawn on its own (the left
+    mirrored) and each front corner given its own setup; the rear as it is (mirrored,
+    a left_setup of its own). ``inline``: the front axle inside the vehicle file."""
+    data = copy.deepcopy(load_yaml(FS)[0])
+    front = axle_data("front")
+    left = front["hardpoints"]["left"]
+    front["hardpoints"]["right"] = {k: {**p, "y": -p["y"]} for k, p in left.items()}
+    front["axle_config"]["left_setup"] = {"pushrod_length_delta": 1.5}
+    front["axle_config"]["right_setup"] = {"trackrod_length_delta": 0.4}
+    rear = axle_data("rear")
+    rear["axle_config"]["left_setup"] = {"trackrod_length_delta": -0.3}
+    (tmp_path / "rear.yaml").write_text(yaml.safe_dump(rear))
+    data["rear"] = "rear.yaml"
+    if inline:
+        data["front"] = front
+    else:
+        (tmp_path / "front.yaml").write_text(yaml.safe_dump(front))
+        data["front"] = "front.yaml"
+    path = tmp_path / ("inline.yaml" if inline else "car.yaml")
+    path.write_text(yaml.safe_dump(data))
+    return path
+
+
+def axle_static(path) -> dict:
+    """An axle file re-loaded and solved at its design state (each wheel centre and the
+    rack held where they are): its columns."""
+    from pin_susp.subjects.axle import load_axle
+
+    model = AxleModel(load_axle(path))
+    targets = [
+        Target("wheel_center", "z", [0.0], "relative", side=side) for side in ("left", "right")
+    ]
+    if model.model.existJointName("rack_slide"):
+        targets.append(Target("trackrod_inboard", "y", [0.0], "relative", side="left"))
+    results = model.run_sweep(Sweep(targets, "<design>"))
+    assert results["solver_converged"].all()
+    return results
+
+
+def test_each_corners_setup_sheet_is_its_axles_own(tmp_path):
+    """The vehicle's sheet per corner (as set, then each listed value, with the exact
+    sensitivities) equals that corner's axle's own sheet for its side; each axle's
+    static columns (track, roll centre) equal that axle's own in every row."""
+    from pin_susp.analyses.setup import axle_setup_sheet, static_state, subject_setup_sheet
+    from pin_susp.subjects.axle import load_axle
+    from pin_susp.subjects.subject import load_drawn
+
+    path = with_own_right(tmp_path)
+    car = load_drawn(path)
+    lists = ([], [-1.0, 0.5], [2.0])
+    sheets = subject_setup_sheet(car, *lists)
+    for end, (first, second) in AXLES.items():
+        axle_path = tmp_path / f"{end}.yaml"
+        own = axle_setup_sheet(load_axle(axle_path), *lists)
+        for label, side in ((first, "left"), (second, "right")):
+            assert len(sheets[label]) == len(own[side]) == 4
+            for got, want in zip(sheets[label], own[side], strict=True):
+                np.testing.assert_array_equal(got.setup, want.setup)
+                for name, value in want.metrics.items():
+                    assert got.metrics[name] == value, (label, name)
+                    np.testing.assert_array_equal(got.derivatives[name], want.derivatives[name])
+        axle = load_drawn(axle_path)
+        for i in range(4):
+            mine = static_state(car, {c: sheets[c][i] for c in LABELS})
+            theirs = static_state(axle, {s: own[s][i] for s in ("left", "right")})
+            for name in ("track", "roll_center_y", "roll_center_z"):
+                assert mine[f"{name}_{end}"] == pytest.approx(theirs[name], abs=1e-9)
+    # the setups the files give: the front's each its own, the rear's mirrored
+    assert sheets["fl"][0].setup[2] == pytest.approx(1.5) and sheets["fr"][0].setup[1] == 0.4
+    assert sheets["rl"][0].setup[1] == sheets["rr"][0].setup[1] == pytest.approx(-0.3)
+    assert sheets["fl"][1].metrics["roadwheel_angle"] != sheets["fl"][2].metrics["roadwheel_angle"]
+
+
+def test_a_solved_setup_is_written_into_its_axles_file(tmp_path, capsys):
+    """--side fr --toe 0.2 --ride-height-change 2: the fr corner's own trackrod and
+    pushrod, written into the front axle's right_setup in an axle file beside the
+    vehicle file (which names it; the rear still the file it was); the front axle
+    re-loaded from it and solved has the fr corner at its targets, the fl one as it
+    was. --side rear sets both rear corners (a mirrored axle: its left_setup)."""
+    path = with_own_right(tmp_path)
+    out = tmp_path / "out" / "set.yaml"
+    out.parent.mkdir()
+    argv = ["setup", str(path), "--side", "fr", "--toe", "0.2", "--ride-height-change", "2"]
+    assert main([*argv, "-o", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert f"  fl corner ({tmp_path / 'front.yaml'}: axle_config.left_setup; not set: " in printed
+    assert f"  fr corner ({tmp_path / 'front.yaml'}: axle_config.right_setup):" in printed
+    assert f"wrote {out}\nwrote {out.parent / 'set_front.yaml'}\n" in printed
+    written = yaml.safe_load(out.read_text())
+    assert written["front"] == "set_front.yaml" and written["rear"] == "../rear.yaml"
+    front = yaml.safe_load((out.parent / "set_front.yaml").read_text())
+    given = yaml.safe_load((tmp_path / "front.yaml").read_text())["axle_config"]
+    assert front["axle_config"]["left_setup"] == given["left_setup"]
+    assert set(front["axle_config"]["right_setup"]) == {"trackrod_length_delta",
+                                                        "pushrod_length_delta"}  # fmt: skip
+    before, after = axle_static(tmp_path / "front.yaml"), axle_static(out.parent / "set_front.yaml")
+    assert after["roadwheel_angle_right"][0] == pytest.approx(0.2, abs=1e-9)
+    for name in ("camber_left", "roadwheel_angle_left", "left_contact_patch_center_z"):
+        assert after[name][0] == pytest.approx(before[name][0], abs=1e-12), name
+    # ride height: the right contact patch 2 mm lower than drawn (no setup at all)
+    drawn = copy.deepcopy(front)
+    del drawn["axle_config"]["left_setup"], drawn["axle_config"]["right_setup"]
+    (tmp_path / "drawn.yaml").write_text(yaml.safe_dump(drawn))
+    rise = axle_static(tmp_path / "drawn.yaml")["right_contact_patch_center_z"][0]
+    assert rise - after["right_contact_patch_center_z"][0] == pytest.approx(2.0, abs=1e-9)
+    Vehicle(out)  # the written car reads
+    # one axle of a vehicle: both its corners, a mirrored axle's left_setup
+    argv = ["setup", str(path), "--side", "rear", "--toe", "-0.1"]
+    assert main([*argv, "-o", str(tmp_path / "rear_set.yaml")]) == 0
+    rear = yaml.safe_load((tmp_path / "rear_set_rear.yaml").read_text())["axle_config"]
+    assert "right_setup" not in rear
+    after = axle_static(tmp_path / "rear_set_rear.yaml")
+    for side in ("left", "right"):
+        assert after[f"roadwheel_angle_{side}"][0] == pytest.approx(-0.1, abs=1e-9)
+    assert yaml.safe_load((tmp_path / "rear_set.yaml").read_text())["front"] == "front.yaml"
+
+
+def test_an_inline_axles_setup_is_the_vehicle_files(tmp_path, capsys):
+    """An axle inside the vehicle file: its corners' setup named and written there,
+    under front.axle_config; its errors too."""
+    path = with_own_right(tmp_path, inline=True)
+    out = tmp_path / "set.yaml"
+    assert main(["setup", str(path), "--side", "fl", "--toe", "0.15", "-o", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert f"  fl corner ({path}: front.axle_config.left_setup):" in printed
+    assert f"wrote {out}\n" in printed and not (tmp_path / "set_front.yaml").exists()
+    written = yaml.safe_load(out.read_text())
+    assert written["front"]["axle_config"]["right_setup"] == {"trackrod_length_delta": 0.4}
+    assert "trackrod_length_delta" in written["front"]["axle_config"]["left_setup"]
+    (tmp_path / "front_set.yaml").write_text(yaml.safe_dump(written["front"]))
+    assert axle_static(tmp_path / "front_set.yaml")["roadwheel_angle_left"][0] == pytest.approx(
+        0.15, abs=1e-9
+    )
+    assert main(["setup", str(path), "--camber", "-2"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"pin-susp: error: {path}: front.axle_config.left_setup.camber_shim: "
+                          "fl corner: a camber target needs a camber shim")  # fmt: skip
+
+
+def test_bad_vehicle_setup_input_names_the_axle_file(capsys, tmp_path):
+    """A mirrored axle's corner alone is refused, naming that axle's file; a side no
+    vehicle has; a corner's setup error names its axle file and key."""
+    front = EXAMPLES / "vehicle" / "fs_front.yaml"
+    assert main(["setup", str(FS), "--side", "fr", "--toe", "0"]) == 2
+    err = capsys.readouterr().err
+    assert f"the front axle ({front}) is mirrored" in err and "give --side front" in err
+    assert main(["setup", str(FS), "--side", "left"]) == 2
+    assert "unknown side 'left' (a vehicle's corner, fl, fr, rl or rr" in capsys.readouterr().err
+    assert main(["setup", str(FS), "--camber", "-2"]) == 2
+    err = capsys.readouterr().err
+    assert f"{front}: axle_config.left_setup.camber_shim: fl corner: " in err
+    out = tmp_path / "x.yaml"
+    assert main(["setup", str(FS), "--toe", "0.1", "-o", str(EXAMPLES / "vehicle" / "fs")]) == 2
+    assert "would be written over an input" in capsys.readouterr().err
+    assert not out.exists()

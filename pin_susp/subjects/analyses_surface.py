@@ -61,10 +61,36 @@ class AnalysesSurface:
         key = self.file_key(label, exc.key) if exc.source == self.source else exc.key
         return InputError(exc.source, key, f"{label} corner: {exc.problem}")
 
+    # what a setup sheet is per where the subject has labelled corners (an axle's sides)
+    setup_unit: str = "side"
+
+    def setup_place(self, label: str) -> str:
+        """Where a labelled corner's setup is, as its setup sheet says: its file's key."""
+        return self.file_key(label, "config.setup")
+
     def setup_data(self, geometries: dict) -> dict:
         """The subject's file data with each given corner's setup (label → Geometry)
         written in."""
         raise NotImplementedError
+
+    def setup_files(self, geometries: dict, path) -> list[tuple]:
+        """The files a solved setup writes, (path, data): the subject's file at ``path``
+        (``setup_data``; a vehicle's axle files beside it too)."""
+        return [(path, self.setup_data(geometries))]
+
+    # the heading of its own static columns in a setup sheet (``static_columns``)
+    static_heading: str = "axle (both sides as set in each row)"
+
+    def static_results(self, corners: dict) -> dict[str, float]:
+        """Its own static columns (``static_columns``, mm) with its corners as given
+        (label → Geometry with its setup values): the subject at its design state."""
+        from ..model.sweep import Sweep
+        from ..solve.solver import Solution
+
+        model = self.with_corners(corners)
+        solution = Solution(model.q_design, True, 0, 0.0)
+        results = model.sweep_results(Sweep([], "<static state>"), [solution])
+        return {name: float(results[name][0]) for name, _ in self.static_columns}
 
     # -- drawings (drawing.py, pin-susp draw) ----------------------------------------
 

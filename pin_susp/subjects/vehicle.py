@@ -33,12 +33,12 @@ from ..model.geometry import contact_patch, summary_repr
 from ..model.mechanisms import xml_name
 from ..solve.bulk import Frames, rows_of, solve_all, tree_of
 from ..solve.linkage import RACK_HELD, Linkage
-from .assembly import Assembly
 from .axle_file import AxleGeometry
 from .corner import Results
 from .elements import elements_of, rack
 from .elements.body import JOINTS, BodyOnRoad
 from .elements.car_axle import AxleOfCar
+from .vehicle_analyses import VehicleAssembly
 from .vehicle_columns import vehicle_columns
 from .vehicle_file import (  # noqa: F401 (the vehicle file's names, importable from here)
     AXLES,
@@ -89,7 +89,7 @@ class AxleElements:
         return out | self.bar.rate_columns(model, points)
 
 
-class Vehicle(Assembly):
+class Vehicle(VehicleAssembly):
     """Four corners under one sprung body on the road, one Pinocchio model
     (docs/vehicle.md): ``Vehicle("examples/vehicle_fs.yaml")`` or a VehicleGeometry.
 
@@ -104,7 +104,8 @@ class Vehicle(Assembly):
 
     labels = LABELS
     noun = "vehicle"
-    commands = ("sweep", "attitude", "loads")  # the rest of docs/vehicle.md's "Not built yet"
+    # the commands that take it (the rest: docs/vehicle.md, "Not built yet")
+    commands = ("sweep", "attitude", "loads", "setup")
     reports = False
     on_road = True
     summary_columns = tuple(
@@ -372,23 +373,6 @@ class Vehicle(Assembly):
 
             out.append((bar.axle.anti_roll_stiffness * 180.0 / np.pi, twist))
         return out
-
-    @property
-    def shared_springs(self) -> tuple:
-        """Each axle's anti-roll bar (the joints whose turn twists it, its stiffness in
-        N·m/deg, its torque's name: ``arb_front``), as an axle's (AxleModel.shared_springs):
-        the loads' statics share each axle's wheel loads between its springs and its bar."""
-        out = []
-        for end, elements in self.axle_elements.items():
-            bar = elements.bar
-            if bar.kind == "none":
-                continue
-            if bar.kind == "u_bar":
-                joints = tuple(f"{c}_arb_arm_pivot" for c in bar.labels)
-            else:
-                joints = (f"{end}_t_bar_pivot_b",)
-            out.append((joints, bar.axle.anti_roll_stiffness, f"arb_{end}"))
-        return tuple(out)
 
     def design_steer(self, label: str) -> float:
         """A corner's steer angle at design (deg, + turning left), as its axle's
