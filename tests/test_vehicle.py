@@ -225,7 +225,10 @@ def test_cli_sweep_writes_the_car(tmp_path):
     header = next(line for line in out.read_text().splitlines() if not line.startswith("#"))
     for column in ("camber_fl", "camber_to_ground_rr", "deriv_camber_wrt_roll_fl", "roll"):
         assert column in header.split(",")
-    for refused in (["urdf", str(FS), "-o", str(tmp_path / "car.urdf")], ["mjcf", str(FS)]):
+    for refused in (
+        ["urdf", str(FS), "-o", str(tmp_path / "car.urdf")],
+        ["mjcf", str(FS), "-o", str(tmp_path / "car.xml")],
+    ):
         run = subprocess.run(
             [sys.executable, "-m", "pin_susp", *refused],
             capture_output=True,

@@ -477,3 +477,181 @@ def test_bad_vehicle_setup_input_names_the_axle_file(capsys, tmp_path):
     assert main(["setup", str(FS), "--toe", "0.1", "-o", str(EXAMPLES / "vehicle" / "fs")]) == 2
     assert "would be written over an input" in capsys.readouterr().err
     assert not out.exists()
+
+
+# ---------------------------------------------------------------- sensitivities
+
+# Central differences of re-solved vehicles, h = 0.01 mm (the axle's, test_axle_setup.py:
+# truncation below 1e-8, each re-solve's residual under 1e-9 mm); tolerance 1e-6
+# (relative) + 1e-7 (absolute, per mm).
+H = 0.01
+STEP = dict(heave=6.0, pitch=0.5, roll=1.5, steer=20.0, roads={"rr": 3.0})  # one step
+
+
+def car_files(tmp_path: Path, right: bool = False) -> dict:
+    """The example car's vehicle and axle files as dicts (``right``: each axle's right
+    corner drawn on its own, the left mirrored)."""
+    data = {"car": copy.deepcopy(load_yaml(FS)[0])}
+    for end in AXLES:
+        axle = axle_data(end)
+        if right:
+            left = axle["hardpoints"]["left"]
+            axle["hardpoints"]["right"] = {k: {**p, "y": -p["y"]} for k, p in left.items()}
+        data[end] = axle
+    return data
+
+
+def build(tmp_path: Path, files: dict, name: str = "car") -> Vehicle:
+    folder = tmp_path / name
+    folder.mkdir(exist_ok=True)
+    car = copy.deepcopy(files["car"])
+    for end in AXLES:
+        (folder / f"{end}.yaml").write_text(yaml.safe_dump(files[end]))
+        car[end] = f"{end}.yaml"
+    (folder / "car.yaml").write_text(yaml.safe_dump(car))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return Vehicle(folder / "car.yaml")
+
+
+def held(car: Vehicle, travel: dict, steer: float):
+    """The car's columns with each corner's chassis-frame wheel travel and the rack as
+    given — what the sensitivities hold: the body at zero (its chassis frame the
+    road's), each road height found so that its wheel centre is where it is wanted."""
+    road = dict(travel)
+    design = {c: car.design_positions[f"{c}_wheel_center"][2] * 1e3 for c in LABELS}
+    slope = dict.fromkeys(LABELS, 1.0)
+    last = None
+    for _ in range(12):
+        sweep = body_sweep(0.0, 0.0, 0.0, steer, road)
+        (solution,) = car.solve_steps(sweep)
+        assert solution.converged
+        at = car.positions(solution.q)
+        got = {c: at[f"{c}_wheel_center"][2] * 1e3 - design[c] for c in LABELS}
+        miss = {c: travel[c] - got[c] for c in LABELS}
+        if max(abs(m) for m in miss.values()) < 1e-11:
+            break
+        if last is not None:  # the secant's slope per corner
+            for c in LABELS:
+                if abs(road[c] - last[0][c]) > 1e-14:
+                    slope[c] = (got[c] - last[1][c]) / (road[c] - last[0][c])
+        last = (dict(road), got)
+        road = {c: road[c] + miss[c] / slope[c] for c in LABELS}
+    else:
+        raise AssertionError(f"the wheel travels were not reached: {miss}")
+    return car.sweep_results(sweep, [solution])
+
+
+def moved(files: dict, end: str, side: str, point: str, axis: str, h: float, mirror: bool):
+    out = copy.deepcopy(files)
+    points = out[end]["hardpoints"]
+    points[side][point][axis] += h
+    if mirror and "right" in points:
+        points["right"][point][axis] += -h if axis == "y" else h
+    return out
+
+
+def central(tmp_path, files, end, side, point, axis, columns, travel, steer, mirror=True):
+    got = []
+    for h in (H, -H):
+        car = build(tmp_path, moved(files, end, side, point, axis, h, mirror), f"m{h}")
+        results = held(car, travel, steer)
+        got.append({c: results[c][0] for c in columns})
+    return {c: (got[0][c] - got[1][c]) / (2 * H) for c in columns}
+
+
+SENSITIVE = ("camber_fl", "roadwheel_angle_rl", "deriv_camber_wrt_hub_z_fr", "caster_rr",
+             "roll_center_z_front", "track_rear", "deriv_roll_center_z_wrt_roll_front",
+             "body_roll_rear", "pitch_center_x", "pitch_center_z", "anti_dive_front",
+             "anti_lift_rear", "anti_squat_rear", "roll_axis_height_at_cg",
+             "roll_axis_inclination")  # fmt: skip
+MIRRORED = [
+    ("front", "upper_wishbone_outboard", "z"),
+    ("front", "lower_wishbone_inboard_rear", "z"),
+    ("front", "trackrod_inboard", "z"),
+    ("rear", "lower_wishbone_inboard_front", "z"),
+    ("rear", "toe_link_outboard", "y"),
+    ("rear", "axle_outboard", "z"),
+]
+
+
+def step_and_sensitivity(car: Vehicle, one_sided: bool = False):
+    from pin_susp.analyses.sensitivity import SubjectSensitivity, subject_sensitivities
+
+    sweep = body_sweep(STEP["heave"], STEP["pitch"], STEP["roll"], STEP["steer"], STEP["roads"])
+    results = car.run_sweep(sweep)
+    (s,), _ = subject_sensitivities(SubjectSensitivity(car, one_sided), sweep)
+    travel = {c: results[f"wheel_travel_{c}"][0] for c in LABELS}
+    return results, s, travel
+
+
+def test_mirrored_sensitivities_match_central_differences_of_re_solved_cars(tmp_path):
+    """At a rolled, pitched, steered and warped step, each hardpoint moved on both
+    corners of its axle (the right mirrored): the corners', the axles' and the car's
+    columns against re-solved cars with the point moved, each wheel centre's
+    chassis-frame travel and the rack held. The held car's columns equal the step's
+    (what is held is all they depend on)."""
+    files = car_files(tmp_path)
+    car = build(tmp_path, files)
+    results, s, travel = step_and_sensitivity(car)
+    again = held(car, travel, STEP["steer"])
+    for column in SENSITIVE:
+        assert s.metrics[column] == pytest.approx(results[column][0], abs=1e-9), column
+        assert again[column][0] == pytest.approx(results[column][0], abs=1e-9), column
+    assert list(s.values)[-len(car.sensitivity_columns) :] == list(car.sensitivity_columns)
+    assert s.hardpoints[0].startswith("front_") and s.hardpoints[-1].startswith("rear_")
+    for end, point, axis in MIRRORED:
+        expected = central(tmp_path, files, end, "left", point, axis, SENSITIVE, travel,
+                           STEP["steer"])  # fmt: skip
+        row = s.hardpoints.index(f"{end}_{point}"), "xyz".index(axis)
+        for column in SENSITIVE:
+            exact = s.values[column][row]
+            assert exact == pytest.approx(expected[column], rel=1e-6, abs=1e-7), (
+                point, axis, column,
+            )  # fmt: skip
+    assert abs(s.values["pitch_center_z"][s.hardpoints.index("front_lower_wishbone_inboard_rear"),
+                                          2]) > 1.0  # fmt: skip
+
+
+def test_one_corners_sensitivities_match_central_differences(tmp_path):
+    """--one-sided on a car whose axles draw their right corners: fl_P moves the fl
+    corner's alone (the fr's columns do not move), against re-solved cars with the left
+    point moved alone."""
+    files = car_files(tmp_path, right=True)
+    car = build(tmp_path, files)
+    results, s, travel = step_and_sensitivity(car, one_sided=True)
+    assert s.hardpoints[0].startswith("fl_") and s.hardpoints[-1].startswith("rr_")
+    columns = ("camber_fl", "camber_fr", "roll_center_z_front", "pitch_center_z",
+               "anti_dive_front", "body_roll_front")  # fmt: skip
+    for end, side, point, axis in (("front", "left", "upper_wishbone_inboard_front", "z"),
+                                   ("rear", "right", "lower_wishbone_outboard", "y")):  # fmt: skip
+        expected = central(tmp_path, files, end, side, point, axis, columns, travel,
+                           STEP["steer"], mirror=False)  # fmt: skip
+        label = AXLES[end][0 if side == "left" else 1]
+        row = s.hardpoints.index(f"{label}_{point}"), "xyz".index(axis)
+        for column in columns:
+            assert s.values[column][row] == pytest.approx(expected[column], rel=1e-6, abs=1e-7), (
+                label, column,
+            )  # fmt: skip
+    row = s.hardpoints.index("fl_upper_wishbone_inboard_front"), 2
+    assert s.values["camber_fr"][row] == 0.0 and s.values["camber_fl"][row] != 0.0
+
+
+def test_vehicle_sensitivity_through_the_cli(tmp_path, capsys):
+    out = tmp_path / "sens.csv"
+    sweep = str(EXAMPLES / "vehicle_roll.yaml")
+    assert main(["sensitivity", str(FS), "--sweep", sweep, "-o", str(out), "--top", "1"]) == 0
+    printed = capsys.readouterr().out
+    assert "a mirrored move per axle: hardpoint front_P" in printed
+    for heading in ("  the front axle:", "  the rear axle:", "  the car:",
+                    "  the fl corner (columns suffixed _fl):",
+                    "  the fr corner's columns mirror the fl's (a mirrored axle)"):  # fmt: skip
+        assert heading in printed, heading
+    assert "  pitch_center_z = " in printed and "  anti_dive_front = " in printed
+    lines = out.read_text().splitlines()
+    assert any(line.startswith("# hardpoint: a mirrored move per axle") for line in lines)
+    rows = [line for line in lines if line.startswith("20,anti_squat_rear,rear_")]
+    assert len(rows) == 3 * len({r.split(",")[2] for r in rows}) > 30
+    assert main(["sensitivity", str(FS), "--points", "fl_upper_wishbone_outboard"]) == 2
+    assert "side-prefixed names" in capsys.readouterr().err
+    assert main(["sensitivity", str(FS), "--points", "toe_link_inboard", "-q"]) == 0

@@ -111,6 +111,38 @@ class AnalysesSurface:
     # corner's (an axle's track, roll centre, ...; a corner: none)
     sensitivity_columns: tuple[str, ...] = ()
 
+    # the pairs of its corners whose own columns (an axle's track, roll centre, ...) its
+    # sensitivities give, each (its left's label, its right's): an axle's one pair
+    sensitivity_pairs: tuple[tuple[str, str], ...] = ()
+    # its columns of the whole car its sensitivities give after the pairs' (a vehicle's
+    # pitch centre, anti %, roll axis; ``car_sensitivities``)
+    car_sensitivity_columns: tuple[str, ...] = ()
+
+    def sensitivity_move(self, label: str, one_sided: bool = False) -> tuple[str, bool]:
+        """How a labelled corner's hardpoint P is named among its sensitivities'
+        directions, and whether it moves mirrored (its y reversed): an axle's P moves
+        both sides' P, the right mirrored; ``one_sided``, each side's alone (left_P)."""
+        if one_sided:
+            return self.prefix(label), False
+        return "", label == "right"
+
+    def sensitivity_move_text(self, one_sided: bool = False) -> str | None:
+        """What its sensitivities' move is, as its table and CSV say it (None: an axle's
+        symmetric or one-sided move, sensitivity.py's words)."""
+        return None
+
+    def pair_column(self, pair: tuple[str, str], name: str) -> str | None:
+        """An axle's column of one pair of its corners (``track``,
+        ``camber_to_ground_left``) as its sensitivities name it (None: not given)."""
+        return name
+
+    def car_sensitivities(self, corners: dict, pairs: dict) -> dict:
+        """Its columns of the whole car (``car_sensitivity_columns``), name → (Dual over
+        the hardpoint coordinates, unit), from each corner's contact patch, wheel centre
+        and side-view instant centre (``corners``: label → name → Dual, mm) and each
+        pair's columns (``pairs``): none."""
+        return {}
+
     def corner_linkage(self, label: str):
         """The Linkage of a labelled corner alone, as set: its sensitivities' model."""
         from ..solve.linkage import Linkage

@@ -105,7 +105,7 @@ class Vehicle(VehicleAssembly):
     labels = LABELS
     noun = "vehicle"
     # the commands that take it (the rest: docs/vehicle.md, "Not built yet")
-    commands = ("sweep", "attitude", "loads", "setup")
+    commands = ("sweep", "attitude", "loads", "setup", "sensitivity")
     reports = False
     on_road = True
     summary_columns = tuple(

@@ -11,14 +11,23 @@ import os
 from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
+
 from ..errors import InputError, PinSuspError
 from .assembly import Assembly
-from .axle_file import AxleReader
+from .axle_file import AXLE_COLUMNS, AxleAssembly, AxleReader
+from .elements.car_axle import SKIPPED
 from .vehicle_file import AXLES, LABELS, axle_key, load_vehicle
 
 SIDE = {"fl": "left", "fr": "right", "rl": "left", "rr": "right"}  # its axle's side
 END = {"fl": "front", "fr": "front", "rl": "rear", "rr": "rear"}
 AXLE_STATIC = (("track", "track"), ("roll_center_y", "RC y"), ("roll_center_z", "RC z"))
+# an axle's per-side rates along its wheels' roll: a vehicle's deriv_camber_wrt_roll_fl is
+# along the body's roll on the road (vehicle.py), which its sensitivities do not hold
+ROLL_RATES = tuple(f"deriv_{m}_wrt_roll_{s}" for m in ("camber", "roadwheel_angle")
+                   for s in ("left", "right"))  # fmt: skip
+ROLL_AXIS = ("roll_axis_inclination", "roll_axis_height_at_cg")
+PITCH_CENTRE = ("pitch_center_x", "pitch_center_z")
 
 
 class VehicleAssembly(Assembly):
@@ -204,3 +213,140 @@ class VehicleAssembly(Assembly):
                 joints = (f"{end}_t_bar_pivot_b",)
             out.append((joints, bar.axle.anti_roll_stiffness, f"arb_{end}"))
         return tuple(out)
+
+    # -- hardpoint sensitivities (sensitivity.py) ---------------------------------
+
+    element_points = AxleAssembly.element_points  # its axles' bars and heave links
+    sensitivity_pairs = tuple(AXLES.values())
+
+    def sensitivity_move(self, label: str, one_sided: bool = False) -> tuple[str, bool]:
+        """A corner's hardpoint P: its axle's ``front_P`` (both corners, the right
+        mirrored), or ``one_sided`` its own ``fl_P``."""
+        if one_sided:
+            return f"{label}_", False
+        return f"{END[label]}_", SIDE[label] == "right"
+
+    def sensitivity_move_text(self, one_sided: bool = False) -> str:
+        if one_sided:
+            return "a one-sided move: fl_P, fr_P, rl_P and rr_P each move alone"
+        return (
+            "a mirrored move per axle: hardpoint front_P moves the fl P by (dx, dy, dz) and "
+            "the fr P by (dx, -dy, dz), rear_P the rl and rr P"
+        )
+
+    def pair_column(self, pair: tuple[str, str], name: str) -> str | None:
+        """An axle's column as the vehicle's sweep names it (``track_front``,
+        ``deriv_roll_center_z_wrt_roll_front``); none of what the vehicle measures on the
+        road instead (camber to ground, the rates along the body's roll)."""
+        if name in SKIPPED or name in ROLL_RATES:
+            return None
+        for side, label in zip(("left", "right"), pair, strict=True):
+            if name.endswith(f"_{side}"):
+                return name.removesuffix(side) + label
+        return f"{name}_{END[pair[0]]}"
+
+    @property
+    def car_sensitivity_columns(self) -> tuple[str, ...]:
+        """The roll axis, the pitch centre and each anti % with a share (vehicle_columns.py)."""
+        return (*ROLL_AXIS, *PITCH_CENTRE, *(name for name, *_ in self._antis()))
+
+    @property
+    def sensitivity_columns(self) -> tuple[str, ...]:
+        """Each axle's columns (``track_front``, ...), then the car's."""
+        pairs = (self.pair_column(pair, n) for pair in self.sensitivity_pairs for n in AXLE_COLUMNS)
+        return (*(n for n in pairs if n is not None), *self.car_sensitivity_columns)
+
+    def _antis(self) -> list[tuple[str, str, float, str]]:
+        """(column, end, share, reaction) of each anti % with a share (vehicle_columns.py's
+        anti_columns)."""
+        v = self.vehicle
+        cases = (
+            ("anti_dive_front", "front", v.brake_share("front"), v.brake_reaction("front")),
+            ("anti_lift_rear", "rear", v.brake_share("rear"), v.brake_reaction("rear")),
+            ("anti_squat_rear", "rear", v.drive_share("rear"), v.drive_reaction("rear")),
+            ("anti_lift_front", "front", v.drive_share("front"), v.drive_reaction("front")),
+        )
+        return [c for c in cases if c[2]]
+
+    def car_sensitivities(self, corners: dict, pairs: dict) -> dict:
+        """The whole car's columns, as vehicle_columns.py computes them from the columns
+        at a step, on Duals over the hardpoint coordinates (mm): the roll axis through
+        both axles' roll centres, the pitch centre where each axle's line from its
+        contact patch to its side-view instant centre (the mean of its two corners')
+        meets the other's, each anti % (the mean of its axle's two corners)."""
+        v = self.vehicle
+        cp = {
+            c: (p["contact_patch_center_x"], p["contact_patch_center_z"])
+            for c, p in corners.items()
+        }
+        x = {end: (cp[a][0] + cp[b][0]) * 0.5 for end, (a, b) in AXLES.items()}
+        rc = {end: pairs[labels]["roll_center_z"][0] for end, labels in AXLES.items()}
+        rise, run = rc["front"] - rc["rear"], x["front"] - x["rear"]
+        out = {
+            "roll_axis_inclination": (np.arctan2(rise, run) * (180.0 / np.pi), "deg"),
+            "roll_axis_height_at_cg": (rc["rear"] + rise * (v.cg[0] * 1e3 - x["rear"]) / run, "mm"),
+        }
+        sv = {}
+        for end, (a, b) in AXLES.items():
+            sv[end] = (
+                (corners[a]["svic_x"] + corners[b]["svic_x"]) * 0.5,
+                (corners[a]["svic_z"] + corners[b]["svic_z"]) * 0.5,
+                (cp[a][0] + cp[b][0]) * 0.5,
+                (cp[a][1] + cp[b][1]) * 0.5,
+            )
+        (xf, zf, pfx, pfz), (xr, zr, prx, prz) = sv["front"], sv["rear"]
+        df, dr = (xf - pfx, zf - pfz), (xr - prx, zr - prz)
+        cross = df[0] * dr[1] - df[1] * dr[0]
+        s = ((prx - pfx) * dr[1] - (prz - pfz) * dr[0]) / cross
+        out["pitch_center_x"] = (pfx + s * df[0], "mm")
+        out["pitch_center_z"] = (pfz + s * df[1], "mm")
+        for name, end, share, reaction in self._antis():
+            per_corner = []
+            for c in AXLES[end]:
+                p = corners[c]
+                at = p["contact_patch_center_x"], p["contact_patch_center_z"]
+                if reaction != "outboard":
+                    at = p["wheel_center_x"], p["wheel_center_z"]
+                run = p["svic_x"] - at[0]
+                if end == "front":
+                    run = -run  # the SVIC behind the front axle, ahead of the rear
+                tan = (p["svic_z"] - at[1]) / run
+                height = v.cg[2] * 1e3 - p["contact_patch_center_z"]
+                per_corner.append(tan * (100.0 * share * v.wheelbase) / height)
+            out[name] = ((per_corner[0] + per_corner[1]) * 0.5, "%")
+        return out
+
+    def held_at(self, sweep, step: int) -> None:
+        return None  # each wheel centre's chassis-frame height and the rack
+
+    def sensitivities_hold(self, sweep) -> bool:
+        return False  # its sweep holds the body and the road, not each wheel's height
+
+    def sensitivity_held(self) -> str:
+        return "each wheel centre's height in the chassis frame and the rack held (the body still)"
+
+    def sensitivity_sweep(self, sweep) -> tuple[list, object]:
+        from .corner import Results  # the solver's columns alone: what the report reads
+
+        solutions = self.solve_steps(sweep)
+        columns, units = Results.solver_columns(solutions)
+        meta = Results.solver_meta(solutions, (self.source, self.sha256), sweep, self)
+        return solutions, Results(columns, units, meta)
+
+    def sensitivity_groups(self, columns: list[str]) -> list[tuple[str, list]]:
+        """Each axle's columns, the car's, then each corner's that does not take another's
+        setup (a mirrored axle's right corner mirrors its left: said once)."""
+        own = set(self.sensitivity_columns)
+        groups = []
+        for end, pair in AXLES.items():
+            names = [self.pair_column(pair, n) for n in AXLE_COLUMNS]
+            groups.append((f"the {end} axle:", [n for n in names if n is not None]))
+        groups.append(("the car:", list(self.car_sensitivity_columns)))
+        groups += super().sensitivity_groups([n for n in columns if n not in own])
+        for label in LABELS:
+            owner = self.setup_owner(label)
+            if owner != label:
+                groups.append(
+                    (f"the {label} corner's columns mirror the {owner}'s (a mirrored axle)", ())
+                )
+        return groups
