@@ -33,9 +33,11 @@ def member_forces(corner, sweep, cases: list, solutions=None, results=None, prog
     """Every force column at every step of a sweep under every load case (docs/loads.md):
     a Results with one row per step and case — ``step_index``, ``load_case``,
     ``loads_unbounded`` (1 at a toggle: the forces there are blank, not huge), the
-    forces, then the sweep's own columns. ``corner``: a Corner, or an AxleModel (its
-    columns suffixed _left/_right, the bar's ``torque_arb``); ``sweep``: a Sweep, path
-    or dict; ``cases``: LoadCases (AxleLoadCases) or a load-case file.
+    forces, then the sweep's own columns. ``corner``: a Corner, an AxleModel (its
+    columns suffixed _left/_right, the bar's ``torque_arb``) or a Vehicle (suffixed _fl
+    …, measured in its chassis frame, the body held: docs/vehicle.md); ``sweep``: a
+    Sweep, path or dict; ``cases``: LoadCases (AxleLoadCases, CornersLoadCases, a
+    vehicle's AccelerationCases) or a load-case file.
 
     >>> forces = member_forces(corner, "examples/bump_steer.yaml", "examples/loads.yaml")
     >>> forces.to_pandas()  # a DataFrame, a row per step and case, as the CSV has it

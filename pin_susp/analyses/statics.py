@@ -1,5 +1,6 @@
-"""The statics of a corner or an axle at its solved poses: every member's and
-joint's force under every load case at once (docs/loads.md).
+"""The statics of a corner, an axle or a vehicle at its solved poses: every member's
+and joint's force under every load case at once (docs/loads.md; a vehicle's in its
+chassis frame, the body's joints held as rigid rows: docs/vehicle.md, "Loads").
 
 At a pose q the closures' Jacobian J_c, the spring's row J_s (d length/dq of a
 coilover, d angle/dq of a torsion bar) and the rack's row J_r hold every
