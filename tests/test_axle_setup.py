@@ -346,7 +346,8 @@ def test_bad_axle_setup_and_sensitivity_input_gets_one_line(tmp_path, capsys):
     cases = [
         (["setup", str(corner), "--side", "left", "-o", str(out), "--camber", "-2"],
          "--side: " + str(corner) + " is a corner"),
-        (["setup", str(axle), "--side", "front"], "argument --side: invalid choice: 'front'"),
+        (["setup", str(axle), "--side", "middle"], "argument --side: invalid choice: 'middle'"),
+        (["setup", str(axle), "--side", "front"], "--side: unknown side 'front' (left or right)"),
         (["setup", str(axle), "--side", "right", "--camber", "-2", "-o", str(out)],
          "is a mirrored axle (no hardpoints.right)"),
         (["setup", str(explicit), "--side", "right", "--camber", "-2", "-o", str(out)],

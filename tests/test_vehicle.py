@@ -244,16 +244,17 @@ def test_cli_sweep_writes_the_car(tmp_path):
     header = next(line for line in out.read_text().splitlines() if not line.startswith("#"))
     for column in ("camber_fl", "camber_to_ground_rr", "deriv_camber_wrt_roll_fl", "roll"):
         assert column in header.split(",")
-    for refused in (["setup", str(FS)],):
+    at = f"{EXAMPLES / 'vehicle_roll.yaml'}:3"
+    for refused in (["urdf", str(FS), "--at", at, "-o", str(tmp_path / "car.urdf")],):
         run = subprocess.run(
             [sys.executable, "-m", "pin_susp", *refused],
             capture_output=True,
             text=True,
             cwd=tmp_path,
         )
-        assert run.returncode == 2 and "not built yet" in run.stderr, refused
+        assert run.returncode == 2 and "not for a vehicle yet" in run.stderr, refused
         assert run.stderr.count("\n") == 1 and "Traceback" not in run.stderr
-    assert not (tmp_path / "car.png").exists()
+    assert not (tmp_path / "car.urdf").exists()
 
 
 def test_misspelt_scope_and_the_wrong_kinds_quantities_say_so(tmp_path):

@@ -1,7 +1,9 @@
 """Load-case files (docs/loads.md): the loads on each wheel, world (chassis) axes —
 a force at the contact patch, a force at the wheel centre, a moment — one case a
 row of ``pin-susp loads``' table; a corner's at each case's top, each of an axle's
-corners in a block of its label's name (``left:``, ``right:``)."""
+or a vehicle's corners in a block of its label's name (``left:``, ``right:``; ``fl:``,
+...). A subject on the road (a vehicle) also takes a steady acceleration, ``{ax, ay}``
+in g: the attitude's forces at that acceleration (docs/vehicle.md, "Loads")."""
 
 from __future__ import annotations
 
@@ -13,6 +15,8 @@ from ..io.yamlio import Reader, load_yaml
 
 CASE_KEYS = ("contact_patch", "wheel_center", "moment")
 SIDES = ("left", "right")  # an axle's corners: a block of loads each
+ACCELERATION_KEYS = ("ax", "ay")  # g: a vehicle's case as a steady acceleration
+MAX_ACCELERATION = 10.0  # g: beyond any car's steady acceleration (a unit mistake)
 
 
 @dataclass(frozen=True)
@@ -43,14 +47,49 @@ class AxleLoadCase:
         return getattr(self, label)
 
 
-def load_cases(source, axle: bool = False, labels: tuple[str, ...] | None = None) -> list:
+@dataclass(frozen=True)
+class CornersLoadCase:
+    """A load case of a subject with more labelled corners than an axle's two (a
+    vehicle's ``fl``, ``fr``, ``rl``, ``rr``): one LoadCase per wheel (a corner not
+    given: no load)."""
+
+    name: str
+    wheels: dict
+
+    def wheel(self, label: str) -> LoadCase:
+        """The loads on the wheel of the corner labelled ``label``."""
+        return self.wheels[label]
+
+
+@dataclass(frozen=True)
+class AccelerationCase:
+    """A vehicle's load case given as a steady acceleration (g, ISO 8855: ax + forward,
+    ay + left): at each step, the forces of the attitude's equilibrium at (ax, ay) on
+    each wheel (analyses/road_loads.py, docs/vehicle.md)."""
+
+    name: str
+    ax: float
+    ay: float
+
+
+def load_cases(
+    source,
+    axle: bool = False,
+    labels: tuple[str, ...] | None = None,
+    accelerations: bool = False,
+) -> list:
     """Read a load-case file (docs/loads.md): ``cases:`` a list of {name,
     contact_patch: {fx, fy, fz}, wheel_center: {…}, moment: {mx, my, mz}}. The loads
     are per corner of the subject whose ``labels`` are given (default: an axle's
     ``left``, ``right`` with ``axle``, else a corner's ``""``): a corner labelled ``""``
-    has them at the case's top, each labelled one in a block of its label's name."""
+    has them at the case's top, each labelled one in a block of its label's name.
+    ``accelerations``: a case may instead be ``{name, ax, ay}`` (g; a vehicle's, a
+    subject on the road: an AccelerationCase)."""
     labels = (SIDES if axle else ("",)) if labels is None else tuple(labels)
     blocks = tuple(label for label in labels if label)  # the corners named in the file
+    who = "an axle's" if blocks == SIDES else "a vehicle's"  # whose cases name blocks
+    listed = " and ".join(", ".join(f"{b}:" for b in blocks).rsplit(", ", 1))
+    steady = ACCELERATION_KEYS if accelerations else ()
     data, name, _ = load_yaml(source)
     r = Reader(name)
     r.mapping(data, "", required=("cases",), optional=("version",))
@@ -66,28 +105,53 @@ def load_cases(source, axle: bool = False, labels: tuple[str, ...] | None = None
             for side in SIDES:
                 if side in case:
                     r.fail(f"{key}.{side}", "a side block is for an axle's load cases")
-        r.mapping(case, key, required=("name",), optional=(*CASE_KEYS, *blocks))
+        r.mapping(case, key, required=("name",), optional=(*CASE_KEYS, *blocks, *steady))
         title = str(r.text(case["name"], f"{key}.name")).strip()
         if not title:
             r.fail(f"{key}.name", "empty: name the case")
         if title in seen:
             r.fail(f"{key}.name", f"{title!r} names two cases")
         seen.add(title)
+        if any(k in case for k in steady):
+            out.append(_acceleration(case, key, title, (*CASE_KEYS, *blocks), r))
+            continue
         if not blocks:
             out.append(_wheel_loads(case, key, title, r))
             continue
         for part in CASE_KEYS:
             if part in case:
-                r.fail(f"{key}.{part}", "an axle's loads go in left: and right: blocks")
+                r.fail(f"{key}.{part}", f"{who} loads go in {listed} blocks")
         if not any(b in case for b in blocks):
-            r.fail(key, "an axle's case needs a left: or right: block of loads")
+            either = " or ".join(", ".join(f"{b}:" for b in blocks).rsplit(", ", 1))
+            also = " (or ax and ay, g: a steady acceleration)" if steady else ""
+            r.fail(key, f"{who} case needs a {either} block of loads{also}")
         wheels = {
             b: _wheel_loads(r.mapping(case.get(b, {}), f"{key}.{b}", optional=CASE_KEYS),
                             f"{key}.{b}", str(title), r)
             for b in blocks
         }  # fmt: skip
-        out.append(AxleLoadCase(str(title), **wheels))
+        if blocks == SIDES:
+            out.append(AxleLoadCase(str(title), **wheels))
+        else:
+            out.append(CornersLoadCase(str(title), wheels))
     return out
+
+
+def _acceleration(case: dict, key: str, title: str, others: tuple, r: Reader) -> AccelerationCase:
+    """A steady acceleration's case: ax and ay (g, each 0 unless given), no wheel's loads."""
+    for part in others:
+        if part in case:
+            r.fail(
+                f"{key}.{part}",
+                "a case is either a steady acceleration (ax, ay) or loads on the wheels, not both",
+            )
+    values = []
+    for name in ACCELERATION_KEYS:
+        x = r.number(case.get(name, 0.0), f"{key}.{name}")
+        if abs(x) > MAX_ACCELERATION:
+            r.fail(f"{key}.{name}", f"{x:g} g is beyond {MAX_ACCELERATION:g} g: no car holds that")
+        values.append(float(x))
+    return AccelerationCase(title, *values)
 
 
 def _wheel_loads(case: dict, key: str, title: str, r: Reader) -> LoadCase:

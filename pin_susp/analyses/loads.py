@@ -24,6 +24,7 @@ from ..solve.rates import rate_columns as rate_columns
 from .load_case import AxleLoadCase as AxleLoadCase  # the load-case file (load_case.py)
 from .load_case import LoadCase as LoadCase
 from .load_case import load_cases
+from .road_loads import RoadLoads, has_accelerations
 from .statics import TOGGLE as TOGGLE  # the equilibrium at a pose (statics.py)
 from .statics import Statics
 
@@ -32,9 +33,11 @@ def member_forces(corner, sweep, cases: list, solutions=None, results=None, prog
     """Every force column at every step of a sweep under every load case (docs/loads.md):
     a Results with one row per step and case — ``step_index``, ``load_case``,
     ``loads_unbounded`` (1 at a toggle: the forces there are blank, not huge), the
-    forces, then the sweep's own columns. ``corner``: a Corner, or an AxleModel (its
-    columns suffixed _left/_right, the bar's ``torque_arb``); ``sweep``: a Sweep, path
-    or dict; ``cases``: LoadCases (AxleLoadCases) or a load-case file.
+    forces, then the sweep's own columns. ``corner``: a Corner, an AxleModel (its
+    columns suffixed _left/_right, the bar's ``torque_arb``) or a Vehicle (suffixed _fl
+    …, measured in its chassis frame, the body held: docs/vehicle.md); ``sweep``: a
+    Sweep, path or dict; ``cases``: LoadCases (AxleLoadCases, CornersLoadCases, a
+    vehicle's AccelerationCases) or a load-case file.
 
     >>> forces = member_forces(corner, "examples/bump_steer.yaml", "examples/loads.yaml")
     >>> forces.to_pandas()  # a DataFrame, a row per step and case, as the CSV has it
@@ -46,22 +49,26 @@ def member_forces(corner, sweep, cases: list, solutions=None, results=None, prog
     if not isinstance(sweep, Sweep):
         sweep = load_sweep(sweep)
     if not isinstance(cases, list):
-        cases = load_cases(cases, labels=corner.labels)
+        cases = load_cases(cases, labels=corner.labels, accelerations=corner.on_road)
     if not cases:
         raise PinSuspError("member_forces: no load cases given")
     statics = _STATICS.get(corner) or _STATICS.setdefault(corner, Statics(corner))
+    road = RoadLoads(corner, cases) if has_accelerations(cases) else None  # a vehicle's
     if solutions is None:
         solutions = corner.solve_steps(sweep)
     if results is None:
         results = corner.sweep_results(sweep, solutions)
     names = statics.names
-    W = statics.loads_matrix(cases)
     n, m = len(cases), len(solutions)
     values = np.full((m, len(names), n), np.nan)
     unbounded = np.full((m, n), np.nan)
     done = [i for i, solution in enumerate(solutions) if solution.converged]
-    if done:  # every converged step at once
-        at, toggles = statics.solve_poses([solutions[i].q for i in done], W)
+    if done:  # every converged step at once, where its corners are measured (a
+        # vehicle's: its chassis frame, the body held as a corner's chassis is)
+        solved = [solutions[i].q for i in done]
+        W = statics.loads_matrix(cases) if road is None else road.at(solved)
+        poses, _ = corner.measured_at(solved, [None] * len(solved))
+        at, toggles = statics.solve_poses(poses, W)
         values[done], unbounded[done] = at, toggles[:, None]
     if progress is not None:
         progress(m, m)
@@ -107,6 +114,8 @@ def _warn_dead_centre_share(subject, cases: list, columns: dict) -> None:
         cause = ", ".join(f"{t.flow} is {t.margin:.1f}° from dead centre" for t in here)
         source = subject.corners[label].source
         for k, case in enumerate(cases):
+            if not hasattr(case, "wheel"):  # a steady acceleration's: its loads per step
+                continue
             c = case.wheel(label)
             fz = abs(float(c.contact_patch[2] + c.wheel_center[2]))
             force = np.abs(np.asarray(spring[k :: len(cases)], dtype=float))

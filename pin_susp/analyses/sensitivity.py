@@ -111,17 +111,22 @@ class SubjectSensitivity:
 
     Each labelled corner is its HardpointSensitivity (the as-set corner's Linkage,
     ``Assembly.corner_linkage``); a corner's one, unlabelled, gives its columns as they
-    are. An axle's (docs/axle.md): with each wheel centre's height and the rack held,
-    the sides share nothing else, so a side's columns (suffixed ``_left``) move with
-    its own points only. The subject's own columns of its corners together
-    (``Assembly.sensitivity_columns``: an axle's track, roll centre, body roll, the
-    roll rates) are plain functions of both sides' contact patches, instant centres,
-    wheel heights and rates, run on the sides' nested Duals lifted onto the axle's
-    directions:
+    are. An axle's (docs/axle.md) or a vehicle's (docs/vehicle.md): with each wheel
+    centre's height and the rack held (a vehicle's in its chassis frame, the body
+    still), the corners share nothing else, so a corner's columns (suffixed ``_left``,
+    ``_fl``) move with its own points only. The subject's own columns of a pair of its
+    corners (``Assembly.sensitivity_pairs``: an axle's track, roll centre, body roll,
+    the roll rates, a vehicle's per axle) are plain functions of both corners' contact
+    patches, instant centres, wheel heights and rates, run on the corners' nested Duals
+    lifted onto the subject's directions; a vehicle's of the whole car
+    (``Assembly.car_sensitivities``: the pitch centre, the anti %, the roll axis)
+    follow from those. The directions (``Assembly.sensitivity_move``):
 
     - symmetric (default): one direction per corner point and axis, the left
-      point moved by (dx, dy, dz) and the right one by (dx, −dy, dz);
-    - one-sided: the left's points (``left_…``), then the right's, each alone.
+      point moved by (dx, dy, dz) and the right one by (dx, −dy, dz) (a vehicle's per
+      axle: ``front_P``, ``rear_P``);
+    - one-sided: the left's points (``left_…``), then the right's, each alone (a
+      vehicle's: ``fl_…``, …, ``rr_…``).
 
     Inside, the one driver is roll's tangent — the left hub z up, the right one
     down, equally, the rack held — so d(column)/d roll and its sensitivities
@@ -134,10 +139,10 @@ class SubjectSensitivity:
         labels = model.labels
         self.sides = {s: HardpointSensitivity(model.corner_linkage(s)) for s in labels}
         names = {s: h.hardpoints for s, h in self.sides.items()}
-        if one_sided:
-            self.hardpoints = [model.prefix(s) + n for s in labels for n in names[s]]
-        else:
-            self.hardpoints = list(dict.fromkeys(n for s in labels for n in names[s]))
+        self.moves = {s: model.sensitivity_move(s, one_sided) for s in labels}
+        self.hardpoints = list(
+            dict.fromkeys(self.moves[s][0] + n for s in labels for n in names[s])
+        )
         # lift[side] (3 subject points, 3 side points): d/d(subject coordinate) from
         # d/d(side's); None for a corner's one (its coordinates as they are)
         self.lift = {}
@@ -145,10 +150,11 @@ class SubjectSensitivity:
             if not s:
                 self.lift[s] = None
                 continue
-            flip = np.diag([1.0, -1.0 if s == "right" and not one_sided else 1.0, 1.0])
+            prefix, mirrored = self.moves[s]
+            flip = np.diag([1.0, -1.0 if mirrored else 1.0, 1.0])
             lift = np.zeros((3 * len(self.hardpoints), 3 * len(names[s])))
             for j, n in enumerate(names[s]):
-                i = self.hardpoints.index(model.prefix(s) + n if one_sided else n)
+                i = self.hardpoints.index(prefix + n)
                 lift[3 * i : 3 * i + 3, 3 * j : 3 * j + 3] = flip
             self.lift[s] = lift
         # each side's corner joints in the subject's configuration
@@ -161,6 +167,11 @@ class SubjectSensitivity:
                 for j in range(1, c.njoints)
             ]
             self.joints[s] = tuple(np.array(x) for x in zip(*pairs, strict=True))
+
+    def name_of(self, label: str, point: str) -> str:
+        """A corner's hardpoint as the subject's direction names it (``P``, ``left_P``,
+        ``front_P``, ``fl_P``)."""
+        return self.moves[label][0] + point
 
     def side_q(self, q: np.ndarray, side: str) -> np.ndarray:
         """The side's corner configuration within the subject's q."""
@@ -189,7 +200,7 @@ class SubjectSensitivity:
         own = self.model.sensitivity_columns
         if own:
             with np.errstate(invalid="ignore", divide="ignore"):
-                columns = self._axle_columns(jets)
+                columns = self._own_columns(jets)
         for name in own:
             x, unit_ = columns[name]
             metrics[name] = float(x.val[0])
@@ -197,10 +208,10 @@ class SubjectSensitivity:
             units[name] = f"{unit_}/mm"
         return Sensitivity(step, self.hardpoints, values, units, metrics)
 
-    def _lifted(self, side: str, x) -> Dual:
-        """A side's nested scalar on the axle's directions: outside, the axle's hardpoint
-        coordinates; inside, roll's tangent (this side's hub z, + left, − right)."""
-        sign = 1.0 if side == "left" else -1.0
+    def _lifted(self, side: str, x, sign: float = 1.0) -> Dual:
+        """A side's nested scalar on the subject's directions: outside, the subject's
+        hardpoint coordinates; inside, roll's tangent (this side's hub z, + ``sign``: the
+        pair's left +, its right −)."""
         lift = self.lift[side]
         return Dual(
             Dual(x.val.val, sign * x.val.der[:1]),
@@ -210,13 +221,42 @@ class SubjectSensitivity:
             ),
         )
 
-    def _axle_columns(self, jets: dict) -> dict:
-        """name → (Dual over the axle's hardpoint coordinates (per m), unit)."""
+    def _own_columns(self, jets: dict) -> dict:
+        """The subject's own columns (``Assembly.sensitivity_columns``): each pair's, as
+        the subject names an axle's (``Assembly.pair_column``), then the car's
+        (``Assembly.car_sensitivities``); name → (Dual over the subject's hardpoint
+        coordinates (per m), unit)."""
+        out, pairs, corners = {}, {}, {}
+        for pair in self.model.sensitivity_pairs:
+            pairs[pair] = self._axle_columns(jets, *pair)
+            for name, column in pairs[pair].items():
+                named = self.model.pair_column(pair, name)
+                if named is not None:
+                    out[named] = column
+        if self.model.car_sensitivity_columns:
+            for s, (points, design) in jets.items():
+                ps = PointSet(points, design, self.sides[s].corner.geometry)
+                parts = {
+                    f"{point}_{a}": points[point][..., i] * 1e3
+                    for point in ("contact_patch_center", "wheel_center")
+                    for i, a in enumerate("xyz")
+                }
+                for name in ("svic_x", "svic_z"):
+                    m = METRIC_BY_NAME[name]
+                    parts[name] = m.function(ps) * m.scale
+                corners[s] = {k: _value(self._lifted(s, v)) for k, v in parts.items()}
+            out |= self.model.car_sensitivities(corners, pairs)
+        return out
+
+    def _axle_columns(self, jets: dict, first: str = "left", second: str = "right") -> dict:
+        """name → (Dual over the subject's hardpoint coordinates (per m), unit): an
+        axle's columns of the pair of corners ``first`` (its left) and ``second``."""
         from ..columns.metrics import fvic_y, fvic_z
         from ..subjects.axle import roll_centre
 
         sides = {}
-        for s, (points, design) in jets.items():
+        for s, sign in ((first, 1.0), (second, -1.0)):
+            points, design = jets[s]
             ps = PointSet(points, design, self.sides[s].corner.geometry)
             cp, wc = points["contact_patch_center"], points["wheel_center"]
             parts = {
@@ -229,8 +269,8 @@ class SubjectSensitivity:
             for name in ("camber", "roadwheel_angle"):
                 m = METRIC_BY_NAME[name]
                 parts[name] = m.function(ps) * m.scale
-            sides[s] = {k: self._lifted(s, v) for k, v in parts.items()}
-        left, right = sides["left"], sides["right"]
+            sides[s] = {k: self._lifted(s, v, sign) for k, v in parts.items()}
+        left, right = sides[first], sides[second]
         deg = 180.0 / np.pi
         b = left["cp_y"] - right["cp_y"]
         roll = np.arctan2(left["dz"] - right["dz"], b)  # rad
@@ -248,7 +288,7 @@ class SubjectSensitivity:
         out = {name: (_value(x), unit_) for name, (x, unit_) in nested.items()}
         per_roll = _rate(roll) * deg  # deg of roll per m along the tangent
         for name in ("camber", "roadwheel_angle"):
-            for s, side in sides.items():
+            for s, side in zip(("left", "right"), (left, right), strict=True):
                 out[f"deriv_{name}_wrt_roll_{s}"] = (_rate(side[name]) / per_roll, "deg/deg")
         for axis, x in zip("yz", rc, strict=True):
             out[f"deriv_roll_center_{axis}_wrt_roll"] = (_rate(x) / per_roll, "mm/deg")

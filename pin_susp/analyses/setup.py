@@ -444,18 +444,12 @@ def static_state(subject, states: dict) -> dict[str, float]:
     """The subject's own static columns (``Assembly.static_columns``, mm) with each
     corner set as in its SetupState (label → state): the subject at its design state;
     none for a corner."""
-    from ..model.sweep import Sweep
-    from ..solve.solver import Solution
-
     if not subject.static_columns:
         return {}
     drawn = subject.drawn_corners
-    model = subject.with_corners(
+    return subject.static_results(
         {s: with_setup(drawn[s], state.setup * MM) for s, state in states.items()}
     )
-    solution = Solution(model.q_design, True, 0, 0.0)
-    results = model.sweep_results(Sweep([], "<static state>"), [solution])
-    return {name: float(results[name][0]) for name, _ in subject.static_columns}
 
 
 # an axle's, by their old names (the axle file as read: an AxleGeometry)

@@ -1,5 +1,6 @@
-"""The statics of a corner or an axle at its solved poses: every member's and
-joint's force under every load case at once (docs/loads.md).
+"""The statics of a corner, an axle or a vehicle at its solved poses: every member's
+and joint's force under every load case at once (docs/loads.md; a vehicle's in its
+chassis frame, the body's joints held as rigid rows: docs/vehicle.md, "Loads").
 
 At a pose q the closures' Jacobian J_c, the spring's row J_s (d length/dq of a
 coilover, d angle/dq of a torsion bar) and the rack's row J_r hold every
@@ -80,12 +81,15 @@ class Statics:
                 held.append(turn)
                 stiffness = None if g.spring_rate is None else g.spring_rate * 180 / np.pi
             compliance.append(stiffness)
-        for joints, k in subject.shared_springs:  # an axle's anti-roll bar, twisted
-            held.append(BarTwist(self.model, list(joints)))
+        for joints, k, *name in subject.shared_springs:  # an axle's anti-roll bar, twisted
+            held.append(BarTwist(self.model, list(joints), *name))
             compliance.append(None if k is None else k * 180 / np.pi)  # N·m/rad
         if "rack_slide" in [self.model.names[j] for j in range(self.model.njoints)]:
             held.append(JointTarget(self.model, "rack_slide"))
             compliance.append(np.inf)  # held by the steering: rigid
+        for joint in subject.held_joints:  # a vehicle's body, held as a corner's chassis is
+            held.append(JointTarget(self.model, joint))
+            compliance.append(np.inf)
         self.solver = NewtonSolver(subject.kin, [*subject.closures, *held], [])
         self.rows = self.solver.rows
         self.size = self.solver.nrows
@@ -133,9 +137,14 @@ class Statics:
                 self.couples.append((col, row))
                 self.direct.append((f"torque_{row.prefix}spring", col, 1, row.resisting))
             elif isinstance(row, BarTwist):
-                self.direct.append(("torque_arb", col, 1, 1.0))
-            else:  # the rack, held by the steering: the trackrods' pull on it is −λ
-                self.direct.append(("force_rack", col, 1, -1.0))
+                self.direct.append((f"torque_{row.name}", col, 1, 1.0))
+            elif row.name == "hold rack_slide":  # held by the steering: the trackrods' pull
+                self.direct.append(("force_rack", col, 1, -1.0))  # on it is −λ
+            else:  # a held joint of the body: the load the wheels put on it along it, −λ
+                joint = row.name.removeprefix("hold ")
+                kind = model.joints[model.getJointId(joint)].shortname()
+                what = "force" if kind.startswith("JointModelP") else "torque"
+                self.direct.append((f"{what}_{joint}", col, 1, -1.0))
             col += row.size
         self.wheels = [
             (subject.points[f"{p}wheel_center"], subject.points[f"{p}contact_patch_center"])
@@ -150,7 +159,7 @@ class Statics:
         self.joints = []  # (body, joint, index, ends inside, wheels inside, couples inside)
         for body in subject.tree.bodies:
             j = body.joint
-            if j is None:
+            if j is None or j.name in subject.held_joints:  # a held body's: its rows' columns
                 continue
             index = model.getJointId(j.name + {"ball": "_x", "universal": "_b"}.get(j.kind, ""))
             first = model.getJointId(j.name + {"ball": "_z", "universal": "_a"}.get(j.kind, ""))
@@ -288,11 +297,14 @@ class Statics:
     def solve_poses(self, qs: list, W: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(values (poses × self.names × cases), unbounded (poses)): every pose's
         kinematics read in turn, then the statics of all poses at once, as stacked
-        arrays (a handful of numpy calls whatever the number of steps)."""
+        arrays (a handful of numpy calls whatever the number of steps). ``W``: the
+        cases' loads (``loads_matrix``), or each pose's (poses × 9 per wheel × cases:
+        a vehicle's steady accelerations, road_loads.py)."""
         kin, model = self.subject.kin, self.model
         n = len(qs)
+        W = W if W.ndim == 3 else W[None]
         Js = np.empty((n, self.size, model.nv))
-        Gs = np.empty((n, model.nv, W.shape[0]))
+        Gs = np.empty((n, model.nv, W.shape[1]))
         P = np.empty((n, len(self.frames), 3))
         wheels = np.empty((n, len(self.wheels), 2, 3))  # (wheel centre, contact patch)
         axes = np.empty((n, len(self.couples), 3))
@@ -323,12 +335,12 @@ class Statics:
         through_f = -np.einsum("je,seic->sjic", self.subtree, forces)
         through_m = -np.einsum("je,seic->sjic", self.subtree, moments)
         for k in range(len(self.wheels)):
-            w = W[9 * k : 9 * k + 9]
-            load_f = (w[0:3] + w[3:6])[None]
+            w = W[:, 9 * k : 9 * k + 9]
+            load_f = w[:, 0:3] + w[:, 3:6]
             load_m = (
-                np.cross(wheels[:, k, 1][..., None], w[0:3][None], axisa=1, axisb=1, axisc=1)
-                + np.cross(wheels[:, k, 0][..., None], w[3:6][None], axisa=1, axisb=1, axisc=1)
-                + w[6:9][None]
+                np.cross(wheels[:, k, 1][..., None], w[:, 0:3], axisa=1, axisb=1, axisc=1)
+                + np.cross(wheels[:, k, 0][..., None], w[:, 3:6], axisa=1, axisb=1, axisc=1)
+                + w[:, 6:9]
             )
             for j in self.wheel_joints[k]:
                 through_f[:, j] -= load_f

@@ -16,7 +16,8 @@ class BarTwist(Row):
     size = 1
     name = "arb"
 
-    def __init__(self, model, joints: list[str]):
+    def __init__(self, model, joints: list[str], name: str = "arb"):
+        self.name = name  # its torque's column: torque_<name> (a vehicle's: arb_front)
         self.row = np.zeros((1, model.nv))
         for sign, joint in zip((1.0, -1.0), joints, strict=False):
             self.row[0, model.joints[model.getJointId(joint)].idx_v] = sign

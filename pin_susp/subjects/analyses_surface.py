@@ -96,10 +96,36 @@ class AnalysesSurface:
         key = self.file_key(label, exc.key) if exc.source == self.source else exc.key
         return InputError(exc.source, key, f"{label} corner: {exc.problem}")
 
+    # what a setup sheet is per where the subject has labelled corners (an axle's sides)
+    setup_unit: str = "side"
+
+    def setup_place(self, label: str) -> str:
+        """Where a labelled corner's setup is, as its setup sheet says: its file's key."""
+        return self.file_key(label, "config.setup")
+
     def setup_data(self, geometries: dict) -> dict:
         """The subject's file data with each given corner's setup (label → Geometry)
         written in."""
         raise NotImplementedError
+
+    def setup_files(self, geometries: dict, path) -> list[tuple]:
+        """The files a solved setup writes, (path, data): the subject's file at ``path``
+        (``setup_data``; a vehicle's axle files beside it too)."""
+        return [(path, self.setup_data(geometries))]
+
+    # the heading of its own static columns in a setup sheet (``static_columns``)
+    static_heading: str = "axle (both sides as set in each row)"
+
+    def static_results(self, corners: dict) -> dict[str, float]:
+        """Its own static columns (``static_columns``, mm) with its corners as given
+        (label → Geometry with its setup values): the subject at its design state."""
+        from ..model.sweep import Sweep
+        from ..solve.solver import Solution
+
+        model = self.with_corners(corners)
+        solution = Solution(model.q_design, True, 0, 0.0)
+        results = model.sweep_results(Sweep([], "<static state>"), [solution])
+        return {name: float(results[name][0]) for name, _ in self.static_columns}
 
     # -- drawings (drawing.py, pin-susp draw) ----------------------------------------
 
@@ -141,6 +167,38 @@ class AnalysesSurface:
     # its own columns of its corners together that its sensitivities give, after each
     # corner's (an axle's track, roll centre, ...; a corner: none)
     sensitivity_columns: tuple[str, ...] = ()
+
+    # the pairs of its corners whose own columns (an axle's track, roll centre, ...) its
+    # sensitivities give, each (its left's label, its right's): an axle's one pair
+    sensitivity_pairs: tuple[tuple[str, str], ...] = ()
+    # its columns of the whole car its sensitivities give after the pairs' (a vehicle's
+    # pitch centre, anti %, roll axis; ``car_sensitivities``)
+    car_sensitivity_columns: tuple[str, ...] = ()
+
+    def sensitivity_move(self, label: str, one_sided: bool = False) -> tuple[str, bool]:
+        """How a labelled corner's hardpoint P is named among its sensitivities'
+        directions, and whether it moves mirrored (its y reversed): an axle's P moves
+        both sides' P, the right mirrored; ``one_sided``, each side's alone (left_P)."""
+        if one_sided:
+            return self.prefix(label), False
+        return "", label == "right"
+
+    def sensitivity_move_text(self, one_sided: bool = False) -> str | None:
+        """What its sensitivities' move is, as its table and CSV say it (None: an axle's
+        symmetric or one-sided move, sensitivity.py's words)."""
+        return None
+
+    def pair_column(self, pair: tuple[str, str], name: str) -> str | None:
+        """An axle's column of one pair of its corners (``track``,
+        ``camber_to_ground_left``) as its sensitivities name it (None: not given)."""
+        return name
+
+    def car_sensitivities(self, corners: dict, pairs: dict) -> dict:
+        """Its columns of the whole car (``car_sensitivity_columns``), name → (Dual over
+        the hardpoint coordinates, unit), from each corner's contact patch, wheel centre
+        and side-view instant centre (``corners``: label → name → Dual, mm) and each
+        pair's columns (``pairs``): none."""
+        return {}
 
     def corner_linkage(self, label: str):
         """The Linkage of a labelled corner alone, as set: its sensitivities' model."""

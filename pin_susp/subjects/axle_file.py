@@ -411,6 +411,7 @@ class AxleAssembly(Assembly):
     noun = "axle"  # validate's messages
     element_points = frozenset(n for ns in (*SIDE_EXTRAS.values(), *CENTER.values()) for n in ns)
     sensitivity_columns = AXLE_COLUMNS
+    sensitivity_pairs = (SIDES,)
     drawing_views = ("front",)
     drawn_at_steps = True
 

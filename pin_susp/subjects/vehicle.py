@@ -35,12 +35,12 @@ from ..model.geometry import contact_patch, summary_repr
 from ..model.mechanisms import xml_name
 from ..solve.bulk import Frames, rows_of, solve_all, tree_of
 from ..solve.linkage import RACK_HELD, Linkage
-from .assembly import Assembly
 from .axle_file import AxleGeometry
 from .corner import Results
 from .elements import elements_of, rack
 from .elements.body import JOINTS, BodyOnRoad
 from .elements.car_axle import AxleOfCar
+from .vehicle_analyses import VehicleAssembly
 from .vehicle_columns import vehicle_columns
 from .vehicle_export import VehicleExport
 from .vehicle_file import (  # noqa: F401 (the vehicle file's names, importable from here)
@@ -94,7 +94,7 @@ class AxleElements:
         return out | self.bar.rate_columns(model, points)
 
 
-class Vehicle(VehicleExport, VehicleViews, Assembly):
+class Vehicle(VehicleExport, VehicleViews, VehicleAssembly):
     """Four corners under one sprung body on the road, one Pinocchio model
     (docs/vehicle.md): ``Vehicle("examples/vehicle_fs.yaml")`` or a VehicleGeometry.
 
@@ -117,6 +117,9 @@ class Vehicle(VehicleExport, VehicleViews, Assembly):
         "validate",
         "view",
         "draw",
+        "loads",
+        "setup",
+        "sensitivity",
     )  # docs/vehicle.md: the rest not yet
     reports = False
     on_road = True
@@ -177,12 +180,17 @@ class Vehicle(VehicleExport, VehicleViews, Assembly):
         self.body_q, self.body_v = [j.idx_q for j in body], [j.idx_v for j in body]
 
     def _check_on_road(self) -> None:
-        """Each contact patch on the road (z = 0) at design, to ON_ROAD: else the
-        wheel centres' heights and the tyres' sizes disagree (or the origin is not on
-        the ground), and every sweep would start by moving the wheels to the road."""
+        """Each contact patch on the road (z = 0) as its file draws it, to ON_ROAD: else
+        the wheel centres' heights and the tyres' sizes disagree (or the origin is not on
+        the ground), and every sweep would start by moving the wheels to the road. (A
+        setup — a shim, a trackrod's length — may then move the wheel off it: the sweep
+        puts the car back on the road as set.)"""
         for end, labels in AXLES.items():
             for label in labels:
-                z = self.design_positions[f"{label}_contact_patch_center"][2] * 1e3
+                g = self.vehicle.corner(label)  # as drawn
+                p = g.design_points()
+                spin = unit(p["axle_outboard"] - p["axle_inboard"])
+                z = contact_patch(p["wheel_center"], spin, g.wheel.radius)[2] * 1e3
                 if abs(z) > ON_ROAD:
                     where, key = axle_key(self.vehicle, end, "hardpoints")
                     raise InputError(

@@ -10,9 +10,10 @@ from ..report import progress_bar, report_failures
 from .sweep import write_results
 
 DESCRIPTION = (
-    "Solve SWEEP on GEOMETRY (a corner or an axle) and, at every step, the "
+    "Solve SWEEP on GEOMETRY (a corner, an axle or a vehicle) and, at every step, the "
     "quasi-static "
-    "forces under each load case of CASES (README, Loads and rates): the tension in every "
+    "forces under each load case of CASES (README, Loads and rates; a vehicle's case "
+    "may be a steady acceleration, ax and ay in g: docs/vehicle.md): the tension in every "
     "two-force member (wishbone legs, trackrod or toe link, pushrod, links), the "
     "spring's force, the rack's, and the load at every ball joint and pivot bushing "
     "(a wishbone's also along each leg: a wishbone carrying the pushrod is no "
@@ -38,6 +39,15 @@ def run(args) -> int:
     check_outputs(args, args.output, args.plot)
     if args.plot is not None:
         check_image(args.plot)
+    if args.plot is not None:
+        from ...errors import InputError
+        from ...subjects.subject import subject_class
+
+        kind = subject_class(args.geometry)
+        if not kind.reports:  # before any work
+            raise InputError(
+                str(args.geometry), "--plot", f"a {kind.noun}'s report is not built yet"
+            )
     corner, sweep, cases = load_inputs(args.geometry, args.sweep, args.cases)
     results, forces = solve_forces(corner, sweep, cases, args.quiet)
     plot = write_results(args, forces)
@@ -56,18 +66,22 @@ def run(args) -> int:
 
 
 def load_inputs(geometry, sweep, cases):
-    """A corner or an axle, its sweep and load cases, every input error said before any
-    work."""
+    """A corner, an axle or a vehicle, its sweep and load cases, every input error said
+    before any work (a vehicle's steady accelerations: each one's equilibrium found)."""
     from ...analyses.loads import Statics, load_cases
+    from ...analyses.road_loads import RoadLoads, has_accelerations
     from ...model.sweep import load_sweep
     from ...subjects.subject import load_subject
 
     subject = load_subject(geometry)
     sweep = load_sweep(sweep)
-    cases = load_cases(cases, axle=bool(subject.blocks))  # a block per labelled corner
+    # a block per labelled corner; on the road, a steady acceleration too
+    found = load_cases(cases, labels=subject.labels, accelerations=subject.on_road)
     subject.check_sweep(sweep)  # target errors before any work
     Statics(subject)  # no load path, or an anti-roll bar without its stiffness
-    return subject, sweep, cases
+    if has_accelerations(found):  # the attitude's inputs, and an equilibrium at each
+        RoadLoads(subject, found, str(cases))
+    return subject, sweep, found
 
 
 def solve_forces(corner, sweep, cases, quiet: bool):
@@ -89,8 +103,12 @@ def chosen_case(path, cases, name: str | None) -> str:
     return names[0] if name is None else name
 
 
+UNLOADED = 1e-6  # N, N·m: a member the case leaves unloaded, not listed in the summary
+
+
 def _force_summary(forces) -> None:
-    """The largest tension and compression of each member over the sweep, per case; a
+    """The largest tension and compression of each member over the sweep, per case (one
+    the case leaves unloaded left out: a corner it puts no load on); a
     wishbone that is not a two-force member (it carries a pushrod, say) by its bushing
     loads resolved along each leg, and said so."""
     import numpy as np
@@ -108,6 +126,8 @@ def _force_summary(forces) -> None:
         for name in names:
             values = forces[name][rows].astype(float)
             if np.isnan(values).all():
+                continue
+            if np.nanmax(np.abs(values)) < UNLOADED:  # a corner the case does not load
                 continue
             unit = forces.units.get(name, "N")
             print(

@@ -1,6 +1,6 @@
-"""`pin-susp sensitivity`: exact d(metric)/d(hardpoint coordinate) of a corner or an
-axle, at design or along a sweep; the long-format CSV and the table of the largest
-entries per metric."""
+"""`pin-susp sensitivity`: exact d(metric)/d(hardpoint coordinate) of a corner, an axle
+or a vehicle, at design or along a sweep; the long-format CSV and the table of the
+largest entries per metric."""
 
 from __future__ import annotations
 
@@ -42,7 +42,9 @@ def arguments(parser) -> None:
         "--one-sided",
         action="store_true",
         help="an axle: move each side's point alone (hardpoints left_P, right_P); default "
-        "a symmetric move, the left P by (dx, dy, dz) and the right P by (dx, -dy, dz)",
+        "a symmetric move, the left P by (dx, dy, dz) and the right P by (dx, -dy, dz); a "
+        "vehicle: each corner's alone (fl_P, ...), default each axle's mirrored (front_P, "
+        "rear_P)",
     )
     parser.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
 
@@ -55,7 +57,6 @@ def run(args) -> int:
         ONE_SIDED_MOVE,
         SYMMETRIC_MOVE,
         SubjectSensitivity,
-        select_points,
         subject_sensitivities,
     )
     from ...model.sweep import load_sweep
@@ -71,10 +72,13 @@ def run(args) -> int:
             f"{args.geometry}: sensitivity: not for an axle with a rigid anti-roll bar yet "
             "(each wheel's height is held, which a rigid bar does not allow)"
         )
+    named = tuple(  # a point named with its side, corner or axle (left_P, fl_P, front_P)
+        p for s in model.labels for one in (False, True) if (p := model.sensitivity_move(s, one)[0])
+    )
     own = [
         n
         for n in (args.points or "").split(",")
-        if n.strip() in model.element_points or n.strip().startswith(model.blocks)
+        if n.strip() in model.element_points or n.strip().startswith((*model.blocks, *named))
     ]
     if own:
         raise PinSuspError(
@@ -83,9 +87,7 @@ def run(args) -> int:
             "corners' hardpoints (both sides move together; --one-sided for one side)"
         )
     sens = SubjectSensitivity(model, args.one_sided)
-    points = select_points(sens.sides[model.labels[0]].corner, args.points)
-    if args.one_sided:
-        points = [model.prefix(s) + p for s in model.labels for p in points]
+    points = _points(sens, args.points)
     sweep = None
     if args.sweep is not None:
         sweep = load_sweep(args.sweep)
@@ -93,7 +95,9 @@ def run(args) -> int:
     progress = progress_bar(sweep.steps if sweep else 1, args.quiet)
     states, results = subject_sensitivities(sens, sweep, progress)
     held = model.sensitivity_held()
-    move = ONE_SIDED_MOVE if args.one_sided else SYMMETRIC_MOVE
+    move = model.sensitivity_move_text(args.one_sided)
+    if move is None:
+        move = ONE_SIDED_MOVE if args.one_sided else SYMMETRIC_MOVE
     notes = [f"exact; {held}; {move}"] if held else []
     if any(g.drawn is not None for g in model.corners.values()):
         adjusted = "shims and adjusters" if model.blocks else "shim and adjusters"
@@ -101,6 +105,24 @@ def run(args) -> int:
     groups = model.sensitivity_groups(list(states[0].values) if states else [])
     head = (f"hardpoint: {move}", held) if held else ()
     return _sensitivity_report(args, model, sweep, states, results, points, groups, notes, head)
+
+
+def _points(sens, spec: str) -> list[str]:
+    """The hardpoints the table ranks, as the subject's directions name them: each
+    corner's chosen points (a group, or names that corner has: a vehicle's rear has
+    toe links, its front trackrods); an unknown name said once, for the first corner."""
+    from ...analyses.sensitivity import select_points
+    from ...errors import InputError
+
+    chosen, errors = [], []
+    for label, side in sens.sides.items():
+        try:
+            chosen += [sens.name_of(label, p) for p in select_points(side.corner, spec)]
+        except InputError as exc:
+            errors.append(exc)
+    if len(errors) == len(sens.sides):
+        raise errors[0]
+    return list(dict.fromkeys(chosen))
 
 
 def _sensitivity_report(

@@ -1,6 +1,7 @@
-"""`pin-susp setup`: the setup sheet of a corner or an axle (static metrics with the
-camber shim and length adjusters applied, a row per listed value), exact sensitivities
-to the adjusters, and the inverse solve to target camber, toe and ride height."""
+"""`pin-susp setup`: the setup sheet of a corner, an axle or a vehicle (static metrics
+with the camber shim and length adjusters applied, a row per listed value; a vehicle's
+per corner), exact sensitivities to the adjusters, and the inverse solve to target
+camber, toe and ride height."""
 
 from __future__ import annotations
 
@@ -76,14 +77,17 @@ def arguments(parser) -> None:
         "-o",
         "--output",
         metavar="SET.yaml",
-        help="with targets: write the geometry with the setup found",
+        help="with targets: write the geometry with the setup found (a vehicle's: the "
+        "vehicle file, with each axle file set beside it, SET_front.yaml)",
     )
     parser.add_argument("--csv", metavar="OUT.csv", help="also write the sheet's rows as CSV")
     parser.add_argument(
         "--side",
-        choices=("left", "right"),
+        choices=("left", "right", "fl", "fr", "rl", "rr", "front", "rear"),
         help="an axle with its own right points: listed values and targets set this side "
-        "alone (default: both sides; a mirrored axle has one setup for both)",
+        "alone (default: both sides; a mirrored axle has one setup for both); a vehicle: "
+        "one corner (fl, fr, rl, rr: its axle with its own right points) or one axle "
+        "(front, rear)",
     )
 
 
@@ -127,20 +131,22 @@ def run(args) -> int:
     subject = load_drawn(args.geometry, args.side)
     chosen = subject.setup_labels(args.side)
     drawn = subject.drawn_corners
-    link = _link(drawn[subject.labels[0]])
+    links = {s: _link(drawn[s]) for s in subject.labels}  # a vehicle's: trackrod, toe link
+    link = links[subject.labels[0]] if len(set(links.values())) == 1 else "trackrod or toe link"
     if targets:
         found = setup.solve_subject_setup(subject, targets, args.side)
         rows = {s: [found[s].before, found[s].after] for s in subject.labels}
-        labels = ["before", "after"]
+        labels = {s: ["before", "after"] for s in subject.labels}
     else:
         rows = setup.subject_setup_sheet(subject, args.shim, args.trackrod, args.pushrod, args.side)
-        labels = _sheet_labels(args, link)
+        labels = {s: _sheet_labels(args, links[s]) for s in subject.labels}
+    longest = max(labels.values(), key=len)
     # the subject's columns per row: its corners as set in that row (one not set: as set)
     statics = [
         setup.static_state(subject, {s: rows[s][min(i, len(rows[s]) - 1)] for s in rows})
-        for i in range(len(labels))
+        for i in range(len(longest))
     ]
-    per = " per side" if subject.blocks else ""
+    per = f" per {subject.setup_unit}" if subject.blocks else ""
     print(f"{subject.name}: setup sheet{per} ({subject.source})")
     for s in subject.labels:
         owner = subject.setup_owner(s)
@@ -151,37 +157,40 @@ def run(args) -> int:
             )
         elif s:
             setting = "" if s in chosen else f"; not set: --side {args.side}"
-            print(f"  {s} corner ({subject.file_key(s, 'config.setup')}{setting}):")
-        _sheet(rows[s], labels[: len(rows[s])], link)
+            print(f"  {s} corner ({subject.setup_place(s)}{setting}):")
+        _sheet(rows[s], labels[s][: len(rows[s])], links[s])
         if targets and (found[s].iterations or not s):  # a corner not set: no hit
             _hit(targets, found[s].iterations)
         if args.sensitivities and not targets:
             _sensitivities(rows[s][0], drawn[s], args.thread_pitch)
     columns = subject.static_columns
     if columns:
-        print("  axle (both sides as set in each row):")
+        print(f"  {subject.static_heading}:")
         print(f"  {'':9}" + "".join(f"{head:>12}" for _, head in columns))
         print(f"  {'':9}" + "".join(f"{'mm':>12}" for _ in columns))
-        for label, row in zip(labels, statics, strict=True):
+        for label, row in zip(longest, statics, strict=True):
             cells = (round(row[name], 3) + 0.0 for name, _ in columns)
             print(
                 f"  {label:9}"
                 + "".join(f"{v:>12.3f}" if np.isfinite(v) else f"{'-':>12}" for v in cells)
             )
+    written = []
+    if args.output is not None:  # the subject's file (a vehicle's axle files beside it)
+        written = subject.setup_files({s: found[s].geometry for s in chosen}, args.output)
+        check_outputs(args, *(path for path, _ in written[1:]), args.csv)
     with all_or_none():
-        if args.output is not None:
-            data = subject.setup_data({s: found[s].geometry for s in chosen})
-            _write_setup(data, subject.name, args.output)
+        for path, data in written:
+            _write_setup(data, subject.name, path)
         if args.csv is not None:
             rows_of = [(s, i) for s in subject.labels for i in range(len(rows[s]))]
             _sheet_csv(
                 [rows[s][i] for s, i in rows_of],
-                [" ".join(filter(None, (s, labels[i]))) for s, i in rows_of],
+                [" ".join(filter(None, (s, labels[s][i]))) for s, i in rows_of],
                 args.csv,
                 link,
                 [statics[i] for _, i in rows_of],
             )
-    wrote(args.output, args.csv)
+    wrote(*(path for path, _ in written), args.csv)
     return 0
 
 
