@@ -105,7 +105,7 @@ class Vehicle(Assembly):
     labels = LABELS
     noun = "vehicle"
     commands = ("sweep", "attitude")  # the rest of docs/vehicle.md's "Not built yet"
-    reports = False
+    reports = True
     on_road = True
     summary_columns = tuple(
         "heave pitch roll steering_wheel_angle camber_fl camber_fr camber_rl camber_rr "
