@@ -113,11 +113,16 @@ def road_inputs(results: ResultsFile) -> list[str]:
 
 
 def sweeps(results: ResultsFile) -> str | None:
-    """What the sweep moved: 'wheel travel', 'rack travel', several joined by 'and'
+    """What the sweep moved: 'wheel travel', 'rack travel', several joined ('a, b and c')
     (a combined sweep), or None (nothing: one step); an axle's: 'roll', 'heave',
     'rack travel'; a vehicle's: 'heave', 'pitch', 'roll', 'steering', 'road height
     (fr, rl)'."""
-    return " and ".join(moved(results)) or None
+    return joined(moved(results)) or None
+
+
+def joined(words: list[str]) -> str:
+    """'a', 'a and b', 'a, b and c'."""
+    return " and ".join(w for w in (", ".join(words[:-1]), words[-1] if words else "") if w)
 
 
 def input_column(results: list[ResultsFile], kind: str) -> tuple[str, str]:
@@ -126,7 +131,7 @@ def input_column(results: list[ResultsFile], kind: str) -> tuple[str, str]:
     if results[0].vehicle:
         if kind.startswith("road height ("):
             corners = kind.removeprefix("road height (").removesuffix(")").split(", ")
-            where = " and ".join(corners)
+            where = joined(corners)
             return ROAD + corners[0], f"Road height under {where} (+ up) [mm]"
         if kind == "steering" and not all(has_values(r, VEHICLE_X[kind][0]) for r in results):
             return RACK_X  # no c-factor: the rack's travel
@@ -345,7 +350,7 @@ def combined_note(results: list[ResultsFile], xname: str) -> str:
         finite = r[column][np.isfinite(r[column])]
         parts.append(f"{kind} {finite[0]:.4g} → {finite[-1]:.4g} {unit}".rstrip())
     return (
-        f"A combined sweep: {' and '.join(parts)} move together. Every panel is drawn "
+        f"A combined sweep: {joined(parts)} move together. Every panel is drawn "
         "against the step (the inputs first): a curve shows what both inputs do at once, "
         "not a gain along one."
     )
