@@ -351,3 +351,24 @@ def test_results_plot_draws_the_vehicle_report(tmp_path):
     out = tmp_path / "roll.png"
     results.plot(out)
     assert matplotlib.image.imread(out).ndim == 3
+
+
+def test_the_fs_cars_roll_in_docs_vehicle_md(runs):
+    """docs/vehicle.md's reading of the report's picture, at 2 deg of roll (step 20)."""
+    columns = read(runs["fs", "roll"])
+    assert columns["roll"][20] == pytest.approx(2.0)
+    told = {
+        "camber_to_ground_fr": (-0.40, 0.005),  # the outer front wheel
+        "camber_to_ground_fl": (-3.45, 0.005),
+        "roll_center_z_front": (8.4, 0.05),
+        "roll_center_z_rear": (30.4, 0.05),
+        "roll_axis_height_at_cg": (18.7, 0.05),
+        "roll_center_y_front": (583, 0.5),
+        "arb_twist_front": (20.2, 0.05),
+        "arb_twist_rear": (23.2, 0.05),
+    }
+    for name, (value, within) in told.items():
+        assert abs(columns[name][20] - value) <= within, name
+    assert columns["camber_to_ground_fr"][10] == pytest.approx(-1.91, abs=0.005)
+    for side in ("left", "right"):
+        assert 0.4 < abs(columns[f"wheelbase_{side}"][20] - columns[f"wheelbase_{side}"][10]) < 0.7

@@ -50,7 +50,7 @@ VEHICLE_PANELS = (
     (
         "Anti geometry under braking",
         (
-            "anti_<…>",
+            "anti_dive_front, anti_lift_rear",
             (
                 ("anti_dive_front", "anti-dive front", "-", "car"),
                 ("anti_lift_rear", "anti-lift rear", "--", "car"),
@@ -60,7 +60,7 @@ VEHICLE_PANELS = (
     (
         "Anti geometry under drive",
         (
-            "anti_<…>",
+            "anti_lift_front, anti_squat_rear",
             (
                 ("anti_lift_front", "anti-lift front", "-", "car"),
                 ("anti_squat_rear", "anti-squat rear", "--", "car"),
@@ -138,5 +138,6 @@ def _panel(results, title: str, shown: str, lines: tuple, xname: str, xlabel: st
             panel.lines.append(
                 (r[xname], r[name], who or "_nolegend_", style, palette[role], marker_for(r, name))
             )
-    panel.legend = len(panel.lines) > 1
+    # a legend where a line is named (a corner, an axle, a file): even when it is alone
+    panel.legend = any(not line[2].startswith("_") for line in panel.lines)
     return panel
