@@ -37,8 +37,10 @@ fuzz: $(STAMP)
 	PIN_SUSP_FUZZ_SEED=$${PIN_SUSP_FUZZ_SEED:-random} \
 	$(BIN)/python -m pytest -q -s tests/test_fuzz.py -k holds
 
-# Drake against pin_susp on every example with every sweep it takes, every step
-# (tests/test_validate_drake.py; `make test` runs a slice of three).
+# Drake against pin_susp on every example with every sweep it takes, every step: each
+# corner and the axle, and both cars with every vehicle sweep (tests/test_validate_drake.py;
+# `make test` runs a slice of four, and short sweeps of both cars in
+# tests/test_vehicle_robotics.py).
 drake: $(STAMP)
 	PIN_SUSP_DRAKE_ALL=1 $(BIN)/python -m pytest -q tests/test_validate_drake.py
 
@@ -47,6 +49,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_sweep.py --json benchmarks/last_run.json
 	$(BIN)/python benchmarks/bench_study.py --full --json benchmarks/last_study_run.json
 	$(BIN)/python benchmarks/bench_validate.py
+	$(BIN)/python benchmarks/bench_attitude.py --json benchmarks/last_attitude_run.json
 
 # Regenerate urdf/ from examples/ (a test fails when they differ).
 urdf: $(STAMP)

@@ -378,7 +378,13 @@ def no_plane_row(bar):
 
 def free_to_twist(bar):
     """The T-bar's formulation as if its bar were not rigid."""
-    return lambda axle, *args: bar(replace(axle, anti_roll_stiffness=None), *args)
+    from pin_susp.subjects.elements import AntiRollBar
+
+    def twisting(element, *args):
+        loose = replace(element.axle, anti_roll_stiffness=None)
+        return bar(AntiRollBar(loose, element.labels, element.prefix), *args)
+
+    return twisting
 
 
 @pytest.mark.parametrize(

@@ -78,3 +78,26 @@ def test_study_benchmark_runs_a_small_slice(tmp_path):
     assert set(report["ways"]) == {"serial", "local, 1 worker", "local, 2 workers"}
     for way in report["ways"].values():
         assert way["variants"] == 64 and way["running"] > 0
+
+
+def test_attitude_benchmark_quick_slice(tmp_path):
+    """bench_attitude.py's quick slice (a list of 10 points, a 3 x 5 grid, two rounds):
+    every point converges and every figure is reported (no timing asserted)."""
+    out = tmp_path / "attitude.json"
+    proc = subprocess.run(
+        [sys.executable, str(ROOT / "benchmarks" / "bench_attitude.py"), "--quick"]
+        + ["--json", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert "ms per point" in proc.stdout and "a sweep step" in proc.stdout
+    report = json.loads(out.read_text())
+    assert set(report["sets"]) == {"list of 10", "grid 3 x 5"}
+    for s in report["sets"].values():
+        assert s["converged"] == s["points"]
+        assert s["max_equilibrium_residual_N"] <= 1e-7
+        for kind in ("run", "equilibria"):
+            assert s["ms_per_point"][kind] > 0 and s["ratio_to_sweep_step"][kind] > 0
+    assert report["baseline_ms_per_step"] > 0 and report["constants_ms"] > 0

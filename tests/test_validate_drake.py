@@ -44,27 +44,21 @@ def _yaml(path: Path) -> dict:
 
 
 def every_example() -> list[tuple[str, str]]:
-    """Every example geometry with every example sweep it can run: a corner's sweeps
-    whose targets its drivers take (pin_susp refuses the others), an axle's sweeps of
-    roll and heave."""
+    """Every example geometry (a corner, an axle, a vehicle) with every example sweep it
+    can run: the sweeps whose targets it takes (pin_susp refuses the others — a corner
+    an axle's, an axle a vehicle's)."""
+    from pin_susp.subjects.subject import load_subject
+
     sweeps = sorted(p for p in EXAMPLES.glob("*.yaml") if "targets" in _yaml(p))
     pairs = []
     for geometry in sorted(EXAMPLES.glob("*.yaml")):
         data = _yaml(geometry)
-        if "hardpoints" not in data and data.get("scope") != "axle":
+        if "hardpoints" not in data and data.get("scope") not in ("axle", "vehicle"):
             continue
+        subject = load_subject(geometry, warn=False)
         for path in sweeps:
-            targets = _yaml(path)["targets"]
-            axle_sweep = any("side" in t or "quantity" in t for t in targets)
-            if data.get("scope") == "axle":
-                if axle_sweep:
-                    pairs.append((geometry.name, path.name))
-                continue
-            if axle_sweep:
-                continue
-            corner = pin_susp.Corner(geometry)
             try:
-                corner.solver_for(pin_susp.load_sweep(path).targets)
+                subject.solver_for(pin_susp.load_sweep(path).targets)
             except PinSuspError:
                 continue
             pairs.append((geometry.name, path.name))
@@ -73,12 +67,13 @@ def every_example() -> list[tuple[str, str]]:
 
 EVERY = every_example()
 # `make drake` runs every pair (PIN_SUSP_DRAKE_ALL=1); `make test` a slice: a corner with
-# a rack, a fixed toe link, and the axle in roll (each mechanism's columns are checked on
-# short sweeps below)
+# a rack, a fixed toe link, the axle in roll and the FS car in roll (each mechanism's
+# columns are checked on short sweeps below, both cars' in tests/test_vehicle_robotics.py)
 SLICE = {
     ("double_wishbone.yaml", "bump_steer.yaml"),
     ("fixed_toe_link.yaml", "bump.yaml"),
     ("axle_front.yaml", "roll.yaml"),
+    ("vehicle_fs.yaml", "vehicle_roll.yaml"),
 }
 RUN = EVERY if os.environ.get("PIN_SUSP_DRAKE_ALL") else [p for p in EVERY if p in SLICE]
 
@@ -96,6 +91,8 @@ def test_every_example_geometry_is_validated():
         "multilink_rear.yaml",
         "semi_trailing_arm.yaml",
         "axle_front.yaml",
+        "vehicle_fs.yaml",
+        "vehicle_saloon.yaml",
     } <= geometries
     assert {s for _, s in EVERY} >= {
         "bump.yaml",
@@ -103,7 +100,9 @@ def test_every_example_geometry_is_validated():
         "bump_rack_held.yaml",
         "roll.yaml",
         "heave_roll.yaml",
-    }
+    } | {f"vehicle_{s}.yaml" for s in ("heave", "pitch", "roll", "warp", "steer", "combined")}
+    cars = {(g, s) for g, s in EVERY if g.startswith("vehicle_")}
+    assert len(cars) == 12 and all(s.startswith("vehicle_") for _, s in cars)
 
 
 @pytest.mark.parametrize(("geometry", "sweep"), RUN, ids=[f"{g[:-5]}-{s[:-5]}" for g, s in RUN])

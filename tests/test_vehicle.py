@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 from scipy.spatial.transform import Rotation
 
 import pin_susp
@@ -157,6 +158,24 @@ def test_mirror_symmetry_in_roll(car):
             )
 
 
+def test_rack_held_without_a_steering_target_is_held_in_the_body(car):
+    """No steering target: the rack stays at design in the body (rack_displacement 0) as
+    the body rolls and pitches, the same steps as a centred steering wheel's. (It used to
+    hold the rack's inboard end in the road's frame: the rack slid about 1 mm at 2° of
+    roll, its left and right rolls not mirrored, and the rack's force went to the road.)"""
+    roll = np.linspace(-2, 2, 5)
+    held = body_sweep(np.full(5, 3.0), np.full(5, 0.4), roll)
+    held = Sweep([t for t in held.targets if t.quantity != "steering_wheel"], "<test>")
+    r = car.run_sweep(held)
+    assert r.meta["notes"] == ["rack held at design (the sweep gives no rack target)"]
+    np.testing.assert_allclose(r["rack_displacement"], 0.0, atol=1e-9)
+    centred = car.run_sweep(body_sweep(np.full(5, 3.0), np.full(5, 0.4), roll))
+    for label in LABELS:
+        for column in ("roadwheel_angle", "camber_to_ground"):
+            name = f"{column}_{label}"
+            np.testing.assert_allclose(r[name], centred[name], rtol=0, atol=1e-9)
+
+
 def test_steering_wheel_is_the_rack_through_the_c_factor(car):
     r = car.run_sweep(EXAMPLES / "vehicle_steer.yaml")
     np.testing.assert_allclose(r["steering_wheel_angle"], np.linspace(-90, 90, 21), atol=1e-9)
@@ -225,7 +244,7 @@ def test_cli_sweep_writes_the_car(tmp_path):
     header = next(line for line in out.read_text().splitlines() if not line.startswith("#"))
     for column in ("camber_fl", "camber_to_ground_rr", "deriv_camber_wrt_roll_fl", "roll"):
         assert column in header.split(",")
-    for refused in (["urdf", str(FS), "-o", str(tmp_path / "car.urdf")], ["setup", str(FS)]):
+    for refused in (["setup", str(FS)],):
         run = subprocess.run(
             [sys.executable, "-m", "pin_susp", *refused],
             capture_output=True,
@@ -234,4 +253,75 @@ def test_cli_sweep_writes_the_car(tmp_path):
         )
         assert run.returncode == 2 and "not built yet" in run.stderr, refused
         assert run.stderr.count("\n") == 1 and "Traceback" not in run.stderr
-    assert not (tmp_path / "car.urdf").exists()
+    assert not (tmp_path / "car.png").exists()
+
+
+def test_misspelt_scope_and_the_wrong_kinds_quantities_say_so(tmp_path):
+    """A misspelt scope is named as such (not taken for an axle's); a vehicle's pitch
+    on an axle and an axle's roll on a corner name whose quantities they are; the
+    steering wheel given twice is named."""
+    from pin_susp.errors import InputError
+    from pin_susp.model.geometry import load_geometry
+    from pin_susp.model.sweep import load_sweep
+    from pin_susp.subjects.axle import AxleModel
+
+    data = yaml.safe_load((EXAMPLES / "vehicle_fs.yaml").read_text())
+    data["scope"] = "vehicel"
+    with pytest.raises(InputError, match="scope: expected one of corner, axle, vehicle"):
+        load_geometry(data)
+    axle = AxleModel(EXAMPLES / "vehicle" / "fs_front.yaml")
+    with pytest.raises(InputError, match="pitch is a vehicle's quantity: this geometry is an axle"):
+        axle.run_sweep(EXAMPLES / "vehicle_pitch.yaml")
+    twice = {
+        "version": 1,
+        "steps": 2,
+        "targets": [{"quantity": q, "start": 0, "stop": 0} for q in ("heave", "pitch", "roll")]
+        + [{"quantity": "steering_wheel", "start": 0, "stop": 10}] * 2,
+    }
+    with pytest.raises(InputError, match=r"targets\[4\]: repeats targets\[3\]'s steering"):
+        Vehicle(EXAMPLES / "vehicle_fs.yaml").run_sweep(load_sweep(twice))
+
+
+def test_a_wheel_off_the_road_at_design_is_an_error(tmp_path):
+    """A wheel centre too low for its tyre (its contact patch below z = 0 at design)
+    is named in its axle file, with how far: every sweep would start by moving it."""
+    from pin_susp.errors import InputError
+
+    for name in ("vehicle_fs.yaml", "vehicle/fs_front.yaml", "vehicle/fs_rear.yaml"):
+        (tmp_path / name).parent.mkdir(exist_ok=True)
+        (tmp_path / name).write_text((EXAMPLES / name).read_text())
+    front = tmp_path / "vehicle" / "fs_front.yaml"
+    data = yaml.safe_load(front.read_text())
+    for key in ("axle_inboard", "axle_outboard"):
+        data["hardpoints"]["left"][key]["z"] -= 3.0
+    front.write_text(yaml.safe_dump(data))
+    with pytest.raises(InputError) as got:
+        Vehicle(tmp_path / "vehicle_fs.yaml")
+    assert got.value.source == str(front) and got.value.key == "hardpoints"
+    assert "the fl contact patch is 3 mm below the road" in got.value.problem
+
+
+def test_the_rack_is_held_and_moved_in_the_chassis_frame():
+    """Without a steering target the rack stays at design while the body rolls (it is
+    held by its joint, not by its end's position on the road); a rack target as on an
+    axle (trackrod_inboard along y) and the vehicle's rack quantity move it by exactly
+    their travel, rolled or not."""
+    from pin_susp.model.sweep import load_sweep
+
+    car = Vehicle(EXAMPLES / "vehicle_fs.yaml")
+    body = [
+        {"quantity": "heave", "start": 0, "stop": 0},
+        {"quantity": "pitch", "start": 0, "stop": 0},
+        {"quantity": "roll", "start": -2, "stop": 2},
+    ]
+    held = car.run_sweep(load_sweep({"version": 1, "steps": 5, "targets": body}))
+    assert held.meta["notes"] and np.abs(held["rack_displacement"]).max() < 1e-9
+    # the rack's end on the road moves with the roll: a hold in the road frame would not
+    assert np.ptp(held["fl_trackrod_inboard_z"]) == 0.0  # (chassis frame: it stays)
+    on_axle = {"point": "trackrod_inboard", "side": "fl", "direction": {"axis": "y"}}
+    for target, expected in (
+        (on_axle | {"start": 5, "stop": 5}, [5.0] * 5),
+        ({"quantity": "rack", "start": -5, "stop": 5}, np.linspace(-5, 5, 5)),
+    ):
+        r = car.run_sweep(load_sweep({"version": 1, "steps": 5, "targets": [*body, target]}))
+        np.testing.assert_allclose(r["rack_displacement"], expected, rtol=0, atol=1e-9)

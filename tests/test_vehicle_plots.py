@@ -320,8 +320,8 @@ def test_a_vehicle_is_not_plotted_with_a_corner_an_axle_or_another_sweep(runs, t
         f"pin-susp: error: {heave}: x is heave but {vehicle}'s is roll: plot them separately\n"
     )
     # an axle is not drawn at a vehicle's step
-    argv = ["draw", str(EXAMPLES / "axle_front.yaml"), "-o", str(out), "--at", f"{vehicle}:3"]
-    assert main(argv) == 2
+    argv = ["draw", str(EXAMPLES / "axle_front.yaml"), "-o", str(out)]
+    assert main([*argv, "--from-results", f"{vehicle}:3"]) == 2
     err = capsys.readouterr().err
     assert err == (
         f"pin-susp: error: {vehicle}: a vehicle's results: an axle is drawn at a step of its own\n"

@@ -64,6 +64,7 @@ class Attitude:
 
     def __init__(self, car):
         from ..solve.bulk import Frames, rows_of, tree_of
+        from ..subjects.vehicle_file import axle_key
 
         self.car = car
         v = car.vehicle
@@ -71,17 +72,15 @@ class Attitude:
         self.masses = masses_of(v)
         self.tyre_rates = tyre_rates_of(v)
         for label, g in car.corners.items():
+            end = "front" if label[0] == "f" else "rear"  # its axle's file, or inline
             if not g.rated_spring:
-                axle = "front" if label[0] == "f" else "rear"
                 raise InputError(
-                    source,
-                    f"{axle}.axle_config.spring.rate",
+                    *axle_key(v, end, "axle_config.spring.rate"),
                     f"the attitude needs every spring's rate: the {label} corner has none",
                 )
             if g.spring != "coilover":
                 raise InputError(
-                    source,
-                    f"{'front' if label[0] == 'f' else 'rear'}.axle_config.spring.type",
+                    *axle_key(v, end, "axle_config.spring.type"),
                     f"the attitude takes coilovers so far (the {label} corner's is {g.spring})",
                 )
         from ..model.sweep import Target

@@ -417,7 +417,9 @@ def _named(target) -> str:
 
 def _anti_roll_bar(bar: AntiRollBar, corners: dict[str, Geometry], spec, hp) -> list:
     """The anti-roll bar's rows (:data:`ANTI_ROLL`, by its type) and its points: its
-    axis or pivot, each corner's droplink ends."""
+    axis or pivot, each of its two corners' droplink ends (its names: its corners'
+    labels and its own prefix — an axle's left/right and none, a vehicle's axle's
+    fl/fr and ``front_``)."""
     axle = bar.axle
     if axle.anti_roll not in ANTI_ROLL:
         raise PinSuspError(
@@ -425,15 +427,18 @@ def _anti_roll_bar(bar: AntiRollBar, corners: dict[str, Geometry], spec, hp) -> 
             f"(it has: {', '.join(ANTI_ROLL)})"
         )
     hp.update(bar.center)
-    _side_points(axle.side_points, corners, "droplink_", hp)
-    return ANTI_ROLL[axle.anti_roll](axle, corners, spec, hp)
+    own = {label: corners[label] for label in bar.labels}
+    side_points = {label: axle.side_points[bar.sides[label]] for label in bar.labels}
+    _side_points(side_points, own, "droplink_", hp)
+    return ANTI_ROLL[axle.anti_roll](bar, own, spec, hp)
 
 
 def _heave_link(link: HeaveLink, corners: dict[str, Geometry], spec, hp) -> list:
-    """The heave link, measured only: its end on each corner's rocker (no rows)."""
-    _side_points(link.side_points, corners, "heave_link_", hp)
+    """The heave link, measured only: its end on each of its corners' rockers (no rows)."""
+    own = {label: corners[label] for label in link.labels}
+    _side_points(link.side_points, own, "heave_link_", hp)
     if link.kind != "none":
-        for label in corners:
+        for label in own:
             p = Assembly.prefix(label)
             spec.parts[f"{p}rocker"].append(f"{p}heave_link_rocker")
     return []
@@ -446,12 +451,12 @@ def _side_points(side_points: dict, corners, start: str, hp) -> None:
         hp.update({p + n: v for n, v in side_points[label].items() if n.startswith(start)})
 
 
-def _no_bar(axle, corners, spec, hp) -> list:
+def _no_bar(bar, corners, spec, hp) -> list:
     """No anti-roll bar: nothing joins the sides but the rack."""
     return []
 
 
-def _u_bar(axle, corners, spec, hp) -> list:
+def _u_bar(bar, corners, spec, hp) -> list:
     """Each side's bar arm is a part of three points: the bar's axis ends, fixed on
     the chassis, and the arm's end, which keeps its distance to both (it turns on a
     circle about the axis). A rigid droplink joins each arm's end to
@@ -459,20 +464,20 @@ def _u_bar(axle, corners, spec, hp) -> list:
     the body named by ``anti_roll.mount`` (``arm``: the wheel's body).
 
     A rigid bar (``stiffness: rigid``) is one part on the axis (:func:`_rigid_bar`)."""
-    axis = ("arb_u_bar_axis_a", "arb_u_bar_axis_b")
+    axis = bar.u_axis
     sides = [Assembly.prefix(label) for label in corners]
     ends = [f"{p}droplink_u_bar" for p in sides]
     spec.fixed.update(axis)
-    if axle.anti_roll_rigid:
-        _rigid_bar(axis, ends, spec, hp)
+    if bar.axle.anti_roll_rigid:
+        _rigid_bar(bar.prefix, axis, ends, spec, hp)
     else:
         for p in sides:
             spec.parts[f"{p}arb_arm"] = [*axis, f"{p}droplink_u_bar"]
-    _droplinks(axle, corners, "droplink_u_bar", spec)
+    _droplinks(bar, corners, "droplink_u_bar", spec)
     return []
 
 
-def _t_bar(axle, corners, spec, hp) -> list:
+def _t_bar(bar, corners, spec, hp) -> list:
     """The crossbar's ends and the pivot ``arb_t_bar_pivot`` (fixed: a ball) are one
     part, a rigid triangle; one plane row holds the crossbar's midpoint in y = 0 (at
     its design y, which the axle's check keeps within 0.02 mm of it); a rigid
@@ -482,42 +487,44 @@ def _t_bar(axle, corners, spec, hp) -> list:
     the chassis y axis through the pivot — the U-bar's rigid bar on that axis, its
     second point ``arb_t_bar_axis`` (the pivot moved along y as far as the left end
     is from it). Its midpoint then stays in its plane by itself."""
-    pivot = "arb_t_bar_pivot"
+    pivot = bar.pivot
     ends = [f"{Assembly.prefix(label)}droplink_t_bar" for label in corners]
     spec.fixed.add(pivot)
     planes = []
-    if axle.anti_roll_rigid:
-        hp["arb_t_bar_axis"] = hp[pivot] + np.linalg.norm(hp[ends[0]] - hp[pivot]) * Y
-        spec.fixed.add("arb_t_bar_axis")
-        _rigid_bar((pivot, "arb_t_bar_axis"), ends, spec, hp)
+    if bar.axle.anti_roll_rigid:
+        second = f"{bar.prefix}arb_t_bar_axis"
+        hp[second] = hp[pivot] + np.linalg.norm(hp[ends[0]] - hp[pivot]) * Y
+        spec.fixed.add(second)
+        _rigid_bar(bar.prefix, (pivot, second), ends, spec, hp)
     else:
-        spec.parts["arb_t_bar"] = [pivot, *ends]
+        spec.parts[f"{bar.prefix}arb_t_bar"] = [pivot, *ends]
         planes.append(Midpoint(*ends, Y, 0.5 * (hp[ends[0]] + hp[ends[1]]) @ Y))
-    _droplinks(axle, corners, "droplink_t_bar", spec)
+    _droplinks(bar, corners, "droplink_t_bar", spec)
     return planes
 
 
-def _rigid_bar(axis, ends, spec, hp) -> None:
+def _rigid_bar(prefix: str, axis, ends, spec, hp) -> None:
     """A rigid bar turning about the fixed ``axis`` (two point names): one part of the
     axis, ``arb_bar_quarter`` — a point a quarter turn round from the last end — and
-    the ``ends``. The distance between two ends alike placed about the axis is at its
-    minimum, so alone it would not fix their relative turn (its gradient vanishes
-    there)."""
+    the ``ends`` (its names with the bar's ``prefix``). The distance between two ends
+    alike placed about the axis is at its minimum, so alone it would not fix their
+    relative turn (its gradient vanishes there)."""
     a, b = (hp[n] for n in axis)
     u = (b - a) / np.linalg.norm(b - a)
     end = hp[ends[-1]]
     foot = a + u * ((end - a) @ u)
-    hp["arb_bar_quarter"] = foot + np.cross(u, end - foot)
-    spec.parts["arb_bar"] = [*axis, "arb_bar_quarter", *ends]
+    hp[f"{prefix}arb_bar_quarter"] = foot + np.cross(u, end - foot)
+    spec.parts[f"{prefix}arb_bar"] = [*axis, f"{prefix}arb_bar_quarter", *ends]
 
 
-def _droplinks(axle, corners: dict[str, Geometry], end: str, spec) -> None:
+def _droplinks(bar, corners: dict[str, Geometry], end: str, spec) -> None:
     """Per corner a rigid link from the rocker's ``droplink_rocker`` (or
     ``droplink_lower`` on the body ``anti_roll.mount`` names) to the bar's point
     ``<label>_<end>``."""
+    axle = bar.axle
     for label, g in corners.items():
         side = Assembly.prefix(label)
-        if "droplink_rocker" in axle.side_points[label]:
+        if "droplink_rocker" in axle.side_points[bar.sides[label]]:
             upper, body = "droplink_rocker", "rocker"
         else:
             mount = axle.anti_roll_mount

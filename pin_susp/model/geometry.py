@@ -363,7 +363,7 @@ def parse_geometry(data: dict, r: Reader, sha: str | None) -> Geometry:
     from . import mechanisms
 
     for scope, (_, keys, needs) in OTHER_SCOPES.items() if isinstance(data, dict) else ():
-        declared = data.get("scope")
+        declared = r.choice(data.get("scope", "corner"), "scope", (*SCOPES, "vehicle"))
         for key in (k for k in keys if k in data and declared != scope):
             r.fail("scope", needs.format(key=key))
     r.mapping(data, "", required=("hardpoints",), optional=CORNER_KEYS)

@@ -7,7 +7,9 @@ rod body hung from its inboard end on a universal joint (two hinges normal
 to the rod) whose outboard end is connected — two freedoms and three
 equations leave exactly the one distance equation, with no free spin.
 Everything sits under one joint-less ``chassis`` body (Pinocchio's MJCF
-parser reads the first subtree only).
+parser reads the first subtree only); a floating one (a vehicle's body,
+``Tree.floating``) is on a ``<freejoint>`` above the road, a ``plane`` geom at
+z = 0 that the tyres touch.
 
 It simulates as written (docs/urdf.md): every body has the URDF's mass and
 inertia (a closure's rod the mass of its drawn rod), every joint the URDF's
@@ -57,6 +59,8 @@ STEERING_KV = 2e3  # N·s/m
 # constant 2 timesteps, MuJoCo's highest impedance). With its defaults (0.02 s,
 # 0.9…0.95) the example pushrod corner under 1.5 kN settles 158 mm off the statics.
 CLOSURE_SOLREF = "0.001 1"
+# The road under a floating body (a vehicle's): the plane z = 0, which only the tyres touch
+ROAD = {"type": "plane", "pos": "0 0 0", "size": "0 0 1", "rgba": "0.5 0.5 0.5 1"}
 CLOSURE_SOLIMP = "0.9999 0.9999 0.001 0.5 2"
 
 
@@ -81,10 +85,19 @@ def tree_to_mjcf(tree: Tree, comment: str = "") -> str:
     limits = joint_limits(steps, rates)
     masses = inertials(tree, steps)
     element, origin = {}, {}
+    floating = tree.floating
+    if floating is not None:  # the road under the floating body
+        ET.SubElement(world, "geom", ROAD | {"name": floating.road})
     for body in tree.bodies:
         if body.joint is None:
             element[body.name] = ET.SubElement(world, "body", {"name": body.name, "pos": "0 0 0"})
-            _inertial(element[body.name], PLACEHOLDER_MASS, np.zeros(3), _placeholder(), 0.0)
+            if floating is not None and floating.mass is not None:
+                inertial = (floating.mass, floating.center, floating.inertia)
+            else:
+                inertial = (PLACEHOLDER_MASS, np.zeros(3), _placeholder())
+            if floating is not None:
+                ET.SubElement(element[body.name], "freejoint", {"name": floating.joint})
+            _inertial(element[body.name], *inertial, 0.0)
             origin[body.name] = np.zeros(3)
     for s in steps:
         el = ET.SubElement(
@@ -118,6 +131,8 @@ def tree_to_mjcf(tree: Tree, comment: str = "") -> str:
     for v in tree.visuals:
         rgba = number_text(tree.materials[v.material])
         attrs = {"contype": "0", "conaffinity": "0", "group": "1", "rgba": rgba}
+        if floating is not None and v.material == "tyre":  # on the road
+            attrs |= {"contype": "1", "conaffinity": "1"}
         o = origin[v.body]
         if v.shape == "ball":
             attrs |= {
@@ -319,6 +334,8 @@ def _elements(root: ET.Element) -> dict[str, dict[str, tuple[str, ...]]]:
                 found["joint"].setdefault(
                     child.get("name", ""), ("of type", child.get("type", "hinge"))
                 )
+            elif child.tag == "freejoint":  # a floating root (a vehicle's body)
+                found["joint"].setdefault(child.get("name", ""), ("of type", "free"))
     for site in root.findall("./worldbody/site"):
         found["site"].setdefault(site.get("name", ""), ("on body", "world"))
     for equality in root.iter("equality"):

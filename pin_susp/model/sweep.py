@@ -28,7 +28,7 @@ AXES = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
 QUANTITIES = ("heave", "roll")  # an axle's own targets: heave mm, roll deg
 # a vehicle's (docs/vehicle.md): the body's pitch (deg), a corner's road height (mm,
 # ``corner:``), the steering wheel (deg)
-VEHICLE_QUANTITIES = ("pitch", "road_z", "steering_wheel")
+VEHICLE_QUANTITIES = ("pitch", "road_z", "steering_wheel", "rack")
 CORNERS = ("fl", "fr", "rl", "rr")  # a vehicle's corners
 
 

@@ -169,6 +169,39 @@ class Spring:
     side: str | None = None
 
 
+@dataclass(frozen=True)
+class FloatingBase:
+    """The root body floats: a vehicle's sprung body on the road (docs/urdf.md). The
+    URDF has no joint for it (its root link is the body: a robotics tool adds a floating
+    base); the MJCF puts it on a ``<freejoint>`` ``joint`` above a ``plane`` geom at
+    z = 0, the road. ``mass`` (kg, None: not given) at ``center`` (m, world at design)
+    with ``inertia`` (kg·m², about the centre, world axes): the URDF's link ``frame``
+    (a point of the root at the centre) carries it, so that the root link has none; the
+    MJCF's root body does."""
+
+    frame: str
+    center: np.ndarray
+    mass: float | None = None
+    inertia: np.ndarray | None = None
+    joint: str = "body_free"
+    road: str = "road"
+
+
+@dataclass(frozen=True)
+class BodyPose:
+    """Where a floating root (``FloatingBase``) is placed: its frame in the road's,
+    w = R·p + t — a vehicle's body at a step's heave, pitch and roll (docs/vehicle.md),
+    first among that step's targets for the validation's engines (their floating base
+    held there; validate/floating.py for an engine whose root is fixed)."""
+
+    rotation: np.ndarray
+    translation: np.ndarray
+
+    def to_road(self, points: dict) -> dict:
+        """Points in the body's frame (name → (3,) m) in the road's."""
+        return {n: self.rotation @ p + self.translation for n, p in points.items()}
+
+
 @dataclass
 class Tree:
     name: str
@@ -183,6 +216,8 @@ class Tree:
     spring: Spring | list[Spring] | None = None
     # <pin_susp:corner>'s attributes: a corner's, or an axle's (one per side)
     metadata: dict[str, str] | list[dict[str, str]] = field(default_factory=dict)
+    # the root floats (a vehicle's body), or None: the root is the world (a corner's chassis)
+    floating: FloatingBase | None = None
 
     def __post_init__(self):
         # A rod between coincident points (a strut bottom on the rocker axis) has

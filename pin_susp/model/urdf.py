@@ -13,14 +13,16 @@ the loop closures back. Conventions of the file:
 - loop closures are ``<pin_susp:loop_closure>`` elements (a namespace every
   URDF parser ignores), each with two ``<pin_susp:frame link=… xyz=…/>``;
 - every moving link has an ``<inertial>``: its drawn shapes as solids
-  (:func:`inertials`); the root has none (it is fixed to the world), and a
-  tree without visuals (a study's variants) is written without any;
+  (:func:`inertials`); the root has none (it is fixed to the world, or a floating
+  body's mass is on a point's link, ``tree.FloatingBase``), and a tree without
+  visuals (a study's variants) is written without any;
 - each joint's limits are what the wheel's and the rack's travel ask of it,
   to first order, with a margin (:func:`joint_limits`);
 - ``<pin_susp:corner>``, ``<pin_susp:spring>`` and
   ``<pin_susp:design_configuration>`` say which side, which tyre, which spring
   and which joint values are the design state (an axle: a corner and a spring
-  per side, each with its ``side``).
+  per side, each with its ``side``); ``<pin_susp:floating_base>`` that the root
+  link floats (a vehicle's body on the road).
 
 docs/urdf.md has the rules and their numbers.
 """
@@ -79,8 +81,11 @@ def tree_to_urdf(tree: Tree, comment: str = "") -> str:
     for v in tree.visuals:
         _visual(links[v.body], v, origin_of[v.body])
 
+    floating = tree.floating
     for name, (body, position) in tree.points.items():
-        ET.SubElement(robot, "link", {"name": name})
+        link = ET.SubElement(robot, "link", {"name": name})
+        if floating is not None and name == floating.frame and floating.mass is not None:
+            _inertial(link, floating.mass, floating.center, floating.inertia, position)
         _joint(robot, f"{body}_to_{name}", "fixed", body, name, position - origin_of[body])
         origin_of[name] = position
 
@@ -174,6 +179,10 @@ def _metadata(robot, tree: Tree, steps: list[Step], rates) -> None:
         attrs["preload"] = number_text([spring.preload])
         attrs["damping"] = number_text([spring.damping])
         ET.SubElement(robot, "pin_susp:spring", attrs)
+    if tree.floating is not None:  # the root is no world: a tool adds a floating base
+        root = next(b.name for b in tree.bodies if b.parent is None)
+        attrs = {"link": root, "mass_link": tree.floating.frame, "road_z": "0.0"}
+        ET.SubElement(robot, "pin_susp:floating_base", attrs)
     design = ET.SubElement(robot, "pin_susp:design_configuration")
     for s in steps:
         ET.SubElement(design, "pin_susp:joint", {"name": s.name, "value": "0.0"})

@@ -1,5 +1,6 @@
 """What the analyses ask every subject (README, How it works): the defaults of an
-Assembly's answers to setup, drawings and hardpoint sensitivities, for a corner; an
+Assembly's answers to its exported model and the validation's engines, setup,
+drawings and hardpoint sensitivities, for a corner; an
 axle's own answers are in axle_file.AxleAssembly. Kept apart from assembly.py, whose
 job is the subject's targets, sweep and columns.
 """
@@ -15,6 +16,40 @@ class AnalysesSurface:
     """The analyses' questions to an :class:`~pin_susp.subjects.assembly.Assembly`, with a
     corner's answers as the defaults (``labels``, ``corners``, ``source`` and
     ``solve_sweep`` are the Assembly's)."""
+
+    # -- the exported model and the validation's engines (urdf, mjcf, validate) ---
+
+    @property
+    def export_tree(self):
+        """The tree its URDF and MJCF are written from (docs/urdf.md): its model's own (a
+        vehicle's: its body floating, without the road and the body's joints)."""
+        return self.tree
+
+    @property
+    def export_urdf(self) -> str:
+        """The URDF ``pin-susp urdf`` writes and the Drake engine reads: its model's own."""
+        return self.urdf
+
+    def engine_steps(self, sweep) -> list[list] | None:
+        """Every step's targets as the validation's engines take them where its sweep's
+        own are not (validate/scopes.py reads those: a point's, an axle's heave and
+        roll): a vehicle's, its body's pose first (a BodyPose) and each target a
+        (point, unit direction, value m) in the road's frame. None: its sweep's."""
+        return None
+
+    def engine_moves(self, sweep) -> list[dict]:
+        """Every step's targets with each of its body's quantities moved a little (a
+        vehicle's heave, pitch and roll: quantity → (h, the steps at −2h, −h, +h, +2h)),
+        for the engines' rates along them: none."""
+        return [{} for _ in range(sweep.steps)]
+
+    def road_columns(self, road: dict, points: dict, columns: dict) -> dict:
+        """Its columns an engine's points give beyond the metric columns (name → (values
+        (1,), unit)), from ``road`` (the points where the engine solved them, m),
+        ``points`` (a Dual per label, as its sweep measures them; ``points.along``: the
+        wheel centres' rates along ``engine_moves``) and the metric ``columns``: none (a
+        vehicle's body: what the road sees, the rates along the body)."""
+        return {}
 
     # -- setup and sensitivity (setup.py, sensitivity.py, their commands) ----------
 
@@ -75,6 +110,28 @@ class AnalysesSurface:
     # whether it is drawn at a step of its sweep results too (draw --from-results), not
     # only at its design state
     drawn_at_steps: bool = False
+
+    # -- the 3D view and the drawings at rest (scene.py, drawing.py) ---------------
+
+    def design_results(self):
+        """Its results (every column) at its design state, one row: a corner's and an
+        axle's at ``q_design``, no sweep solved (a vehicle's on the road: its own)."""
+        from ..model.sweep import Sweep
+        from ..solve.solver import Solution
+
+        return self.sweep_results(Sweep([]), [Solution(self.q_design, True, 0, 0.0)])
+
+    @property
+    def q_rest(self):
+        """The configuration its view shows and its drawing draws at design: its
+        ``q_design`` (a vehicle's: its body on the road at heave, pitch and roll 0)."""
+        return self.q_design
+
+    def marker_places(self, results) -> dict:
+        """Where each of its markers (``markers``) is at every step of its results: name
+        → (n, 3) m in the world's frame (the road's, for a body on it), NaN where blank.
+        A corner has none."""
+        return {}
 
     # -- hardpoint sensitivities (sensitivity.py, its command) ---------------------
 

@@ -31,6 +31,9 @@ CHUNK = 10_000  # steps solved and written at a time by a streamed sweep
 Z = np.array([0.0, 0.0, 1.0])
 
 
+VEHICLE_QUANTITIES = ("pitch", "road_z", "steering_wheel", "rack")  # a body on the road's alone
+
+
 class Assembly(Composed, AnalysesSurface):
     """The surface :class:`~pin_susp.subjects.corner.Corner` and
     :class:`~pin_susp.subjects.axle.AxleModel` share.
@@ -102,6 +105,12 @@ class Assembly(Composed, AnalysesSurface):
     commands: tuple[str, ...] | None = None  # the commands that take it (None: every one)
     reports: bool = True  # whether ``pin-susp sweep --plot`` draws its report
     on_road: bool = False  # a body on the road: ``pin-susp attitude`` takes it (a vehicle)
+
+    @property
+    def article(self) -> str:
+        """ "an" before its noun (an axle), else "a"."""
+        return "an" if self.noun[0] in "aeiou" else "a"
+
     tree: object
     urdf: str
     output_points: list[str]
@@ -181,10 +190,13 @@ class Assembly(Composed, AnalysesSurface):
                 seen[what] = i
             if t.quantity is not None:
                 if t.quantity not in quantities:
+                    owner = "a vehicle's" if t.quantity in VEHICLE_QUANTITIES else "an axle's"
+                    takes = ", ".join(quantities) if quantities else "no quantity, only points"
                     raise InputError(
                         source,
                         f"targets[{i}].quantity",
-                        f"{t.quantity} is an axle's quantity: this geometry is one corner",
+                        f"{t.quantity} is {owner} quantity: this geometry is {self.article} "
+                        f"{self.noun} (it takes {takes})",
                     )
                 rows.append(quantities[t.quantity].row(self, i, t, source))
                 continue

@@ -414,6 +414,14 @@ class AxleAssembly(Assembly):
     drawing_views = ("front",)
     drawn_at_steps = True
 
+    def marker_places(self, results) -> dict:
+        """Its roll centre at each step (m, (n, 3); NaN where blank): y and z from the
+        ``roll_center_y``/``_z`` columns, x midway between the contact patches (the
+        front view it is found in)."""
+        x = 0.5 * (results["left_contact_patch_center_x"] + results["right_contact_patch_center_x"])
+        columns = [x, results["roll_center_y"], results["roll_center_z"]]
+        return {"roll_centre": 1e-3 * np.column_stack(columns)}
+
     @classmethod
     def as_drawn(cls, path, label: str | None = None) -> AxleAssembly:
         drawn = cls.__new__(cls)  # no model built: the setup surface alone

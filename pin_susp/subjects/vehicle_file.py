@@ -137,6 +137,7 @@ def load_vehicle(source) -> VehicleGeometry:
         dicts[key] = dict(value)
     brakes, drive = _brakes_and_drive(dicts["brakes"], dicts["drive"], r)
     tyres = _tyres(config.get("tyres"), r)
+    _masses(dicts["masses"], r)
     return VehicleGeometry(
         str(data.get("name", Path(name).stem)),
         axles["front"],
@@ -154,6 +155,22 @@ def load_vehicle(source) -> VehicleGeometry:
         sha,
         data,
     )
+
+
+MASSES = ("sprung", "unsprung_front", "unsprung_rear", "sprung_roll_inertia")
+
+
+def _masses(masses: dict, r: Reader) -> None:
+    """``vehicle_config.masses``: its keys known, each a number (kg, kg·m²), the sprung
+    mass and the roll inertia positive, the unsprung ones not negative — checked as the
+    file is read; the attitude asks for the ones it needs (analyses/attitude_file.py)."""
+    key = "vehicle_config.masses"
+    r.mapping(masses, key, optional=MASSES)
+    for name, value in masses.items():
+        if name in ("sprung", "sprung_roll_inertia"):
+            r.positive(value, f"{key}.{name}")
+        elif r.number(value, f"{key}.{name}") < 0:
+            r.fail(f"{key}.{name}", f"{value:g} kg is negative")
 
 
 def _tyres(given, r: Reader) -> dict | None:

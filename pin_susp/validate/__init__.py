@@ -138,7 +138,7 @@ def _engine_report(engine, scope, sweep, results, text, source, tolerance) -> En
     if missing:
         return missing
     if text is None:
-        text = tree_to_mjcf(scope.tree) if engine == "mujoco" else scope.subject.urdf
+        text = tree_to_mjcf(scope.tree) if engine == "mujoco" else scope.subject.export_urdf
         source = f"the {scope.kind}'s exported {fmt}"
     points, warnings = points_of(scope, sweep, text, source)
     report = compare(scope, results, points, engine, tolerance)

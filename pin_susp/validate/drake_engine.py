@@ -1,6 +1,8 @@
 """The Drake engine (README, How it works): the exported URDF in Drake's own parser,
 the closures and targets as constraints of its InverseKinematics, solved by IPOPT;
-the URDF checked to be the subject's.
+the URDF checked to be the subject's. A floating root (a vehicle's body: the URDF's
+root link, which Drake puts on a floating joint) is held at each step's pose by
+bounds on that joint's positions.
 """
 
 from __future__ import annotations
@@ -14,8 +16,9 @@ import numpy as np
 
 from ..analyses.pointwise import Along, as_target
 from ..errors import PinSuspError
+from ..model.tree import BodyPose
 from ..model.urdf import NAMESPACE, read_closures, tree_to_urdf
-from .engines import Warnings, target_rows, with_contact_patches
+from .engines import Warnings, richardson, target_rows, with_contact_patches
 from .scopes import scope_of
 
 # ---------------------------------------------------------------- Drake
@@ -97,10 +100,12 @@ class DrakeCorner:
 
         scope = scope_of(subject)
         root = next(b.name for b in scope.tree.bodies if b.parent is None)
+        floating = scope.tree.floating is not None
         self.plant = plant = MultibodyPlant(0.0)
         try:
             Parser(plant).AddModelsFromString(urdf_text, "urdf")
-            plant.WeldFrames(plant.world_frame(), plant.GetFrameByName(root))
+            if not floating:  # the root is the world; else Drake floats it
+                plant.WeldFrames(plant.world_frame(), plant.GetFrameByName(root))
             plant.Finalize()
         except (RuntimeError, ValueError) as exc:
             detail = " ".join(str(exc).replace("<literal-string>.urdf:", "line ").split())
@@ -109,7 +114,20 @@ class DrakeCorner:
         self.wrt = JacobianWrtVariable.kQDot
         self.context = plant.CreateDefaultContext()
         self.q_design = np.zeros(plant.num_positions())
+        # the floating root's positions (quaternion w x y z, then x y z) and the rest
+        self.base, self.moving = None, np.ones(plant.num_positions(), dtype=bool)
+        if floating:
+            body = plant.GetBodyByName(root)
+            self.root = body
+            if not body.is_floating_base_body():
+                raise PinSuspError(f"{source}: its root {root} does not float in Drake")
+            start = body.floating_positions_start()
+            self.base = slice(start, start + 7)
+            self.moving[self.base] = False
+            self.q_design[start] = 1.0  # the identity quaternion: the design place
         plant.SetPositions(self.context, self.q_design)
+        self.road = {}  # the points where the last solve put them
+        self.moved = {}  # its tangent along each of the body's quantities there (dq)
         for i in range(plant.num_frames()):
             f = plant.get_frame(FrameIndex(i))
             where = f.CalcPoseInWorld(self.context).translation()
@@ -177,14 +195,35 @@ class DrakeCorner:
             out.append(np.linalg.norm(d) if c.kind == "ball" else np.linalg.norm(d) - c.length)
         return np.array(out)
 
-    def program(self, targets):
+    def _placed(self, pose: BodyPose | None) -> np.ndarray:
+        """The design configuration with a floating root at ``pose`` (None: its design
+        place)."""
+        q = self.q_design.copy()
+        if pose is None or self.base is None:
+            if pose is not None:
+                raise PinSuspError("the URDF's root does not float: not this vehicle's")
+            return q
+        from pydrake.math import RigidTransform, RotationMatrix
+
+        self.plant.SetPositions(self.context, q)
+        self.plant.SetFreeBodyPose(
+            self.context,
+            self.root,
+            RigidTransform(RotationMatrix(np.asarray(pose.rotation)), pose.translation),
+        )
+        return self.plant.GetPositions(self.context).copy()
+
+    def program(self, targets, pose: BodyPose | None = None):
         """Drake's InverseKinematics of one step: the closures and the targets as its
         constraints (no cost: the system is square), joint limits left out as
-        pin_susp's solver has none."""
+        pin_susp's solver has none; a floating root's positions bounded to ``pose``."""
         from pydrake.math import RigidTransform, RotationMatrix
         from pydrake.multibody.inverse_kinematics import InverseKinematics
 
         ik = InverseKinematics(self.plant, with_joint_limits=False)
+        if self.base is not None:
+            held = self._placed(pose)[self.base]
+            ik.prog().AddBoundingBoxConstraint(held, held, ik.q()[self.base])
         for c in self.closures:
             if c.kind == "ball":
                 # anchor a, seen from b's link, is at anchor b
@@ -215,17 +254,23 @@ class DrakeCorner:
                 ik.prog().AddConstraint(self._target_constraint(t), [0.0], [0.0], ik.q())
         return ik
 
-    def solve(self, targets) -> dict | None:
+    def solve(self, targets, moves: dict | None = None) -> dict | None:
         """IPOPT from the design configuration; None unless it succeeds and Drake's
-        plant has every closure and target within DRAKE_RESIDUAL at its answer."""
+        plant has every closure and target within DRAKE_RESIDUAL at its answer. A
+        floating root: its points where solved kept as ``road``, returned with the root
+        back at its design place (the joints kept); ``moves``: the step's targets with
+        the body moved (Scope.step_moves), for the tangent along each (``moved``)."""
         from pydrake.solvers import IpoptSolver, SolverOptions
 
-        ik = self.program(targets)
+        pose = next((t for t in targets if isinstance(t, BodyPose)), None)
+        targets = [t for t in targets if t is not pose]
+        self.moved = {}
+        ik = self.program(targets, pose)
         solver = IpoptSolver()
         options = SolverOptions()
         for key, value in IPOPT_OPTIONS.items():
             options.SetOption(solver.solver_id(), key, value)
-        result = solver.Solve(ik.prog(), self.q_design, options)
+        result = solver.Solve(ik.prog(), self._placed(pose), options)
         q = result.GetSolution(ik.q())
         if not (result.is_success() and np.all(np.isfinite(q))):
             return None
@@ -233,13 +278,17 @@ class DrakeCorner:
         residual = np.r_[self._closure_residuals(), self._rows(targets)[0]]
         if not np.max(np.abs(residual), initial=0.0) < DRAKE_RESIDUAL:
             return None
+        self.road = {name: site.position(self).copy() for name, site in self.sites.items()}
+        self.moved = self._moved(q, targets, moves or {})
+        if self.base is None:
+            return self.road
+        q[self.base] = self.q_design[self.base]  # the root back at its design place
+        self.plant.SetPositions(self.context, q)
         return {name: site.position(self).copy() for name, site in self.sites.items()}
 
-    def rates(self, held, links, k: int) -> dict[str, np.ndarray]:
-        """At the solved pose: each point's rate along the k drivers, J·dq = e: the
-        closures' rows (a ball's three, a distance's one along the link) and the held
-        targets' rows; a driver that is a link's length (``links``: its two points)
-        is a 1 on its distance closure's row. NaN for a link no closure joins."""
+    def _closure_rows(self) -> tuple[list, dict]:
+        """The closures' rows of d residual / dq at the context's pose (a ball's three, a
+        distance's one along the link), and each distance closure's row by its links."""
         rows, link_row = [], {}
         for c in self.closures:
             Ja, Jb = c.a.jacobian(self), c.b.jacobian(self)
@@ -249,6 +298,53 @@ class DrakeCorner:
                 d = c.a.position(self) - c.b.position(self)
                 link_row[c.links] = len(rows)
                 rows.append(d @ (Ja - Jb) / np.linalg.norm(d))
+        return rows, link_row
+
+    def _moved(self, q: np.ndarray, targets, moves: dict) -> dict:
+        """At the solved pose q: dq per unit of each of the body's quantities, the others
+        held — J·dq = −∂r/∂s, the change of the targets' residuals as the floating root
+        moves with the joints held (Richardson differences over the moved poses; the
+        closures' rows do not change)."""
+        if not moves:
+            return {}
+        closures = self._closure_rows()[0]
+        J = np.array(closures + self._rows(targets)[1])
+        out = {}
+        for quantity, (h, moved) in moves.items():
+            residuals = []
+            for step in moved:
+                pose = next(t for t in step if isinstance(t, BodyPose))
+                shifted = q.copy()
+                shifted[self.base] = self._placed(pose)[self.base]
+                self.plant.SetPositions(self.context, shifted)
+                p = _Positions(self)
+                errors = [as_target(t).error(p) for t in step if t is not pose]
+                residuals.append(np.r_[np.zeros(len(closures)), errors])
+            dq = np.zeros(len(q))
+            dq[self.moving] = np.linalg.lstsq(
+                J[:, self.moving], -richardson(residuals, h), rcond=None
+            )[0]
+            out[quantity] = dq
+        self.plant.SetPositions(self.context, q)
+        return out
+
+    def along(self, hubs: dict) -> dict:
+        """Each wheel centre's z rate along the body's quantities (``moved``), at the
+        context's pose (the chassis frame): quantity → {label: m per m or rad}."""
+        return {
+            quantity: {
+                label: float((self.sites[hub].jacobian(self) @ dq)[2])
+                for label, hub in hubs.items()
+            }
+            for quantity, dq in self.moved.items()
+        }
+
+    def rates(self, held, links, k: int) -> dict[str, np.ndarray]:
+        """At the solved pose: each point's rate along the k drivers, J·dq = e: the
+        closures' rows (a ball's three, a distance's one along the link) and the held
+        targets' rows; a driver that is a link's length (``links``: its two points)
+        is a 1 on its distance closure's row. NaN for a link no closure joins."""
+        rows, link_row = self._closure_rows()
         first = len(rows)
         rows += self._rows(held)[1]
         rhs = np.zeros((len(rows), k))
@@ -258,7 +354,8 @@ class DrakeCorner:
             if frozenset(pair) in link_row:
                 rhs[link_row[frozenset(pair)], j] = 1.0
                 known.append(j)
-        dq = np.linalg.lstsq(np.array(rows), rhs, rcond=None)[0]
+        dq = np.zeros((len(self.moving), k))  # a floating root stays still
+        dq[self.moving] = np.linalg.lstsq(np.array(rows)[:, self.moving], rhs, rcond=None)[0]
         out = {}
         for name, site in self.sites.items():
             out[name] = np.full((k, 3), np.nan)
@@ -299,7 +396,7 @@ def drake_points(subject, sweep, urdf_text: str | None = None, source: str = "th
     """Drake's points at every step (None where it did not converge), quietly, as the
     subject's motion gives them; ``urdf_text`` defaults to the subject's own export."""
     scope = scope_of(subject)
-    text = scope.subject.urdf if urdf_text is None else urdf_text
+    text = scope.subject.export_urdf if urdf_text is None else urdf_text
     return scope.as_motion(drake_run(scope, sweep, text, source)[0])
 
 
@@ -309,9 +406,9 @@ def drake_run(scope, sweep, urdf_text: str, source: str):
     with quiet_drake() as counter:
         engine = DrakeCorner(urdf_text, scope, source)
         points = []
-        for targets in scope.step_targets(sweep):
+        for targets, moves in zip(scope.step_targets(sweep), scope.step_moves(sweep), strict=True):
             try:
-                at = engine.solve(targets)
+                at = engine.solve(targets, moves)
             except RuntimeError as exc:
                 detail = " ".join(str(exc).split())
                 raise PinSuspError(f"{source}: Drake failed on it: {detail}") from None
@@ -319,7 +416,7 @@ def drake_run(scope, sweep, urdf_text: str, source: str):
                 points.append(None)
                 continue
             rates = engine.rates(scope.held(at), scope.links, scope.drivers)
-            points.append(scope.duals(at, rates))
+            points.append(scope.duals(at, rates, engine.road, engine.along(scope.hubs)))
     return points, counter
 
 

@@ -26,15 +26,20 @@ def pointwise_run(scope, sweep) -> list[dict | None]:
     """The point-based formulation's points at every step, a Dual per label (the
     scope's form); None where it did not converge.
 
-    The rates: the tangent of its own equations, J·dx = e for the driver's row
+    Where the root floats (a vehicle's body), the points are solved in the body's frame,
+    the targets turned into it (Scope.fixed_root_targets), and placed on the road by the
+    step's pose. The rates: the tangent of its own equations, J·dx = e for the driver's row
     (the held target's, or the toe link's distance), solved in the least-squares
     sense (its rigid-part distances are redundant, the system is consistent);
     the points then move along dx (Richardson differences of the explicit point
-    formulas, error ~1e-12).
+    formulas, error ~1e-12). Along a floating body's heave, pitch and roll, the same
+    tangent with the change of its targets' residuals as the body moves (Richardson
+    differences of its targets at the step's moved poses, Scope.step_moves).
     """
     model = scope.pointwise()
     out = []
-    for targets in scope.step_targets(sweep):
+    for targets, moves in zip(scope.step_targets(sweep), scope.step_moves(sweep), strict=True):
+        targets, pose = scope.fixed_root_targets(targets)  # a floating body's: its frame
         x, residual = model.solve(targets)
         if not residual < 1e-12:
             out.append(None)
@@ -57,8 +62,25 @@ def pointwise_run(scope, sweep) -> list[dict | None]:
             for name in points:
                 d1, d2 = at[1][name] - at[-1][name], at[2][name] - at[-2][name]
                 rates[name][j] = (8.0 * d1 - d2) / (12.0 * h)
-        out.append(scope.duals(points, rates))
+        along = {}
+        J = model.jacobian(x, targets) if moves else None
+        for quantity, (step, moved) in moves.items():  # a vehicle's body: its own tangent
+            r = [model.residual(x, scope.fixed_root_targets(m)[0]) for m in moved]
+            dx = np.linalg.lstsq(J, -richardson(r, step), rcond=None)[0]
+            at = [model.points(x + s * h * dx) for s in (-2, -1, 1, 2)]
+            along[quantity] = {
+                label: float(richardson([a[hub][2] for a in at], h))
+                for label, hub in scope.hubs.items()
+            }
+        road = None if pose is None else pose.to_road(points)
+        out.append(scope.duals(points, rates, road, along))
     return out
+
+
+def richardson(values: list, h: float) -> np.ndarray:
+    """d/ds from the values at s − 2h, s − h, s + h, s + 2h: (8(f₁ − f₋₁) − (f₂ − f₋₂))/12h."""
+    f_2, f_1, f1, f2 = (np.asarray(v, dtype=float) for v in values)
+    return (8.0 * (f1 - f_1) - (f2 - f_2)) / (12.0 * h)
 
 
 def target_rows(engine, p, targets) -> tuple[list, list]:

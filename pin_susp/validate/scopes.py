@@ -1,7 +1,10 @@
 """What the engines need from a subject (README, How it works): its points, drivers,
 targets and columns, as one :class:`Scope` over the Assembly's labelled corners (a
 corner's one, labelled ``""``: its names unprefixed, its columns unsuffixed; an axle's
-``left`` and ``right``); the engines only see points and targets.
+``left`` and ``right``; a vehicle's ``fl`` … ``rr``); the engines only see points and
+targets. A subject whose exported root floats (a vehicle's body, docs/vehicle.md) has
+each step's body pose first among its targets (a BodyPose): the engines place their
+floating base there, and read its points back in the body's frame.
 """
 
 from __future__ import annotations
@@ -12,6 +15,7 @@ from ..analyses.pointwise import Along, PointwiseLinkage, Y, Z, labelled, sweep_
 from ..columns.metrics import METRICS
 from ..maths.jet import Dual
 from ..maths.jet import value as plain
+from .floating import in_body_frame
 
 RATE_METRICS = {m.name for m in METRICS if m.rates}
 
@@ -53,9 +57,15 @@ class Scope:
     def __init__(self, subject):
         self.subject = subject
         self.kind = subject.noun
-        self.tree = subject.tree
-        self.driver_columns = subject.driver_columns
-        self.drivers = len(set().union(*self.driver_columns.values()))
+        self.tree = subject.export_tree  # the exported model's, which the engines load
+        # the drivers' columns, counted without the subject's joints no driver moves (a
+        # vehicle's body: held in its rates, Composed.held_joints)
+        used = sorted(set().union(*subject.driver_columns.values()))
+        rank = {c: i for i, c in enumerate(used)}
+        self.driver_columns = {
+            label: [rank[c] for c in columns] for label, columns in subject.driver_columns.items()
+        }
+        self.drivers = len(used)
         self.links, self.wheels, self.racks = [], {}, []
         for label, g in subject.corners.items():
             p = subject.prefix(label)
@@ -75,10 +85,26 @@ class Scope:
 
     def step_targets(self, sweep) -> list[list]:
         """Every step's targets, as its sweep holds them (the rack at design if not
-        given): a point's by its label's prefix, its values absolute (m, rad)."""
+        given): a point's by its label's prefix, its values absolute (m, rad); where the
+        exported root floats, the body's pose first (Assembly.engine_steps)."""
+        steps = self.subject.engine_steps(sweep)
+        if steps is not None:
+            return steps
         targets = self.subject.held_sweep(sweep).targets
         design = self.subject.design_positions
         return [targets_at(targets, v, design) for v in sweep_values(targets, design)]
+
+    def step_moves(self, sweep) -> list[dict]:
+        """Every step's targets with the body's quantities moved (Assembly.engine_moves):
+        quantity → (h, the steps at −2h, −h, +h, +2h); none but a vehicle's."""
+        return self.subject.engine_moves(sweep)
+
+    def fixed_root_targets(self, targets: list) -> tuple[list, object]:
+        """One step's targets for an engine without a floating base (the point-based
+        one): in the body's frame where they place a floating body, with its pose
+        (floating.in_body_frame); else as they are, and None."""
+        radii = {prefix: radius for prefix, (radius, _) in self.wheels.items()}
+        return in_body_frame(targets, radii)
 
     def held(self, points: dict) -> list:
         """The drivers that targets hold, where the engine's pose is: each wheel
@@ -87,21 +113,26 @@ class Scope:
         held += [Along(inner, Y, float(points[inner][1])) for inner in self.racks[:1]]
         return held
 
-    def duals(self, points: dict, rates: dict) -> dict[str, dict[str, Dual]]:
+    def duals(
+        self, points: dict, rates: dict, road: dict | None = None, along: dict | None = None
+    ) -> StepPoints:
         """Each label's rates; for a rigid anti-roll bar none along a wheel's own height,
-        as the sweep writes none (one wheel cannot move with the other held)."""
+        as the sweep writes none (one wheel cannot move with the other held). ``road``:
+        the points where the engine solved them (default: ``points``); ``along``: each
+        wheel centre's rate along the body's quantities (``step_moves``)."""
         hub = np.array([np.nan if self.subject.anti_roll_rigid else 1.0])
         scale = {
             label: np.r_[hub, np.ones(len(columns) - 1)][:, None]
             for label, columns in self.driver_columns.items()
         }
-        return {
+        duals = {
             name: {
                 label: Dual(p[None], rates[name][columns][:, None] * scale[label])
                 for label, columns in self.driver_columns.items()
             }
             for name, p in points.items()
         }
+        return StepPoints(duals, points if road is None else road, along or {})
 
     def as_motion(self, points_per_step: list) -> list:
         """Every step's points (a Dual per label) as the subject's motion gives them
@@ -109,10 +140,12 @@ class Scope:
         own = self.subject.motion_points
         return [None if points is None else own(points) for points in points_per_step]
 
-    def columns(self, points: dict) -> dict:
+    def columns(self, points: StepPoints) -> dict:
         """Every metric column, computed from the points as the subject's sweep computes
-        them (Assembly.metric_columns_of)."""
-        return self.subject.metric_columns_of(points)
+        them (Assembly.metric_columns_of), then what the points where the engine solved
+        them give (Assembly.road_columns: a vehicle's camber to ground, ...)."""
+        columns = self.subject.metric_columns_of(points)
+        return columns | self.subject.road_columns(points.road, points, columns)
 
     def positions(self, points: dict) -> dict[str, np.ndarray]:
         first = self.subject.labels[0]
@@ -144,6 +177,19 @@ class Scope:
         rc = np.hypot(results["roll_center_y"][i], results["roll_center_z"][i])
         lever = max(1.0, rc / results["track"][i])
         return np.hypot(*(results[n][i] for n in self.ROLL_CENTRE[name])) * lever
+
+
+class StepPoints(dict):
+    """An engine's points at one step: name → {label: Dual}, in the subject's frame as
+    its sweep measures them (a vehicle's chassis frame); ``road``: name → (3,) m, where
+    the engine solved them (the road's frame; a corner's and an axle's the same);
+    ``along``: quantity → {label: its wheel centre's z rate along it, m per m or rad},
+    the body's quantities held by the engine's own tangent (a vehicle's; else none)."""
+
+    def __init__(self, points: dict, road: dict, along: dict | None = None):
+        super().__init__(points)
+        self.road = road
+        self.along = along or {}
 
 
 # the names the scopes had, one per kind of subject: now one Scope for every subject

@@ -1,7 +1,8 @@
-"""2D drawings of a corner and an axle, with matplotlib (Agg, no display).
+"""2D drawings of a corner, an axle and a whole car, with matplotlib (Agg, no display).
 
 ``subject_figure`` draws a subject as its views say: a corner's by
-``drawing_figure``, an axle's by ``axle_drawing_figure``.
+``drawing_figure``, an axle's by ``axle_drawing_figure``, a vehicle's by
+``vehicle_drawing_figure``.
 
 ``drawing_figure`` draws the corner in front and side view at its design
 state, with the instant-centre construction of the as-set corner: front view,
@@ -17,6 +18,10 @@ tyre is its silhouette: the two rim-edge circles, projected, cut at the road.
 ``axle_drawing_figure`` draws the axle in front view at design or at a pose
 (``axle_pose``: a step of its results), with each side's FVIC construction and
 the roll centre where the two contact-patch lines cross.
+
+``vehicle_drawing_figure`` draws a whole car at its design on the road: its side
+view (the left corners, the CG, each axle's SVIC and the lines from its contact patch
+meeting at the pitch centre) over each axle's front view.
 
 The instant-centre construction is ``drawing_centres.py``'s, the points' names
 placed by ``drawing_labels.py``. The drawings build on the model (``axle.py``, the
@@ -44,6 +49,7 @@ from .drawing_centres import (  # noqa: E402
     SIDE,
     in_mm,
     instant_centres,
+    pitch_centre_construction,
     roll_centre_construction,
 )
 from .drawing_centres import PARALLEL as PARALLEL  # noqa: E402 (its old address too)
@@ -54,9 +60,12 @@ def subject_figure(subject, labels: bool = False, at=None, caption: str = "desig
     """The drawing of a subject (an Assembly) in its views (``Assembly.drawing_views``):
     a corner's front and side view at its design state (``drawing_figure``); an axle's
     front view (``axle_drawing_figure``) at design or, ``at`` = (ResultsFile, step), at
-    a step of its results (``axle_pose``: for a subject ``drawn_at_steps``)."""
+    a step of its results (``axle_pose``: for a subject ``drawn_at_steps``); a whole
+    car's side view over its axles' front views (``vehicle_drawing_figure``)."""
     if "side" in subject.drawing_views:
         return drawing_figure(subject, labels=labels)
+    if "car side" in subject.drawing_views:
+        return vehicle_drawing_figure(subject, labels=labels)
     q = None
     if at is not None:
         q, caption = axle_pose(subject, *at)
@@ -246,12 +255,28 @@ def axle_drawing_figure(model, q=None, labels: bool = False, caption: str = "des
     roll centre further than that. ``labels``: the left corner's hardpoints and the
     bar's points named (the right corner is its mirror image), and a legend.
     """
+    fig, front = plt.subplots(figsize=(15, 7.5))
+    drawn, named = axle_front_view(front, model, q, caption)
+    fig.suptitle(model.name)
+    if labels:
+        more = [h for h in front.get_lines() if h.get_gid() == "heave_link"][:1]
+        left = _AxleSide(model, "left", model.positions(model.q_design if q is None else q))
+        _legend(fig, left, ghost=False, construction=drawn, tree=model.tree, more=more)
+    fig.tight_layout(rect=(0, 0.06 if labels else 0, 1, 1))
+    if labels:
+        label_points(fig, ((front, FRONT),), named)
+    return fig
+
+
+def axle_front_view(front, model, q=None, caption: str = "design state"):
+    """An axle's front view (``axle_drawing_figure``'s) drawn on the axes ``front`` at
+    ``q`` (default: its design state): whether its construction was drawn, and the
+    points (mm) its labels name (its left corner's hardpoints, the bar's points)."""
     from ..subjects.axle import SIDES
 
     q = model.q_design if q is None else q
     positions = model.positions(q)
     sides = {s: _AxleSide(model, s, positions) for s in SIDES}
-    fig, front = plt.subplots(figsize=(15, 7.5))
     views = ((front, FRONT),)
     _rods(views, _posed_visuals(model, q), model.tree.materials, 1.0, "-")
     for c in sides.values():
@@ -266,41 +291,142 @@ def axle_drawing_figure(model, q=None, labels: bool = False, caption: str = "des
     _view_axes(front, f"Front view: {caption}", "y [mm] (+ left, seen from the front)", True)
     drawn, keep = roll_centre_construction(front, model, q, sides)
     _fit_view(views, list(sides.values()), keep)
-    fig.suptitle(model.name)
-    if labels:
-        more = [h for h in front.get_lines() if h.get_gid() == "heave_link"][:1]
-        _legend(fig, sides["left"], ghost=False, construction=drawn, tree=model.tree, more=more)
-    fig.tight_layout(rect=(0, 0.06 if labels else 0, 1, 1))
-    if labels:
-        named = {n: in_mm(sides["left"])[n] for n in sides["left"].geometry.hardpoints}
-        named |= {n.removeprefix("left_"): p for n, p in extras.items() if n[:6] != "right_"}
-        label_points(fig, views, named)
-    return fig
+    named = {n: in_mm(sides["left"])[n] for n in sides["left"].geometry.hardpoints}
+    named |= {n.removeprefix("left_"): p for n, p in extras.items() if n[:6] != "right_"}
+    return drawn, named
 
 
-def _axle_links(views, model, positions, sides) -> None:
-    """The axle's own links: the bar's droplinks (its distance closures that are no
-    corner's), and the heave link between the rockers (thin: it only measures)."""
+def _axle_links(views, model, positions, sides, heave_link: bool = True) -> None:
+    """The links its corners share: the bar's droplinks (its distance closures that are
+    no corner's) of the corners drawn (``sides``: label → the corner drawn), and the
+    heave link between the rockers (thin: it only measures)."""
     from .view_parts import LINK
 
-    own = {f"{s}_{c.name}" for s, side in sides.items() for c in side.tree.closures}
+    own = {
+        f"{model.prefix(label)}{c.name}"
+        for label, g in model.corners.items()
+        for c in g.mechanism.tree(g).closures
+    }
+    drawn = tuple(model.prefix(label) for label in sides)
     bar = model.tree.materials.get("bar", (0.85, 0.75, 0.15, 1.0))[:3]
     for c in model.tree.closures:
-        if c.kind == "distance" and c.name not in own:
+        if c.kind == "distance" and c.name not in own and c.name.startswith(drawn):
             a, b = (positions[n] for n in c.points)
             _segment(views, a, b, "-", color=bar, lw=1.5, gid="droplink")
     ends = [f"{s}_heave_link_rocker" for s in sides]
-    if all(n in positions for n in ends):
+    if heave_link and all(n in positions for n in ends):
         colour = f"#{LINK[0]:06x}"
         a, b = (positions[n] for n in ends)
         _segment(views, a, b, "--", color=colour, lw=1.0, gid="heave_link", label="heave link")
 
 
+def vehicle_drawing_figure(car, labels: bool = False):
+    """A whole car at its design state on the road: its side view over each axle's
+    front view.
+
+    The side view (x–z, + forward to the right) draws the corners of its left side,
+    their wheels and the CG, each axle's SVIC and the line from its contact patch
+    through it; where the two meet, the pitch centre (``pitch_centre_construction``:
+    the car's ``pitch_center_x``, ``_z`` at design). Each axle's front view is its
+    axle drawing (``axle_front_view``) of that axle on its own posed at the car's
+    design step (``Vehicle.axles_at_design``): its roll centre is the car's. ``labels``:
+    the side view's hardpoints (prefixed by their corner) and each front view's left
+    corner named, and a legend."""
+    results = car.design_results()
+    positions = car.positions(car.q_rest)
+    fig = plt.figure(figsize=(16, 12))
+    grid = fig.add_gridspec(2, 2, height_ratios=(1.0, 1.1))
+    side = fig.add_subplot(grid[0, :])
+    left = {label: _AxleSide(car, label, positions) for label in car.labels}
+    left = {label: c for label, c in left.items() if c.geometry.sign > 0}
+    named = {}
+    for label, c in left.items():
+        named |= {f"{label}_{n}": in_mm(c)[n] for n in c.geometry.hardpoints}
+    keep = _car_side(side, car, positions, left, results)
+    panels = [((side, SIDE), named)]
+    drawn = False
+    for i, (end, (axle, q)) in enumerate(car.axles_at_design().items()):
+        front = fig.add_subplot(grid[1, i])
+        construction, own = axle_front_view(front, axle, q, f"the {end} axle at design")
+        drawn |= construction
+        panels.append(((front, FRONT), own))
+    side_view = (side, SIDE)
+    _fit_car(side_view, list(left.values()), keep, car)
+    fig.suptitle(f"{car.name}: side view (the left corners) and each axle's front view")
+    if labels:
+        first, more = _corners_legend(left.values())
+        _legend(fig, first, ghost=False, construction=True, tree=car.tree, more=more)
+    fig.tight_layout(rect=(0, 0.04 if labels else 0, 1, 1))
+    if labels:
+        for view, points in panels:
+            label_points(fig, (view,), points)
+    return fig
+
+
+def _corners_legend(corners) -> tuple:
+    """The legend's corner (the first) and the handles of the links the others have and
+    it has not (a rear's toe link): ``_legend``'s corner and ``more``."""
+    from matplotlib.lines import Line2D
+
+    from .view_parts import links, segments
+
+    first, *others = corners
+    seen = set(segments(first, first.design_positions))
+    more = []
+    for c in others:
+        for name in segments(c, c.design_positions):
+            if name not in seen and name != "steering_axis":
+                seen.add(name)
+                colour = f"#{links(c)[name][1]:06x}"
+                more.append(Line2D([], [], color=colour, lw=1.5, label=name.replace("_", " ")))
+    return first, more
+
+
+def _car_side(ax, car, positions, corners, results) -> list[np.ndarray]:
+    """The car's side view: the corners drawn (label → _AxleSide), their bars'
+    droplinks, the road, the CG and the pitch-centre construction; the points (mm)
+    the view should keep."""
+    views = ((ax, SIDE),)
+    prefixes = tuple(car.prefix(label) for label in corners)
+    visuals = [v for v in _posed_visuals(car, car.q_rest) if v.body.startswith(prefixes)]
+    _rods(views, visuals, car.tree.materials, 1.0, "-")
+    for c in corners.values():
+        _draw_corner(views, c, 1.0, "-")
+    _axle_links(views, car, positions, corners, heave_link=False)
+    ground = float(np.mean([in_mm(c)["contact_patch_center"][2] for c in corners.values()]))
+    ax.axhline(ground, color="0.5", lw=0.8, gid="road")
+    cg = car.body.cg * 1e3
+    ax.plot(cg[0], cg[2], "o", mfc="white", mec="0.1", ms=9, mew=1.5, gid="cg")
+    ax.plot(cg[0], cg[2], "+", color="0.1", ms=9, mew=1.5)
+    ax.annotate("CG", cg[[0, 2]], xytext=(7, 5), textcoords="offset points", fontsize=8)
+    _view_axes(ax, "Side view: design state", "x [mm] (+ forward)", centreline=False)
+    return [cg[[0, 2]], *pitch_centre_construction(ax, results, car.axle_labels)]
+
+
+def _fit_car(view, corners, keep, car) -> None:
+    """The side view's limits: the corners' tyres and points and the CG, with the pitch
+    centre where it is within a wheelbase of them; a line to a far SVIC runs off the
+    edge."""
+    ax, v = view
+    pts = np.vstack(
+        [tyre_outline(c, v) for c in corners]
+        + [np.array([p[list(v)] for p in in_mm(c).values()]) for c in corners]
+    )
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    reach = float(hi[0] - lo[0])
+    near = [q for q in keep if np.all(q > lo - reach) and np.all(q < hi + reach)]
+    pts = np.vstack([pts, *near]) if near else pts
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    pad = 0.04 * float(np.max(hi - lo)) + 30.0
+    ax.set_xlim(lo[0] - pad, hi[0] + pad)
+    ax.set_ylim(lo[1] - pad, hi[1] + pad)
+
+
 class _AxleSide(Assembly):
-    """One corner of an axle at a pose, read as the drawing reads a corner (an Assembly
-    of one corner, labelled ""): its geometry (as set), its own tree (the links drawn
-    between its points) and, as ``design_positions``, the pose's points (m) by the
-    corner's names."""
+    """One labelled corner of an axle or a vehicle at a pose, read as the drawing reads a
+    corner (an Assembly of one corner, labelled ""): its geometry (as set), its own tree
+    (the links drawn between its points) and, as ``design_positions``, the pose's points
+    (m) by the corner's names."""
 
     labels = ("",)
 
@@ -308,7 +434,8 @@ class _AxleSide(Assembly):
         g = model.corners[side]
         self.geometry, self.tree = g, g.mechanism.tree(g)
         self.corners = {"": g}
-        self.design_positions = {n: positions[f"{side}_{n}"] for n in model.point_names[side]}
+        prefix = model.prefix(side)
+        self.design_positions = {n: positions[prefix + n] for n in model.corner_points[side]}
 
 
 def _posed_visuals(model, q) -> list:

@@ -16,6 +16,12 @@ FRONT, SIDE = (1, 2), (0, 2)  # the world axes each view shows, in mm
 IC_FAR = 20_000.0  # mm from the wheel centre: beyond this an instant centre is noted, not drawn
 CONSTRUCTION = "#c2185b"  # instant-centre construction: a colour no body has
 PARALLEL = "arms parallel: instant centre at infinity"
+ANTI = {  # a car's anti columns (docs/vehicle.md), as its side view's note says them
+    "anti_dive_front": "anti-dive front",
+    "anti_lift_rear": "anti-lift rear (braking)",
+    "anti_squat_rear": "anti-squat rear",
+    "anti_lift_front": "anti-lift front (drive)",
+}
 
 
 def in_mm(c) -> dict[str, np.ndarray]:
@@ -129,13 +135,16 @@ def _roll_centre(cp: np.ndarray, ic: np.ndarray) -> float | None:
     return -cp[0] / run
 
 
-def _note(ax, text: str) -> None:
+def _note(ax, text: str, x: float = 0.02, ha: str = "left") -> None:
+    """A note in a box at the top of the view: its left side at ``x`` (of the axes'
+    width), or its middle with ``ha="center"``."""
     ax.text(
-        0.02,
+        x,
         0.98,
         text,
         transform=ax.transAxes,
         va="top",
+        ha=ha,
         fontsize=8,
         gid="ic_note",
         bbox={"facecolor": "white", "edgecolor": "0.7", "alpha": 0.85},
@@ -196,3 +205,67 @@ def roll_centre_construction(ax, model, q, sides) -> tuple[bool, list[np.ndarray
         ax.plot(*line.T, "-.", color=CONSTRUCTION, lw=0.9, gid=f"fvic_contact_patch_{s}")
     _note(ax, "\n".join(notes))
     return rc is not None or any(near for *_, near in lines.values()), [] if rc is None else [rc]
+
+
+def pitch_centre_construction(ax, results, ends: dict) -> list[np.ndarray]:
+    """A whole car's side view at a step of its results (row 0, mm, the chassis frame):
+    each axle's SVIC (``ends``: end → its corners' labels; the mean of their
+    ``svic_x_<c>``, ``svic_z_<c>``), the line from its contact patch (the mean of its
+    two) through it, and where the two lines meet, the pitch centre (``pitch_center_x``,
+    ``_z``: docs/vehicle.md). An SVIC at infinity (blank) or further than IC_FAR, or a
+    pitch centre blank or that far, is noted, not drawn. The points (mm) the view
+    should keep: the pitch centre, where drawn."""
+
+    def at(name):
+        return float(results[name][0]) if name in results.columns else np.nan
+
+    pc = np.array([at("pitch_center_x"), at("pitch_center_z")])
+    lines, notes = {}, []
+    for end, labels in ends.items():
+        cp = np.mean([[at(f"{c}_contact_patch_center_{k}") for k in "xz"] for c in labels], 0)
+        sv = np.mean([[at(f"svic_{k}_{c}") for k in "xz"] for c in labels], axis=0)
+        problem = _too_far(sv, cp, f"SVIC {end}")
+        if problem is None:
+            ax.plot(*sv, "o", color=CONSTRUCTION, ms=4, gid=f"svic_{end}")
+            ax.annotate(
+                f"SVIC {end}",
+                sv,
+                xytext=(4, -9),
+                textcoords="offset points",
+                fontsize=7,
+                color=CONSTRUCTION,
+            )
+            notes.append(f"SVIC {end}: x = {sv[0]:.0f} mm, z = {sv[1]:.0f} mm")
+        else:
+            notes.append(f"{end}: {problem}".replace("arms", "arms in side view", 1))
+        if np.all(np.isfinite(sv)):
+            lines[end] = (cp, sv, problem is None)
+    middle = np.mean([cp for cp, _, _ in lines.values()], axis=0) if lines else None
+    keep = []
+    if not np.all(np.isfinite(pc)):
+        notes.insert(0, "pitch centre: none (an SVIC at infinity, or the lines parallel)")
+        pc = None
+    elif (far := float(np.linalg.norm(pc - middle))) > IC_FAR:
+        notes.insert(0, f"pitch centre {far / 1e3:.0f} m away, not drawn")
+        pc = None
+    else:
+        ax.plot(*pc, "D", color=CONSTRUCTION, ms=6, gid="pitch_centre")
+        ax.annotate(
+            "PC", pc, xytext=(6, 5), textcoords="offset points", fontsize=8, color=CONSTRUCTION
+        )
+        x, z = np.round(pc) + 0.0
+        notes.insert(0, f"pitch centre: x = {x:.0f} mm, z = {z:.0f} mm")
+        keep.append(pc)
+    for end, (cp, sv, near) in lines.items():
+        ends_at = [0.0, 1.0] if near else [0.0]  # along CP (0) → SVIC (1)
+        if pc is not None:
+            ends_at.append(float((pc - cp) @ (sv - cp) / ((sv - cp) @ (sv - cp))))
+        if len(ends_at) == 1:  # a far SVIC, no pitch centre: towards it, a wheelbase long
+            ends_at.append(float(np.linalg.norm(middle - cp)) * 2 / float(np.linalg.norm(sv - cp)))
+        line = np.array([cp + t * (sv - cp) for t in (min(ends_at), max(ends_at))])
+        ax.plot(*line.T, "-.", color=CONSTRUCTION, lw=0.9, gid=f"pitch_line_{end}")
+    for name, said in ANTI.items():
+        if np.isfinite(value := at(name)):
+            notes.append(f"{said}: {value:.1f} %")
+    _note(ax, "\n".join(notes), 0.5, "center")  # between the axles: the corners at its sides
+    return keep

@@ -26,6 +26,12 @@ rocker. The roll centre is a marker, placed from an axle's results columns
 the contact patches) and hidden where they are blank. It is seen from the
 left side, and the ground is widened to the axle's track.
 
+A vehicle (docs/vehicle.md) is drawn on the road, the world of its model: each pose
+its full configuration, the body pitched and rolled as solved, its design (no sweep)
+with every wheel on the road (the subject's ``q_rest``). Its markers are each axle's
+roll centre, the pitch centre and the CG, from its results' columns put in the road's
+frame by the body's pose (the subject's ``marker_places``).
+
 Under a load case the members are coloured by their force (``force_colours.py``).
 What is drawn between the solved points, and the framing, is ``view_parts.py``'s
 (the 2D drawings draw them too); meshcat's server is ``meshcat_server.py``'s.
@@ -47,26 +53,28 @@ from .server import signals_held as signals_held
 from .view_parts import LINK as LINK  # what is drawn between points, by its old address
 from .view_parts import LINKS as LINKS
 from .view_parts import ROOT as ROOT
-from .view_parts import as_drawn, framing, links, outline, roll_centres, segments, sides
+from .view_parts import as_drawn, framing, links, outline, segments, sides
 from .view_parts import bounds as bounds
+from .view_parts import roll_centres as roll_centres  # an axle's, by its old address
 
 AXIS_COLOUR, PATCH_COLOUR = 0xE8C020, 0xE83070
 GHOST = [0.55, 0.55, 0.6, 0.35]
 GROUND_COLOUR, GROUND_OPACITY = 0xB4B4A8, 0.3
 GROUND_SIZE, GROUND_THICKNESS = 1.5, 0.002  # m: a square under the corner, its top at the CP
 GROUND_SPAN = 1.2  # ... or this times the width of what is drawn, if wider (an axle)
-MARKERS = {"roll_centre": (0x00D8F0, 0.025)}  # name: colour, radius (m)
+MARKERS = {  # name: colour, radius (m)
+    "roll_centre": (0x00D8F0, 0.025),  # an axle's
+    "roll_centre_front": (0x00D8F0, 0.025),  # a vehicle's axles'
+    "roll_centre_rear": (0x00D8F0, 0.025),
+    "pitch_centre": (0xA040F0, 0.03),
+    "cg": (0x202020, 0.03),
+}
 
 
 def design_results(model):
-    """A subject's results columns at its design state: one row, no sweep."""
-    from ..model.sweep import Sweep
-    from ..solve.solver import Solution
-
-    return model.sweep_results(Sweep([]), [Solution(model.q_design, True, 0, 0.0)])
-
-
-MARKED = {"roll_centre": roll_centres}  # a marker's place at each step, from the columns
+    """A subject's results columns at its design state, one row (its own
+    ``design_results``: a corner's and an axle's at q_design, a vehicle's on the road)."""
+    return model.design_results()
 
 
 def _rod_transform(p0: np.ndarray, p1: np.ndarray) -> np.ndarray:
@@ -127,9 +135,10 @@ class Scene:
             self.viewer[f"{ROOT}/{prefix}contact_patch"].set_object(
                 mg.Sphere(0.018), mg.MeshLambertMaterial(color=PATCH_COLOUR)
             )
-        # the markers (an axle's roll centre): where its design results put them
-        design = design_results(model) if model.markers else None
-        self.design_markers = {name: MARKED[name](design)[0] for name in model.markers}
+        # the markers (an axle's roll centre; a vehicle's roll and pitch centres, its
+        # CG): where its design results put them
+        places = model.marker_places(model.design_results()) if model.markers else {}
+        self.design_markers = {name: places[name][0] for name in model.markers}
         for name in self.design_markers:
             colour, radius = MARKERS[name]
             self.viewer[f"{ROOT}/{name}"].set_object(
@@ -145,7 +154,7 @@ class Scene:
         viz.initViewer(viewer=self.viewer, loadModel=False)
         kwargs = {} if colour is None else {"visual_color": colour}
         viz.loadViewerModel(f"{ROOT}/{name}", **kwargs)
-        viz.display(model.q_design)
+        viz.display(model.q_rest)
         return model, viz
 
     def _frame(self, models) -> None:
@@ -171,10 +180,8 @@ class Scene:
         )
         self.viewer["/Axes"].set_property("visible", False)
 
-        patches = [
-            self.model.design_positions[f"{prefix}contact_patch_center"][2]
-            for prefix, _ in sides(self.model)
-        ]
+        rest = self.model.positions(self.model.q_rest)  # a vehicle's: on the road
+        patches = [rest[f"{prefix}contact_patch_center"][2] for prefix, _ in sides(self.model)]
         ground = float(np.mean(patches))
         low, high = points.min(axis=0), points.max(axis=0)
         size = max(GROUND_SIZE, GROUND_SPAN * float(np.max(high[:2] - low[:2])))
@@ -200,7 +207,7 @@ class Scene:
         at the design state, where the design results put them. ``colours``:
         {node: rgb (0 to 1)} of members coloured by their force."""
         if q is None:
-            q = self.model.q_design
+            q = self.model.q_rest
             markers = self.design_markers if markers is None else markers
         target = self.viewer if viewer is None else viewer
         model, viz = self.robots[-1]

@@ -55,7 +55,8 @@ def run(args) -> int:
         raise InputError(
             str(args.geometry),
             "scope",
-            f"attitude takes a vehicle (scope: vehicle): a {kind.noun} has no body on the road",
+            f"attitude takes a vehicle (scope: vehicle): {article(kind.noun)} has no body on "
+            "the road",
         )
     car = load_subject(args.geometry)
     accelerations = load_accelerations(args.accelerations)
@@ -66,6 +67,11 @@ def run(args) -> int:
     if not args.quiet:
         _summary(args, results)
     return _failures(results)
+
+
+def article(noun: str) -> str:
+    """The noun with its indefinite article: "an axle", "a corner"."""
+    return f"{'an' if noun[0] in 'aeiou' else 'a'} {noun}"
 
 
 def _write(args, results, name: str) -> None:

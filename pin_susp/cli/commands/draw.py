@@ -1,5 +1,6 @@
 """`pin-susp draw`: front and side view of a corner at design, or an axle in front view
-(at design, or at a step of its sweep results with --from-results RESULTS.csv:STEP).
+(at design, or at a step of its sweep results with --from-results RESULTS.csv:STEP), or
+a whole car at design (its side view with the pitch centre, each axle's front view).
 
 `--at` names a step of a sweep YAML across the CLI (`urdf --at SWEEP.yaml:STEP`);
 draw's old `--at RESULTS.csv:STEP` still works, hidden from --help, with a one-line
@@ -22,7 +23,9 @@ DESCRIPTION = (
     "the centreline); a shimmed corner shows its drawn geometry dashed. An axle "
     "(scope: axle) is drawn in front view, both corners, each contact patch through its "
     "FVIC and the roll centre where the two lines cross; --from-results draws it at a "
-    "step of its sweep results."
+    "step of its sweep results. A vehicle (scope: vehicle) is drawn at design in side "
+    "view, each axle's contact patch through its SVIC to the pitch centre where the two "
+    "lines meet, over each axle's front view."
 )
 
 
@@ -76,9 +79,10 @@ def run(args) -> int:
         path, _, step = at.rpartition(":")
         if not path or not re.fullmatch(r"[0-9]{1,9}", step):
             raise PinSuspError(f"{option} {at}: expected RESULTS.csv:STEP, e.g. axle.csv:15")
-        if not subject_class(args.geometry).drawn_at_steps:  # before the file is read
+        kind = subject_class(args.geometry)
+        if not kind.drawn_at_steps:  # before the file is read
             raise PinSuspError(
-                f"{option}: {args.geometry} is a corner, drawn at its design state only"
+                f"{option}: {args.geometry} is a {kind.noun}, drawn at its design state only"
             )
     subject = load_subject(args.geometry)
     pose = None if at is None else (ResultsFile(path), int(step))

@@ -1,4 +1,4 @@
-"""`pin-susp urdf`: the corner (or axle) as URDF with its loop closures (docs/urdf.md);
+"""`pin-susp urdf`: the corner (axle, vehicle) as URDF with its loop closures (docs/urdf.md);
 --at SWEEP.yaml:STEP adds the joint values of that solved step as a YAML sidecar."""
 
 from __future__ import annotations
@@ -42,15 +42,19 @@ def run(args) -> int:
             raise PinSuspError(f"--at writes a sidecar beside the URDF: {args.output} is a stream")
         sidecar = Path(args.output).with_suffix(".pose.yaml")
         check_outputs(args, args.output, sidecar)
-    if args.at is not None and not subject_class(args.geometry).poses_at_steps:
-        raise PinSuspError("--at: not for an axle yet (a corner's URDF at a step only)")
-    corner = load_subject(args.geometry)  # an axle's: both corners on one chassis
+    kind = subject_class(args.geometry) if args.at is not None else None
+    if kind is not None and not kind.poses_at_steps:
+        article = "an" if kind.noun[0] in "aeiou" else "a"
+        raise PinSuspError(
+            f"--at: not for {article} {kind.noun} yet (a corner's URDF at a step only)"
+        )
+    corner = load_subject(args.geometry)  # an axle's: both corners on one chassis; a car's
     pose = _pose_at(corner, args.at) if args.at is not None else None
     if args.output is None:
-        sys.stdout.write(corner.urdf)
+        sys.stdout.write(corner.export_urdf)
         return 0
     with all_or_none():
-        write_text(corner.urdf, args.output)
+        write_text(corner.export_urdf, args.output)
         if pose is not None:
             import yaml
 

@@ -4,6 +4,8 @@ engine's verdict."""
 
 from __future__ import annotations
 
+import numpy as np
+
 from ...errors import PinSuspError
 from ..options import geometry_argument, positive
 from ..report import report_failures, step_list
@@ -14,7 +16,9 @@ DESCRIPTION = (
     "distances, scipy) and with MuJoCo (from the exported MJCF) and/or Drake (the exported "
     "URDF in Drake's own parser, its InverseKinematics solved by IPOPT); print the largest "
     "difference per column and engine; exit 1 where one exceeds the tolerance. GEOMETRY "
-    "is a corner or an axle (scope: axle: each side's columns, the axle's, the bar). "
+    "is a corner, an axle (scope: axle: each side's columns, the axle's, the bar) or a "
+    "vehicle (scope: vehicle: the engines' floating body placed at each step's heave, "
+    "pitch and roll, every corner's columns, what the road sees). "
     "MuJoCo and Drake are optional: pip install 'pin_susp[validate]'."
 )
 
@@ -105,6 +109,9 @@ def run(args) -> int:
             for r in reports
         )
         print(f"  {name:<{width}}{unit:>7}{cells}")
+    unchecked = _not_compared(results, reports, corner)
+    if unchecked:
+        print(f"  not compared (no engine computes them): {', '.join(unchecked)}")
     ok = report_failures(results, "are not compared") == 0
     for r in reports:
         if r.note:
@@ -146,6 +153,26 @@ def run(args) -> int:
                 f"{' and '.join(unsolved)} unconfirmed (nothing marked)"
             )
     return 0 if ok else 1
+
+
+def _not_compared(results, reports, subject) -> list[str]:
+    """The columns with values that no engine that ran compared (a rated spring's, a
+    vehicle's body pose and its rates along it), each corner's once (``_*``): none
+    where no engine ran."""
+    compared = set().union(*(set(r.differences) | r.not_compared for r in reports))
+    if not compared:
+        return []
+    points = {f"{p}_{axis}" for p in subject.output_points for axis in "xyz"}
+    suffixes = [subject.suffix(label) for label in subject.labels if label]
+    out = {}
+    for name in results.columns:
+        if name in compared or name in points or name == "step_index":
+            continue
+        if name.startswith("solver_") or np.isnan(results[name]).all():
+            continue
+        stem = next((name.removesuffix(s) for s in suffixes if name.endswith(s)), None)
+        out.setdefault(name if stem is None else f"{stem}_*", None)
+    return list(out)
 
 
 def _other_branch(r, subject) -> str:

@@ -1,5 +1,6 @@
-"""`pin-susp view`: the corner or axle in meshcat, live or as a self-contained HTML
-replay of its sweep, members coloured by force with --cases."""
+"""`pin-susp view`: the corner, axle or whole car (on the road) in meshcat, live or as a
+self-contained HTML replay of its sweep, a corner's or an axle's members coloured by
+force with --cases."""
 
 from __future__ import annotations
 
@@ -17,6 +18,8 @@ DESCRIPTION = (
     "its URL; with SWEEP, play the solved motion as an animation. --html writes the scene "
     "and animation as one HTML file that opens in a browser with no server. An axle file "
     "shows both corners, the anti-roll bar and the roll centre (hidden where it is blank). "
+    "A vehicle file shows the whole car on the road, pitched and rolled as solved, with "
+    "each axle's roll centre, the pitch centre and the CG. "
     "With --cases (and SWEEP), the members are coloured by their force under one load "
     "case at every frame: red tension, blue compression, grey zero, full colour at the "
     "largest |force| over the sweep; one replay per case (--case)."
@@ -43,14 +46,20 @@ def run(args) -> int:
 
     from ...io.atomic import write_text
     from ...model.sweep import load_sweep
-    from ...subjects.subject import load_subject
-    from ...viz.scene import Scene, force_caption, force_key, roll_centres, signals_held
+    from ...subjects.subject import load_subject, subject_class
+    from ...viz.scene import Scene, force_caption, force_key, signals_held
 
     check_outputs(args, args.html)
     if args.case is not None and args.cases is None:
         raise PinSuspError(f"--case {args.case}: needs --cases LOADS.yaml, the cases it names")
     if args.cases is not None and args.sweep is None:
         raise PinSuspError(f"--cases {args.cases}: needs a SWEEP, whose steps the forces are of")
+    if args.cases is not None:
+        kind = subject_class(args.geometry)  # a subject pin-susp loads takes
+        if kind.commands is not None and "loads" not in kind.commands:
+            raise PinSuspError(
+                f"--cases {args.cases}: a {kind.noun}'s forces (pin-susp loads) are not built yet"
+            )
     qs, results, markers, forces = None, None, None, None
     if args.cases is not None:  # a corner, its sweep and its forces under every case
         model, sweep, cases = load_inputs(args.geometry, args.sweep, args.cases)
@@ -75,7 +84,8 @@ def run(args) -> int:
         scene = Scene(model)
     try:  # an interrupt before the scene is served is one as in every command: 130, 143
         if results is not None:  # the scene's markers (an axle's roll centre) at each step
-            markers = {name: roll_centres(results) for name in scene.design_markers}
+            places = model.marker_places(results)
+            markers = {name: places[name] for name in scene.design_markers}
         colours, caption = None, ""
         if forces is not None:
             colours, scale = scene.force_colours(forces, case)

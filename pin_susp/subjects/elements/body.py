@@ -23,11 +23,12 @@ import numpy as np
 
 from ...constraints import JointTarget, PointTarget
 from ...errors import InputError
-from ...model.tree import Body, Joint
+from ...model.tree import Body, FloatingBase, Joint, Tree
 from . import rack
 
 JOINTS = ("body_heave", "body_pitch", "body_roll")
 ROAD = "road"
+CG = "cg"  # the exported model's frame at the CG, on the body (its sprung mass)
 Z = np.array([0.0, 0.0, 1.0])
 
 
@@ -36,7 +37,7 @@ class BodyOnRoad:
     rack per steering-wheel turn (None: no steering-wheel target); ``steer_sense``:
     +1 where the rack's travel to the left (+y) turns the car left."""
 
-    quantities = ("heave", "pitch", "roll", "road_z", "steering_wheel")
+    quantities = ("heave", "pitch", "roll", "road_z", "steering_wheel", "rack")
 
     def __init__(self, cg: np.ndarray, c_factor: float | None, steer_sense: float = 1.0):
         self.cg = np.asarray(cg, dtype=float)
@@ -69,6 +70,14 @@ class BodyOnRoad:
                     f"a vehicle's sweep gives the body's {name} exactly once "
                     f"(got {len(given)}): heave, pitch and roll fix the body on the road",
                 )
+        steering = [i for i, t in enumerate(targets) if t.quantity in ("steering_wheel", "rack")]
+        if len(steering) > 1:
+            raise InputError(
+                source,
+                f"targets[{steering[1]}]",
+                f"repeats targets[{steering[0]}]'s steering (the steering wheel or the rack: "
+                "one of them, once)",
+            )
         seen = set()
         for i, t in enumerate(targets):
             if t.quantity == "road_z":
@@ -89,7 +98,9 @@ class BodyOnRoad:
                 )
             return PointTarget(model.points[f"{t.side}_contact_patch_center"], Z)
         if not model.model.existJointName(rack.JOINT):
-            raise InputError(source, f"targets[{i}]", "steering_wheel: this vehicle has no rack")
+            raise InputError(source, f"targets[{i}]", f"{t.quantity}: this vehicle has no rack")
+        if t.quantity == "rack":  # its travel in the chassis frame: the rack's joint
+            return JointTarget(model.model, rack.JOINT)
         if self.c_factor is None:
             raise InputError(
                 source,
@@ -99,13 +110,15 @@ class BodyOnRoad:
         return JointTarget(model.model, rack.JOINT)
 
     def value(self, t) -> np.ndarray:
-        """A quantity target's values in SI: heave and road_z m, pitch and roll rad, the
-        steering wheel as the rack's travel (m)."""
+        """A quantity target's values in SI: heave, road_z and the rack's travel m, pitch
+        and roll rad, the steering wheel as the rack's travel (m)."""
         v = np.asarray(t.values, dtype=float)
-        if t.quantity in ("heave", "road_z"):
+        if t.quantity in ("heave", "road_z", "rack"):
             return v * 1e-3
         if t.quantity in ("pitch", "roll"):
             return np.radians(v)
+        if self.c_factor is None:  # the wheel centred (row: any other is refused)
+            return np.zeros_like(v)
         return self.steer_sense * v / 360.0 * self.c_factor * 1e-3
 
     def columns_of(self, model, points: dict, sides: dict) -> dict:
@@ -121,3 +134,28 @@ class BodyOnRoad:
         c, s = np.cos(pitch), np.sin(pitch)
         x, z = c * x + s * z, -s * x + c * z  # R_y
         return np.stack([x, y, z + heave], axis=1) + self.cg
+
+    def placement(self, heave: float, pitch: float, roll: float) -> tuple:
+        """The body's frame in the road's at its pose (m, rad): (R, t), w = R·p + t, with
+        R = R_y(θ)·R_x(φ) and t = c + h·ẑ − R·c (``to_world``'s)."""
+        c, s = np.cos(roll), np.sin(roll)
+        rx = np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+        c, s = np.cos(pitch), np.sin(pitch)
+        ry = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+        rotation = ry @ rx
+        return rotation, self.cg + heave * Z - rotation @ self.cg
+
+    def exported(self, tree: Tree, mass: float | None = None, inertia=None) -> Tree:
+        """The tree as the URDF and MJCF export it (docs/urdf.md): without the road and
+        the body's three joints — the chassis its root, floating (``Tree.floating``: a
+        robotics tool's free-flyer, MuJoCo's freejoint) — and a point ``cg`` on it at the
+        CG that carries the sprung ``mass`` (kg, None: none given) and ``inertia``."""
+        ours = {ROAD, JOINTS[0], JOINTS[1]}
+        bodies = [
+            replace(b, parent=None, joint=None) if b.name == "chassis" else b
+            for b in tree.bodies
+            if b.name not in ours
+        ]
+        points = dict(tree.points) | {CG: ("chassis", self.cg.copy())}
+        base = FloatingBase(CG, self.cg.copy(), mass, inertia)
+        return replace(tree, bodies=bodies, points=points, floating=base)
