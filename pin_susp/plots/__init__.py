@@ -25,6 +25,14 @@ An axle's results (per-side columns, ``roll``, ``heave``) give the axle report
 rack travel — what the sweep varied, the step when it varied several — and
 Ackermann against the mean steer angle when the rack moved.
 
+A vehicle's results (its corners labelled fl, fr, rl, rr; the body's ``heave``,
+``pitch``, ``roll``) give the vehicle report (``vehicle_panels``, docs/vehicle.md): a
+line per corner (the front solid, the rear dashed, the left and the right a colour
+each) and per axle, and the whole car's roll axis, pitch centre, anti % and wheelbase,
+against heave, pitch, roll, the steering wheel (the rack without a c-factor) or a road
+height under some corners (warp) — the step when several moved. An attitude's results
+(``pin-susp attitude``: a row per acceleration) are refused: their plot is its --plot.
+
 A forces CSV (``pin-susp loads``: a ``load_case`` column, a row per step and
 case) gives the force report (``force_figure``): a panel per member (the
 two-force members, the spring, the rack) and per joint (the magnitude of its
@@ -39,8 +47,8 @@ instant-centre construction — are ``drawing.py``.
 
 The package: ``results_file`` (a results file read back), ``axes`` (what every
 report's panels share: labels, the x axis, spans, grid, header), ``kinematics`` (the
-kinematics report), ``axle_panels``, ``forces`` (the force report), ``output`` (the
-image file).
+kinematics report), ``axle_panels``, ``vehicle_panels``, ``forces`` (the force report),
+``output`` (the image file).
 """
 
 # ruff: noqa: E402, F401, F811 (the backend chosen first; the package's names, importable as before)
@@ -63,6 +71,7 @@ from .axes import (
     RACK_X,
     RELATIVE_SPAN,
     STEP_X,
+    VEHICLE_X,
     WHEEL_X,
     Panel,
     combined_note,
@@ -87,12 +96,13 @@ from .forces import (
 )
 from .kinematics import panels, report_figure
 from .output import check_image_path, save_figure
-from .results_file import DERIVED, DRAWABLE, EXTRA, TEXT, ResultsFile
+from .results_file import DERIVED, DRAWABLE, EXTRA, TEXT, VEHICLE_CORNERS, ResultsFile
+from .vehicle_panels import VEHICLE_PANELS, vehicle_panels
 
 
 def plot_results(results, path, label: str | None = None) -> None:
-    """``Results.plot``: the standard report of a results table (a sweep's, an axle's or
-    member_forces') drawn from its CSV text, as ``pin-susp plot`` draws the file, into
+    """``Results.plot``: the standard report of a results table (a sweep's, an axle's, a
+    vehicle's or member_forces') drawn from its CSV text, as ``pin-susp plot`` draws the file, into
     an image file (format from its ending). ``label``: the name in the title (default:
     the sweep file's). A PinSuspError when no step converged, before any drawing."""
     from ..io.tables import csv_text

@@ -1,5 +1,6 @@
 """What every report's panels share: the columns' labels, the x axis (what the sweep
-moved), the panels' y spans (MIN_SPAN), their grid, the header and the colours.
+moved: a corner's, an axle's or a vehicle's inputs), the panels' y spans (MIN_SPAN), their
+grid, the header and the colours.
 """
 
 from __future__ import annotations
@@ -11,7 +12,7 @@ import numpy as np
 
 from ..columns.metrics import METRIC_BY_NAME, Derivative
 from ..errors import InputError
-from .results_file import ResultsFile
+from .results_file import VEHICLE_CORNERS, ResultsFile
 
 LABELS = {  # columns the registry does not hold
     "motion_ratio": "Motion ratio",
@@ -45,6 +46,17 @@ AXLE_X = {
     "rack travel": RACK_X,
 }
 
+# a vehicle's sweep (docs/vehicle.md, "The sweep"), by what it moved, in this order; the
+# steering by the steering wheel's angle (the rack's travel without a c-factor), and a
+# road's height under some corners (warp: ROAD) after
+VEHICLE_X = {
+    "heave": ("heave", "Heave of the body at the CG (+ up) [mm]"),
+    "pitch": ("pitch", "Pitch (+ nose down) [deg]"),
+    "roll": ("roll", "Roll (+ right side down) [deg]"),
+    "steering": ("steering_wheel_angle", "Steering wheel angle (+ turning left) [deg]"),
+}
+ROAD = "contact_patch_road_z_"  # + a corner: the road's height under it, as solved
+
 
 # a sweep that moved two inputs or more (a combined bump + steer, a roll at a steer):
 # no one input is its x, so every panel is drawn against the step and the inputs
@@ -55,7 +67,17 @@ STEP_X = ("step_index", "Step ({} move together)")
 def moved(results: ResultsFile) -> list[str]:
     """What the sweep moved, in order: a corner's 'wheel travel', 'rack travel'; an
     axle's 'roll', 'heave', 'rack travel'. Read from the results: an input held (a
-    rack held at centre, a roll at a fixed heave) is not moved."""
+    rack held at centre, a roll at a fixed heave) is not moved. A vehicle's: 'heave',
+    'pitch', 'roll', 'steering', and 'road height (fr, rl)' for the corners whose road
+    rose together (each its own input where they moved apart)."""
+    if results.vehicle:
+        out = [k for k, (x, _) in VEHICLE_X.items() if k != "steering" and varies(results[x])]
+        if any(
+            n in results.columns and varies(results[n])
+            for n in ("steering_wheel_angle", "rack_displacement")
+        ):
+            out.append("steering")
+        return out + road_inputs(results)
     if results.axle:
         return [k for k, (x, _) in AXLE_X.items() if x in results.columns and varies(results[x])]
     out = ["wheel travel"] if varies(results["wheel_travel"]) else []
@@ -67,16 +89,53 @@ def moved(results: ResultsFile) -> list[str]:
     return out
 
 
+def road_inputs(results: ResultsFile) -> list[str]:
+    """A vehicle's road heights that moved: 'road height (fr, rl)' for corners whose
+    road rose together (to 1e-6 mm at every step), one input per group."""
+    rising = [c for c in VEHICLE_CORNERS if has_values(results, ROAD + c)]
+    rising = [c for c in rising if varies(results[ROAD + c])]
+    groups: list[list[str]] = []
+    for corner in rising:
+        column = results[ROAD + corner]
+        same = next(
+            (
+                g
+                for g in groups
+                if np.allclose(column, results[ROAD + g[0]], rtol=0.0, atol=1e-6, equal_nan=True)
+            ),
+            None,
+        )
+        if same is None:
+            groups.append([corner])
+        else:
+            same.append(corner)
+    return [f"road height ({', '.join(g)})" for g in groups]
+
+
 def sweeps(results: ResultsFile) -> str | None:
-    """What the sweep moved: 'wheel travel', 'rack travel', several joined by 'and'
+    """What the sweep moved: 'wheel travel', 'rack travel', several joined ('a, b and c')
     (a combined sweep), or None (nothing: one step); an axle's: 'roll', 'heave',
-    'rack travel'."""
-    return " and ".join(moved(results)) or None
+    'rack travel'; a vehicle's: 'heave', 'pitch', 'roll', 'steering', 'road height
+    (fr, rl)'."""
+    return joined(moved(results)) or None
+
+
+def joined(words: list[str]) -> str:
+    """'a', 'a and b', 'a, b and c'."""
+    return " and ".join(w for w in (", ".join(words[:-1]), words[-1] if words else "") if w)
 
 
 def input_column(results: list[ResultsFile], kind: str) -> tuple[str, str]:
     """The column (and its axis label) that records an input ('wheel travel', 'roll',
     ...) in these files: the rack from centre, or the absolute rack of old files."""
+    if results[0].vehicle:
+        if kind.startswith("road height ("):
+            corners = kind.removeprefix("road height (").removesuffix(")").split(", ")
+            where = joined(corners)
+            return ROAD + corners[0], f"Road height under {where} (+ up) [mm]"
+        if kind == "steering" and not all(has_values(r, VEHICLE_X[kind][0]) for r in results):
+            return RACK_X  # no c-factor: the rack's travel
+        return VEHICLE_X[kind]
     if results[0].axle:
         return AXLE_X[kind]
     if kind == "wheel travel":
@@ -88,7 +147,8 @@ def input_column(results: list[ResultsFile], kind: str) -> tuple[str, str]:
 
 def x_axis(results: ResultsFile | list[ResultsFile]) -> tuple[str, str]:
     """The x column and label: what the sweep moved (wheel travel, rack travel from
-    centre; an axle's roll, heave, rack), or the step when it moved several inputs.
+    centre; an axle's roll, heave, rack; a vehicle's heave, pitch, roll, steering wheel,
+    a road height), or the step when it moved several inputs.
 
     Several files must have moved the same thing, else an InputError naming
     two that differ (a file where nothing moved goes with any).
@@ -105,7 +165,7 @@ def x_axis(results: ResultsFile | list[ResultsFile]) -> tuple[str, str]:
             )
     if first is not None and len(moved(first)) > 1:
         return STEP_X[0], STEP_X[1].format(first_kind)
-    default = "roll" if files[0].axle else "wheel travel"
+    default = "roll" if files[0].axle or files[0].vehicle else "wheel travel"
     return input_column(files, first_kind or default)
 
 
@@ -290,7 +350,7 @@ def combined_note(results: list[ResultsFile], xname: str) -> str:
         finite = r[column][np.isfinite(r[column])]
         parts.append(f"{kind} {finite[0]:.4g} → {finite[-1]:.4g} {unit}".rstrip())
     return (
-        f"A combined sweep: {' and '.join(parts)} move together. Every panel is drawn "
+        f"A combined sweep: {joined(parts)} move together. Every panel is drawn "
         "against the step (the inputs first): a curve shows what both inputs do at once, "
         "not a gain along one."
     )

@@ -1,5 +1,6 @@
 """The kinematics report: a panel per metric against what the sweep moved, several
-results files as several lines; an axle's and a forces file's reports chosen here.
+results files as several lines; an axle's, a vehicle's and a forces file's reports
+chosen here.
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ from .axes import (
 from .axle_panels import axle_panels
 from .forces import force_figure
 from .results_file import DERIVED, EXTRA, ResultsFile
+from .vehicle_panels import vehicle_panels
 
 
 def panels(results: list[ResultsFile], xname: str) -> list[str]:
@@ -40,11 +42,14 @@ def panels(results: list[ResultsFile], xname: str) -> list[str]:
 def report_figure(results: list[ResultsFile]):
     """One panel per metric against what the sweep moved, one line (and one colour) per
     results file, a legend of the files; a sweep that moved several inputs against the
-    step, its inputs drawn first. An axle's results: the axle report (``axle_panels``)."""
+    step, its inputs drawn first. An axle's results: the axle report (``axle_panels``); a
+    vehicle's: the vehicle report (``vehicle_panels``)."""
     if not results:
         raise PinSuspError("no results file to plot")
     if all_of(results, "forces", "a sweep's results", "holds forces (pin-susp loads)"):
         return force_figure(results)
+    odd = next((r for r in results if not r.vehicle), results[0])
+    vehicle = all_of(results, "vehicle", f"{odd.kind} results", "is a vehicle's")
     axle = all_of(results, "axle", "a corner's results", "is an axle's")
     xname, xlabel = x_axis(results)
     for r in results[1:]:
@@ -55,7 +60,10 @@ def report_figure(results: list[ResultsFile]):
                 f"no values, but {results[0].label} is plotted against it: "
                 "plot results of the same kind of sweep together",
             )
-    if axle:
+    if vehicle:
+        drawn = vehicle_panels(results, xname, xlabel)
+        title = "pin_susp vehicle kinematics: "
+    elif axle:
         drawn = axle_panels(results, xname, xlabel)
         title = "pin_susp axle kinematics: "
     else:
@@ -67,7 +75,7 @@ def report_figure(results: list[ResultsFile]):
     drawn = input_panels(results, xname) + drawn
     fig = grid(drawn)
     handles = []
-    if not axle and len(results) > 1:  # the axle's panels name file and side themselves
+    if not (axle or vehicle) and len(results) > 1:  # theirs name file and side themselves
         from matplotlib.lines import Line2D
 
         handles = [

@@ -1,5 +1,5 @@
-"""A results file read back for the reports (a sweep's, an axle's, a forces CSV): its
-columns, units and what it is; anything pin_susp could not have written refused.
+"""A results file read back for the reports (a sweep's, an axle's, a vehicle's, a forces
+CSV): its columns, units and what it is; anything pin_susp could not have written refused.
 """
 
 from __future__ import annotations
@@ -35,6 +35,10 @@ TEXT = ("load_case",)  # columns of names, not numbers
 # matplotlib's tick arithmetic (±8e307 already does); pin_susp's own columns stay far
 # below (an instant centre is blank, not huge, when the arms are parallel)
 DRAWABLE = 1e300
+# a whole car's corners (docs/vehicle.md, "The file"): its results carry their suffixes
+VEHICLE_CORNERS = ("fl", "fr", "rl", "rr")
+# the columns of pin-susp attitude's results (docs/vehicle.md, "Attitude under acceleration")
+ATTITUDE = {"ax", "ay", "equilibrium_residual"}
 
 
 class ResultsFile:
@@ -122,10 +126,25 @@ class ResultsFile:
         # the corners' labels its columns carry, as the subject wrote them: a corner
         # column's suffix (camber_left, camber_right), none for a corner's one ("")
         self.labels = corner_labels(self.columns)
-        # several corners' results (an axle's): the axle's own columns too, heave and roll
-        self.axle = self.labels != ("",)
-        travel, shape = ("heave", "roll") if self.axle else ("wheel_travel", "camber")
-        for needed in (travel, shape):
+        # a whole car's (docs/vehicle.md): its four corners fl, fr, rl, rr, the body's
+        # heave, pitch and roll; else several corners' (an axle's): heave and roll
+        self.vehicle = set(self.labels) == set(VEHICLE_CORNERS)
+        self.axle = self.labels != ("",) and not self.vehicle
+        self.kind = "a vehicle's" if self.vehicle else "an axle's" if self.axle else "a corner's"
+        if self.vehicle and ATTITUDE <= set(self.columns):
+            raise InputError(
+                source,
+                "",
+                "an attitude's results (a row per acceleration, not a sweep): its g-g plot "
+                "is pin-susp attitude --plot",
+            )
+        if self.vehicle:
+            travel, shape = "heave", ("pitch", "roll")
+        elif self.axle:
+            travel, shape = "heave", ("roll",)
+        else:
+            travel, shape = "wheel_travel", ("camber",)
+        for needed in (travel, *shape):
             if needed not in self.columns:
                 raise InputError(source, needed, "missing column: not a sweep results CSV")
         values = [c for n, c in self.columns.items() if n not in TEXT]
@@ -143,14 +162,18 @@ class ResultsFile:
 
 def corner_labels(columns) -> tuple[str, ...]:
     """The corners' labels a results table's columns carry, in their order: the suffix
-    of each camber column (``camber_left`` → ``left``), ``""`` for an unsuffixed one
-    (and for a table with no camber: a corner's, read as such)."""
+    of each camber column (``camber_left`` → ``left``; ``camber_to_ground_left`` is the
+    axle's, not a corner's), ``""`` for an unsuffixed one (and for a table with no
+    camber: a corner's, read as such)."""
     labels = tuple(
         name.removeprefix("camber").removeprefix("_")
         for name in columns
-        if name == "camber" or name.startswith("camber_")
+        if name == "camber" or (name.startswith("camber_") and not name.startswith(GROUND))
     )
     return labels or ("",)
+
+
+GROUND = "camber_to_ground"  # an axle's or a vehicle's column, not a corner's camber
 
 
 def _cell(text: str) -> float:

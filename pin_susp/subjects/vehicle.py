@@ -121,7 +121,7 @@ class Vehicle(VehicleExport, VehicleViews, VehicleAssembly):
         "setup",
         "sensitivity",
     )  # docs/vehicle.md: the rest not yet
-    reports = False
+    reports = True
     on_road = True
     summary_columns = tuple(
         "heave pitch roll steering_wheel_angle camber_fl camber_fr camber_rl camber_rr "

@@ -462,7 +462,7 @@ def axle_pose(model, results: ResultsFile, step: int) -> tuple[np.ndarray, str]:
 
     if not results.axle:
         raise InputError(
-            results.source, "", "a corner's results: an axle is drawn at a step of its own"
+            results.source, "", f"{results.kind} results: an axle is drawn at a step of its own"
         )
     rows = np.flatnonzero(results["step_index"] == step)
     if rows.size == 0:

@@ -1,5 +1,5 @@
-"""`pin-susp plot`: the standard kinematics report (a corner's, an axle's or a forces
-report) from one or more results files."""
+"""`pin-susp plot`: the standard kinematics report (a corner's, an axle's, a vehicle's or
+a forces report) from one or more results files."""
 
 from __future__ import annotations
 
@@ -15,8 +15,13 @@ DESCRIPTION = (
     "An axle's CSV gives the axle report: camber (to the chassis and to the ground), toe, "
     "steer angle, roll centre, bar twist, IC heights, rates, per side, against roll, "
     "heave or rack (the step when several moved), and Ackermann against the mean steer "
-    "angle. A forces CSV (pin-susp loads) gives the force report: each member's force and "
-    "each joint's load, a line per load case, a toggle's steps left as gaps. A column "
+    "angle. A vehicle's CSV gives the vehicle report: each corner's camber to ground, "
+    "camber, toe and wheel travel (the front solid, the rear dashed, left and right a colour "
+    "each), each axle's roll centre, track, bar twist and roll stiffness, the roll axis, "
+    "the pitch centre, the anti % and the wheelbase, against heave, pitch, roll, steering "
+    "or a road height (warp), the step when several moved. A forces CSV (pin-susp loads) "
+    "gives the force report: each member's force and each joint's load, a line per load "
+    "case, a toggle's steps left as gaps. A column "
     "that varies less than its unit's smallest span (0.5 mm, 0.05 deg, ...) is drawn "
     "flat, and labelled when constant."
 )

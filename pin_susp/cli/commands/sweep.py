@@ -30,7 +30,10 @@ def arguments(parser) -> None:
         parser,
         "results CSV",
         "also draw the standard kinematics report (an axle's: camber, toe, steer, roll "
-        "centre, bar twist, ... against roll, heave or rack)",
+        "centre, bar twist, ... against roll, heave or rack; a vehicle's: each corner's "
+        "camber to ground, camber and toe, the roll centres, roll axis, pitch centre, anti-dive, "
+        "-lift and -squat, wheelbase, bar twist, ... against heave, pitch, roll, steering or road "
+        "height)",
     )
 
 
