@@ -341,7 +341,7 @@ def test_bad_inputs_are_one_line_and_write_nothing(tmp_path, capsys):
     roll = str(EXAMPLES / "vehicle_roll.yaml")
     cases = (
         (["view", fs, str(sweep), "--html", str(html)], "heave exactly once"),
-        (["view", fs, roll, "--cases", str(loads), "--html", str(html)], "not built yet"),
+        (["view", fs, roll, "--cases", str(loads), "--html", str(html)], "a list of load cases"),
         (["draw", fs, "-o", str(png), "--from-results", "r.csv:3"], "is a vehicle, drawn at"),
         (["draw", fs, "-o", str(tmp_path / "car.txt")], "car.txt"),
     )
