@@ -561,7 +561,7 @@ def central(tmp_path, files, end, side, point, axis, columns, travel, steer, mir
 
 
 SENSITIVE = ("camber_fl", "roadwheel_angle_rl", "deriv_camber_wrt_hub_z_fr", "caster_rr",
-             "roll_center_z_front", "track_rear", "deriv_roll_center_z_wrt_roll_front",
+             "roll_center_z_front", "track_rear", "deriv_roll_center_z_wrt_axle_roll_front",
              "body_roll_rear", "pitch_center_x", "pitch_center_z", "anti_dive_front",
              "anti_lift_rear", "anti_squat_rear", "roll_axis_height_at_cg",
              "roll_axis_inclination")  # fmt: skip

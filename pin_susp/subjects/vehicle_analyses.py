@@ -16,7 +16,7 @@ import numpy as np
 from ..errors import InputError, PinSuspError
 from .assembly import Assembly
 from .axle_file import AXLE_COLUMNS, AxleAssembly, AxleReader
-from .elements.car_axle import SKIPPED
+from .elements.car_axle import car_column
 from .vehicle_file import AXLES, LABELS, axle_key, load_vehicle
 
 SIDE = {"fl": "left", "fr": "right", "rl": "left", "rr": "right"}  # its axle's side
@@ -236,14 +236,11 @@ class VehicleAssembly(Assembly):
 
     def pair_column(self, pair: tuple[str, str], name: str) -> str | None:
         """An axle's column as the vehicle's sweep names it (``track_front``,
-        ``deriv_roll_center_z_wrt_roll_front``); none of what the vehicle measures on the
+        ``deriv_roll_center_z_wrt_axle_roll_front``); none of what the vehicle measures on the
         road instead (camber to ground, the rates along the body's roll)."""
-        if name in SKIPPED or name in ROLL_RATES:
+        if name in ROLL_RATES:
             return None
-        for side, label in zip(("left", "right"), pair, strict=True):
-            if name.endswith(f"_{side}"):
-                return name.removesuffix(side) + label
-        return f"{name}_{END[pair[0]]}"
+        return car_column(name, pair, END[pair[0]])
 
     @property
     def car_sensitivity_columns(self) -> tuple[str, ...]:

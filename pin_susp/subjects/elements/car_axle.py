@@ -83,16 +83,26 @@ class AxleOfCar:
         return self.suffixed(out)
 
     def suffixed(self, columns: dict) -> dict:
-        """An axle's column names as the vehicle's: ``_left``/``_right`` → the corner's
-        label, the rest ``_<end>``."""
+        """An axle's column names as the vehicle's (``car_column``)."""
         out = {}
         for name, column in columns.items():
-            if name in SKIPPED:
-                continue
-            for side, label in zip(SIDES, self.labels, strict=True):
-                if name.endswith(f"_{side}"):
-                    out[name.removesuffix(side) + label] = column
-                    break
-            else:
-                out[f"{name}_{self.end}"] = column
+            named = car_column(name, self.labels, self.end)
+            if named is not None:
+                out[named] = column
         return out
+
+
+def car_column(name: str, labels: tuple[str, str], end: str) -> str | None:
+    """An axle's column as a vehicle names it: ``_left``/``_right`` → the corner's label
+    (``steer_angle_fl``), the rest ``_<end>`` (``track_front``); a rate along the axle's
+    own roll (its left wheel up, its right down, the body held) ``_wrt_axle_roll`` —
+    ``_wrt_roll`` is the body's roll on the road (``deriv_camber_wrt_roll_fl``); None for
+    what the vehicle writes itself (SKIPPED)."""
+    if name in SKIPPED:
+        return None
+    if name.startswith("deriv_"):
+        name = name.replace("_wrt_roll", "_wrt_axle_roll")
+    for side, label in zip(SIDES, labels, strict=True):
+        if name.endswith(f"_{side}"):
+            return name.removesuffix(side) + label
+    return f"{name}_{end}"
