@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 import yaml
 from scipy.spatial.transform import Rotation
+from vehicles import body_sweep
 
 import pin_susp
 from pin_susp.errors import InputError
@@ -31,20 +32,6 @@ SALOON = EXAMPLES / "vehicle_saloon.yaml"  # MacPherson front, multilink rear
 @pytest.fixture(scope="module", params=[FS, SALOON], ids=["fs", "saloon"])
 def car(request):
     return Vehicle(request.param)
-
-
-def body_sweep(heave, pitch, roll, steer=0.0, roads=None) -> Sweep:
-    n = max(len(np.atleast_1d(v)) for v in (heave, pitch, roll, steer))
-    full = lambda v: np.broadcast_to(np.asarray(v, dtype=float), (n,)).copy()  # noqa: E731
-    targets = [
-        Target(None, None, full(heave), quantity="heave"),
-        Target(None, None, full(pitch), quantity="pitch"),
-        Target(None, None, full(roll), quantity="roll"),
-        Target(None, None, full(steer), quantity="steering_wheel"),
-    ]
-    for label, z in (roads or {}).items():
-        targets.append(Target(None, None, full(z), side=label, quantity="road_z"))
-    return Sweep(targets, "<test>")
 
 
 @pytest.fixture(scope="module")

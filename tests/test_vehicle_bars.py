@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from vehicles import body_sweep
 
 from pin_susp.errors import InputError
 from pin_susp.io.yamlio import load_yaml
@@ -63,20 +64,6 @@ def car(request):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # <dict> inline axles: nothing to warn of here
         return Vehicle(t_bar_and_heave_link())
-
-
-def body_sweep(heave, pitch, roll, steer=0.0, roads=None) -> Sweep:
-    n = max(len(np.atleast_1d(v)) for v in (heave, pitch, roll, steer, *(roads or {}).values()))
-    full = lambda v: np.broadcast_to(np.asarray(v, dtype=float), (n,)).copy()  # noqa: E731
-    targets = [
-        Target(None, None, full(heave), quantity="heave"),
-        Target(None, None, full(pitch), quantity="pitch"),
-        Target(None, None, full(roll), quantity="roll"),
-        Target(None, None, full(steer), quantity="steering_wheel"),
-    ]
-    for label, z in (roads or {}).items():
-        targets.append(Target(None, None, full(z), side=label, quantity="road_z"))
-    return Sweep(targets, "<test>")
 
 
 @pytest.fixture(scope="module")
