@@ -703,3 +703,32 @@ def test_cli_bad_input_gets_one_clear_line(tmp_path, capsys, case_name):
     assert f"pin-susp: error: {source.get(named, named)}: {says}" in err, err
     assert not out.exists() and not png.exists()
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temporaries
+
+
+def test_the_splits_a_longitudinal_acceleration_needs_and_a_grids_size(tmp_path):
+    """Braking without the brakes' split, or driving without the drive's, is one error
+    naming the key (not a car that neither brakes nor drives); a bar without its
+    stiffness too; a grid of more than 20 000 accelerations is refused before any work."""
+    import pin_susp
+    from pin_susp.analyses.attitude import Attitude, load_accelerations
+    from pin_susp.errors import InputError
+    from pin_susp.io.yamlio import load_yaml
+
+    examples = Path(__file__).resolve().parent.parent / "examples"
+    data = load_yaml(examples / "vehicle_fs.yaml")[0]
+    data["front"], data["rear"] = (
+        str(examples / "vehicle" / f"fs_{e}.yaml") for e in ("front", "rear")
+    )
+    for key, ax in (("brakes", -0.5), ("drive", 0.5)):
+        given = {**data, "vehicle_config": dict(data["vehicle_config"])}
+        del given["vehicle_config"][key]
+        attitude = Attitude(pin_susp.Vehicle(given))
+        attitude.equilibria(np.array([0.0]), np.array([1.0]))  # lateral alone: no split needed
+        with pytest.raises(InputError, match=f"vehicle_config.{key}"):
+            attitude.equilibria(np.array([ax]), np.array([0.0]))
+    big = tmp_path / "big.yaml"
+    big.write_text(
+        "grid:\n  ax: {start: -1, stop: 1, steps: 200}\n  ay: {start: -1, stop: 1, steps: 101}\n"
+    )
+    with pytest.raises(InputError, match="20,200 accelerations: at most 20,000"):
+        load_accelerations(big)

@@ -313,3 +313,30 @@ def test_the_rack_is_held_and_moved_in_the_chassis_frame():
     ):
         r = car.run_sweep(load_sweep({"version": 1, "steps": 5, "targets": [*body, target]}))
         np.testing.assert_allclose(r["rack_displacement"], expected, rtol=0, atol=1e-9)
+
+
+def test_a_vehicles_axle_files_are_its_inputs_and_must_be_axles(tmp_path, capsys):
+    """-o never writes over an axle file the vehicle reads; a front or rear that is not
+    an axle file, or is the other end's, says so; the CG's x_mm lies between the axles."""
+    from pin_susp.cli import main
+
+    for name in ("vehicle_fs.yaml", "vehicle/fs_front.yaml", "vehicle/fs_rear.yaml"):
+        (tmp_path / name).parent.mkdir(exist_ok=True)
+        (tmp_path / name).write_text((EXAMPLES / name).read_text())
+    car, rear = tmp_path / "vehicle_fs.yaml", tmp_path / "vehicle" / "fs_rear.yaml"
+    before = rear.read_text()
+    sweep = str(EXAMPLES / "vehicle_roll.yaml")
+    assert main(["sweep", str(car), sweep, "-o", str(rear)]) == 2
+    assert "is an input of this command" in capsys.readouterr().err
+    assert rear.read_text() == before
+    data = yaml.safe_load(car.read_text())
+    cases = (
+        ({"front": str(EXAMPLES / "double_wishbone.yaml")}, "front", "not an axle file"),
+        ({"rear": "vehicle/fs_front.yaml"}, "rear", "axle_position: front, not rear"),
+        ({"vehicle_config": data["vehicle_config"] | {"cg": {"x_mm": 700, "z": 280}}},
+         "vehicle_config.cg.x_mm", "not between the axles"),
+    )  # fmt: skip
+    for change, key, said in cases:
+        with pytest.raises(InputError) as got:
+            load_vehicle(data | change if "front" not in change else {**data, **change})
+        assert got.value.key == key and said in got.value.problem, (key, got.value)

@@ -50,6 +50,7 @@ STEP = 1e-7  # m, rad: the Jacobian's differences
 MAX_STEP = 0.05  # m, rad: a Newton step's largest move
 SHARES = 60  # the lateral force's share by the wheels' loads: its passes at most
 HELD = "the steering held straight (the rack at design); the tyres' forces as docs/vehicle.md says"
+CHUNK = 256  # accelerations solved together (a batch's arrays grow with it)
 CONTINUATION = (0.25, 0.5, 0.75, 1.0)  # a point that failed from design, on the way to it
 FRAMES = ("wheel_center", "axle_inboard", "axle_outboard", "strut_top", "strut_bottom")
 SMALL = 0.01  # g: the gradients' difference step
@@ -74,8 +75,9 @@ class Attitude:
         for label, g in car.corners.items():
             end = "front" if label[0] == "f" else "rear"  # its axle's file, or inline
             if not g.rated_spring:
+                key = "strut.rate" if g.type == "macpherson" else "spring.rate"
                 raise InputError(
-                    *axle_key(v, end, "axle_config.spring.rate"),
+                    *axle_key(v, end, f"axle_config.{key}"),
                     f"the attitude needs every spring's rate: the {label} corner has none",
                 )
             if g.spring != "coilover":
@@ -415,7 +417,11 @@ class Attitude:
         last). ``why`` per point: '' where converged, else the reason; a wheel whose
         load falls below zero has lifted: not an equilibrium on four wheels."""
         ax, ay = np.asarray(ax, dtype=float), np.asarray(ay, dtype=float)
-        s = self.solve(ax, ay)
+        self.check_splits(ax)
+        parts = [self.solve(ax[k : k + CHUNK], ay[k : k + CHUNK]) for k in range(0, len(ax), CHUNK)]
+        s = {key: np.concatenate([p[key] for p in parts]) for key in ("u", "q", "loads")}
+        s |= {key: np.concatenate([p[key] for p in parts]) for key in ("residual", "converged")}
+        s["parts"] = {k: np.concatenate([p["parts"][k] for p in parts]) for k in parts[0]["parts"]}
         failed = np.flatnonzero(~s["converged"])
         if failed.size:
             part = None
@@ -429,9 +435,12 @@ class Attitude:
         for i in range(len(ax)):
             lifted = [c for c, load in zip(self.car.labels, s["loads"][i], strict=True) if load < 0]
             if not s["converged"][i]:
+                light = int(np.argmin(s["loads"][i]))
                 why.append(
                     "no equilibrium found (residual "
-                    f"{s['residual'][i]:.3g} N): past the linkage's reach or a wheel's lift-off"
+                    f"{s['residual'][i]:.3g} N): past the linkage's reach or a wheel's lift-off "
+                    f"(the {self.car.labels[light]} wheel the lightest, "
+                    f"{s['loads'][i][light]:.0f} N, at the last step)"
                 )
             elif lifted:
                 why.append(
@@ -444,6 +453,24 @@ class Attitude:
         if progress is not None:
             progress(len(ax), len(ax))
         return s
+
+    def check_splits(self, ax: np.ndarray) -> None:
+        """Braking (ax < 0) needs the brakes' front share, driving (ax > 0) the drive's
+        split: without them the tyres' longitudinal forces are unknown (an InputError
+        naming the key, not a car that neither brakes nor drives)."""
+        v = self.car.vehicle
+        if np.any(ax < 0) and v.front_bias is None:
+            raise InputError(
+                v.source,
+                "vehicle_config.brakes.front_bias",
+                "braking (ax < 0) needs the brakes' front share (0…1)",
+            )
+        if np.any(ax > 0) and v.drive_split is None:
+            raise InputError(
+                v.source,
+                "vehicle_config.drive",
+                "accelerating (ax > 0) needs the drive's split (front, rear: shares adding to 1)",
+            )
 
     def run(self, accelerations: Accelerations, progress=None):
         """The attitude at every acceleration (docs/vehicle.md): the vehicle sweep's

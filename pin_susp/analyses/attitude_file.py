@@ -13,6 +13,7 @@ import numpy as np
 from ..io.yamlio import Reader, load_yaml
 
 ENDS = {"front": ("fl", "fr"), "rear": ("rl", "rr")}
+MOST = 20_000  # accelerations in one file
 
 
 @dataclass(frozen=True)
@@ -63,6 +64,11 @@ def load_accelerations(source) -> Accelerations:
         ay += list(Y.ravel())
     if not ax:
         r.fail("accelerations", "the list is empty")
+    if len(ax) > MOST:
+        r.fail(
+            "grid" if "grid" in data else "accelerations",
+            f"{len(ax):,} accelerations: at most {MOST:,} (about 10 ms each)",
+        )
     return Accelerations(np.array(ax, dtype=float), np.array(ay, dtype=float), name, sha)
 
 

@@ -449,6 +449,11 @@ class Vehicle(VehicleExport, VehicleViews, VehicleAssembly):
                     "the attitude takes U-bars so far (a T-bar's twist in its potential "
                     "is not built yet)",
                 )
+            if bar.axle.anti_roll_stiffness is None:
+                raise InputError(
+                    *axle_key(self.vehicle, end, "axle_config.anti_roll.stiffness"),
+                    "the attitude needs the bar's stiffness (N·m/deg of its twist)",
+                )
             names = [f"{c}_arb_arm_pivot" for c in bar.labels]
             joints = [self.model.joints[self.model.getJointId(n)] for n in names]
             (iq, jq), (iv, jv) = [j.idx_q for j in joints], [j.idx_v for j in joints]

@@ -122,6 +122,12 @@ def load_vehicle(source) -> VehicleGeometry:
         x = centres["front"] - share * wheelbase
     else:
         x = r.length(cg["x_mm"], "vehicle_config.cg.x_mm")
+        if not centres["rear"] <= x <= centres["front"]:
+            r.fail(
+                "vehicle_config.cg.x_mm",
+                f"{x:g} mm is not between the axles (their wheel centres at "
+                f"{centres['rear']:g} and {centres['front']:g} mm)",
+            )
     z = r.positive(cg["z"], "vehicle_config.cg.z")
     steering = r.mapping(
         config.get("steering", {}), "vehicle_config.steering", optional=("c_factor",)
@@ -243,7 +249,18 @@ def _axle(given, end: str, here: Path, name: str, r: Reader) -> AxleGeometry:
         raw, where, prefix = given, name, f"{end}."
     else:
         r.fail(end, "expected an axle file's path or the axle inline (a mapping)")
+    scope = raw.get("scope", "corner") if isinstance(raw, dict) else None
+    if isinstance(raw, dict) and scope != "axle":
+        what = f"{given!r} is" if isinstance(given, str) else "the axle inline is"
+        r.fail(
+            end,
+            f"{what} not an axle file (scope: {scope}): a vehicle's front and rear are "
+            "axle files (scope: axle, docs/axle.md)",
+        )
     config = raw.get("axle_config") if isinstance(raw, dict) else None  # (load_axle: the rest)
+    position = config.get("axle_position") if isinstance(config, dict) else None
+    if position in AXLES and position != end:  # before what the other end may not have
+        r.fail(end, f"its axle file says axle_position: {position}, not {end}")
     if isinstance(config, dict) and end == "rear":
         steering = config.get("steering", {})
         if isinstance(steering, dict) and steering.get("type") == "rack":
