@@ -78,7 +78,10 @@ class Assembly(Composed, AnalysesSurface):
     when it is solved, as an axle's always were); ``tangents_by_drivers``: every
     step's tangent kept per driver, T·(J_drive·T)⁻¹, whatever the targets (an axle's:
     the numbers it always had, to the last bit; a corner keeps them only when its
-    targets are its drivers).
+    targets are its drivers); ``tangents_by_targets``: the tangent per target (dq per
+    unit of each held target) kept where the sweep is solved at once (bulk.newton_all
+    has it at each solution: a vehicle's rates along its body), for its own columns
+    (``own_columns``), None per step otherwise.
     """
 
     labels: tuple[str, ...]
@@ -96,6 +99,7 @@ class Assembly(Composed, AnalysesSurface):
     refuses: tuple[str, ...] = ()
     checks_counts_first: bool = True
     tangents_by_drivers: bool = False
+    tangents_by_targets: bool = False
     results_class: type = None  # the class of its sweep's Results
     # setup and sensitivity: the subject's own static columns of its corners set
     # together, (column, heading) in mm (an axle's track and roll centre; a corner: none)
@@ -334,7 +338,9 @@ class Assembly(Composed, AnalysesSurface):
         step's exact tangent per driver (dq per unit of each corner's hub z, the rack)
         where the solve has it (``tangents_by_drivers``, or the targets are the
         drivers) — it stays empty otherwise. Each solution keeps its own
-        (``drive_tangent``)."""
+        (``drive_tangent``). Where ``tangents_by_targets`` instead: each step's tangent
+        per target where the sweep is solved at once (None per step marched: its
+        Jacobian there is the last iterate's), for own_columns alone."""
         check_held(sweep)
         solver = self.solver_for(sweep.targets, sweep.source)
         values = self.target_values(sweep.targets)
@@ -344,6 +350,23 @@ class Assembly(Composed, AnalysesSurface):
         if self.tangents_by_drivers:
             solver.keep_jacobian = True  # exact tangents: better predictions, the rates
             keep = self._per_driver()
+        elif self.tangents_by_targets and tangents is not None:
+            # the tangents per target of every step solved at once (at each solution,
+            # bulk.newton_all); a marched step's are not kept (keep_jacobian off: the
+            # march as it was, its Jacobian the last iterate's)
+            solutions = march(
+                solver,
+                values,
+                q,
+                previous,
+                progress=progress,
+                step_times=step_times,
+                tangents=found,
+                keep=lambda tangent: tangent if tangent.ndim == 3 else None,
+                bulk=True,
+            )
+            tangents.extend(found)
+            return solutions
         else:
             order = self.drive_order(sweep.targets) if tangents is not None else None
             solver.keep_jacobian = order is not None
@@ -501,6 +524,7 @@ class Assembly(Composed, AnalysesSurface):
         solved = [s.q if s.converged else None for s in solutions]
         if tangents is None:
             tangents = [s.drive_tangent for s in solutions]
+        given = tangents
         qs, tangents = self.measured_at(solved, tangents)
         points = self.label_motion(qs, tangents)
         for name, (values, column_unit) in self.metric_columns(points, only).items():
@@ -514,7 +538,9 @@ class Assembly(Composed, AnalysesSurface):
             for name, (values, column_unit) in rate_columns(corner, poses).items():
                 columns[name + self.suffix(label)] = values
                 units[name + self.suffix(label)] = column_unit
-        for name, (values, column_unit) in self.own_columns(sweep, solved, plain, columns).items():
+        for name, (values, column_unit) in self.own_columns(
+            sweep, solved, plain, columns, given
+        ).items():
             columns[name], units[name] = values, column_unit
         for name, (values, column_unit) in point_columns(self.output_points, plain).items():
             if only is None or name in only:
@@ -528,10 +554,13 @@ class Assembly(Composed, AnalysesSurface):
         tangents per driver: the solved ones (a vehicle's: its chassis frame)."""
         return qs, tangents
 
-    def own_columns(self, sweep: Sweep, qs: list, plain: dict, columns: dict) -> dict:
+    def own_columns(
+        self, sweep: Sweep, qs: list, plain: dict, columns: dict, tangents=None
+    ) -> dict:
         """Its columns beyond its corners' and elements' (name → (values, unit)), from the
-        solved configurations ``qs``, the points as measured (``plain``, m) and the
-        columns so far: none (a vehicle's body)."""
+        solved configurations ``qs``, the points as measured (``plain``, m), the columns
+        so far and the sweep's tangents per step (sweep_results', or None): none (a
+        vehicle's body)."""
         return {}
 
     def run_sweep_chunks(self, sweep: Sweep | str | dict, rows: int = CHUNK, progress=None):

@@ -131,6 +131,7 @@ class Vehicle(VehicleExport, VehicleViews, VehicleAssembly):
         "arb_twist_rear heave_link_length_front heave_link_length_rear".split()
     )
     held_joints = JOINTS  # a corner's rates: its own height with the body still
+    tangents_by_targets = True  # a sweep solved at once: its tangents, the body's rates
     needs = (
         "the body's heave, pitch and roll, and the steering (steering_wheel or a rack "
         "target); each road_z is 0 unless given"
@@ -383,15 +384,16 @@ class Vehicle(VehicleExport, VehicleViews, VehicleAssembly):
         tangents per driver solved there (the sweep's are along its own targets)."""
         return self.chassis_configurations(qs), None
 
-    def own_columns(self, sweep, qs: list, plain: dict, columns: dict) -> dict:
+    def own_columns(self, sweep, qs: list, plain: dict, columns: dict, tangents=None) -> dict:
         """The body's pose, what the road sees and the rates along the body
-        (``body_columns``)."""
-        return self.body_columns(sweep, qs, plain, columns)
+        (``body_columns``; ``tangents``: the sweep's per target, where it has them)."""
+        return self.body_columns(sweep, qs, plain, columns, tangents)
 
-    def body_columns(self, sweep, qs: list, plain: dict, columns: dict) -> dict:
+    def body_columns(self, sweep, qs: list, plain: dict, columns: dict, tangents=None) -> dict:
         """The body's heave, pitch, roll and steering-wheel angle; each corner's camber
         to ground; the wheelbase on the road per side; and the exact rates of each
-        corner's camber, toe and wheel-centre height along heave, pitch and roll."""
+        corner's camber, toe and wheel-centre height along heave, pitch and roll
+        (``body_rates``)."""
         pose = np.full((len(qs), 3), np.nan)
         solved = [i for i, q in enumerate(qs) if q is not None]
         if solved:
@@ -430,7 +432,7 @@ class Vehicle(VehicleExport, VehicleViews, VehicleAssembly):
         for label in LABELS:
             out[f"contact_patch_road_z_{label}"] = (contact[label][:, 2] * 1e3, "mm")
         out |= vehicle_columns(self, plain, columns | {k: v[0] for k, v in out.items()})
-        out |= self.body_rates(sweep, qs, columns)
+        out |= self.body_rates(sweep, qs, columns, tangents)
         return out
 
     def bar_energies(self) -> list:
@@ -466,28 +468,35 @@ class Vehicle(VehicleExport, VehicleViews, VehicleAssembly):
         a = d[f"{label}_axle_outboard"] - d[f"{label}_axle_inboard"]
         return -g.sign * np.degrees(np.arctan2(a[0], g.sign * a[1]))
 
-    def body_rates(self, sweep, qs: list, columns: dict) -> dict:
+    def body_rates(self, sweep, qs: list, columns: dict, tangents=None) -> dict:
         """d(column)/d(heave) per mm and d/d(pitch), d/d(roll) per deg, the other targets
-        held: the sweep's tangent dq/d(target) at every solved step (its rows' Jacobian,
-        all steps at once), each corner's chassis-frame wheel-centre rate along it, times
-        the corner's own rate along its hub z (its rack held: the steering is a target)."""
+        held: the sweep's tangent dq/d(target) at every solved step (``tangents``' where
+        the sweep's solve has every solved step's, per target — bulk.newton_all's, at the
+        solution — else its rows' Jacobian, all steps at once), each corner's
+        chassis-frame wheel-centre rate along it, times the corner's own rate along its
+        hub z (its rack held: the steering is a target)."""
         solved = [i for i, q in enumerate(qs) if q is not None]
         n = len(qs)
         if not solved:
             return {}
-        solver = self.solver_for(sweep.targets, sweep.source)
-        rows = rows_of(solver)
         targets = self.held_targets(sweep.targets)
-        Q = np.array([qs[i] for i in solved])
-        zero = np.zeros((len(Q), len(targets)))
-        _, J = rows.evaluate(Q, zero)
         want = [i for i, t in enumerate(targets) if t.quantity in ("heave", "pitch", "roll")]
-        rhs = np.zeros((rows.nrows, len(want)))
-        for c, i in enumerate(want):
-            rhs[rows.first_target + i, c] = 1.0
-        T = solve_all(J, rhs)
-        if T is None:
-            return {}
+        Q = np.array([qs[i] for i in solved])
+        shape = (self.model.nv, len(targets))
+        given = [None if tangents is None else tangents[i] for i in solved]
+        if all(t is not None and t.shape == shape for t in given):
+            T = np.array(given)[:, :, want]
+        else:
+            solver = self.solver_for(sweep.targets, sweep.source)
+            rows = rows_of(solver)
+            zero = np.zeros((len(Q), len(targets)))
+            _, J = rows.evaluate(Q, zero)
+            rhs = np.zeros((rows.nrows, len(want)))
+            for c, i in enumerate(want):
+                rhs[rows.first_target + i, c] = 1.0
+            T = solve_all(J, rhs)
+            if T is None:
+                return {}
         tree = tree_of(self.kin)
         Qc = np.array(self.chassis_configurations(list(Q)))
         frames = [self.points[f"{label}_wheel_center"].frame_id for label in LABELS]
