@@ -356,9 +356,14 @@ class Vehicle(VehicleExport, VehicleViews, VehicleAssembly):
 
     def label_corner(self, label: str, plain: dict, qs: list) -> tuple:
         """A corner of its own for one label's rated spring and its configurations at
-        ``qs`` (chassis frame): solved at its wheel centre's height and the rack's travel,
-        every step at once where the sweep is long (the corner's own march; an axle's
-        label_corner solves one step after another)."""
+        ``qs`` (chassis frame): each its joints' values in the vehicle's configuration
+        (the corner's joints are the vehicle's, prefixed by its label, and the shared
+        rack; the body's at zero, its closures among the vehicle's: the pose at its
+        wheel centre's height and the rack's travel, as a solve of its own would find it
+        to the tolerance). Where a joint of its is not the vehicle's, solved at its
+        wheel centre's height and the rack's travel, every step at once where the sweep
+        is long (the corner's own march; an axle's label_corner solves one step after
+        another)."""
         from ..model.sweep import Sweep, Target
         from .corner import Corner
 
@@ -367,6 +372,14 @@ class Vehicle(VehicleExport, VehicleViews, VehicleAssembly):
         solved = [i for i, q in enumerate(qs) if q is not None]
         poses = [None] * len(qs)
         if not solved:
+            return corner, poses
+        mapped = self._joints_in_vehicle(label, corner.model)
+        if mapped is not None:
+            own, theirs = mapped
+            for i in solved:
+                q = np.empty(corner.model.nq)
+                q[own] = qs[i][theirs]
+                poses[i] = q
             return corner, poses
         p = self.prefix(label)
         targets = [
@@ -378,6 +391,24 @@ class Vehicle(VehicleExport, VehicleViews, VehicleAssembly):
         for i, s in zip(solved, corner.solve_steps(Sweep(targets, "<corner>")), strict=True):
             poses[i] = s.q if s.converged else None
         return corner, poses
+
+    def _joints_in_vehicle(self, label: str, model) -> tuple | None:
+        """Where a corner's own model's joints (``model``) are in the vehicle's q: (its
+        indices, the vehicle's), each joint its label's (``fl_lower_wishbone_pivot``) or
+        the shared one (``rack_slide``) of as many values; None where one is neither."""
+        own, theirs = [], []
+        for joint, name in zip(model.joints[1:], model.names[1:], strict=True):
+            named = self.prefix(label) + name
+            if not self.model.existJointName(named):
+                named = name
+                if not self.model.existJointName(named):
+                    return None
+            other = self.model.joints[self.model.getJointId(named)]
+            if other.nq != joint.nq or other.nv != joint.nv:
+                return None
+            own += range(joint.idx_q, joint.idx_q + joint.nq)
+            theirs += range(other.idx_q, other.idx_q + other.nq)
+        return np.array(own, dtype=int), np.array(theirs, dtype=int)
 
     def measured_at(self, qs: list, tangents: list) -> tuple[list, None]:
         """Its chassis frame: each configuration with the body's joints at zero, the
