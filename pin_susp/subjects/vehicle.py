@@ -363,12 +363,15 @@ class Vehicle(VehicleExport, VehicleViews, VehicleAssembly):
         to the tolerance). Where a joint of its is not the vehicle's, solved at its
         wheel centre's height and the rack's travel, every step at once where the sweep
         is long (the corner's own march; an axle's label_corner solves one step after
-        another)."""
+        another). Each label's Corner is built once, at its first sweep."""
         from ..model.sweep import Sweep, Target
         from .corner import Corner
 
         g = self.corners[label]
-        corner = Corner(g, apply_setup=False, warn=False, visuals=False)
+        own = self.__dict__.setdefault("_own_corners", {})  # built once per label
+        if label not in own:
+            own[label] = Corner(g, apply_setup=False, warn=False, visuals=False)
+        corner = own[label]
         solved = [i for i, q in enumerate(qs) if q is not None]
         poses = [None] * len(qs)
         if not solved:
