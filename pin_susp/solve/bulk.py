@@ -369,16 +369,21 @@ class Rows:
         return out
 
 
-def newton_all(rows: Rows, q: np.ndarray, values: np.ndarray, tolerance: float):
+def newton_all(rows: Rows, q: np.ndarray, values: np.ndarray, tolerance: float, extra=None):
     """Newton iterations for every step at once: (q, tangents, iterations, max |r|) or
-    (None, ...) if any step does not converge to ``tolerance`` (or takes a wild step)."""
+    (None, ...) if any step does not converge to ``tolerance`` (or takes a wild step).
+    ``extra``: more right-hand sides (nrows, e) solved at each solution with the
+    tangents, their columns after the targets' (J·x = e: a closure's value changed by
+    one, the targets held)."""
     n = q.shape[0]
     q = q.copy()
     iterations = np.zeros(n, dtype=int)
     error = np.zeros(n)
-    tangents = np.empty((n, rows.tree.nv, values.shape[1]))
     rhs = np.zeros((rows.nrows, values.shape[1]))
     rhs[rows.first_target :] = np.eye(values.shape[1])
+    if extra is not None:
+        rhs = np.hstack([rhs, extra])
+    tangents = np.empty((n, rows.tree.nv, rhs.shape[1]))
     active = np.arange(n)
     for iteration in range(MAX_ITERATIONS + 1):
         r, J = rows.evaluate(q[active], values[active])

@@ -352,7 +352,8 @@ class Assembly(Composed, AnalysesSurface):
             keep = self._per_driver()
         elif self.tangents_by_targets and tangents is not None:
             # the tangents per target of every step solved at once (at each solution,
-            # bulk.newton_all); a marched step's are not kept (keep_jacobian off: the
+            # bulk.newton_all), then each closure driver's (a toe link's length, the
+            # targets held); a marched step's are not kept (keep_jacobian off: the
             # march as it was, its Jacobian the last iterate's)
             solutions = march(
                 solver,
@@ -364,6 +365,7 @@ class Assembly(Composed, AnalysesSurface):
                 tangents=found,
                 keep=lambda tangent: tangent if tangent.ndim == 3 else None,
                 bulk=True,
+                extra=self._closure_drivers(solver),
             )
             tangents.extend(found)
             return solutions
@@ -392,6 +394,18 @@ class Assembly(Composed, AnalysesSurface):
         if tangents is not None:
             tangents.extend(found)
         return solutions
+
+    def _closure_drivers(self, solver: NewtonSolver) -> np.ndarray | None:
+        """The drivers that change a closure's value (a toe link's length: drive_rhs's
+        columns after its targets') as right-hand sides of ``solver``'s rows (the
+        closures first, as the drive solver's; the targets held), or None."""
+        columns = self.drive_rhs[:, len(self._drive.targets) :]
+        if not columns.shape[1]:
+            return None
+        closures = sum(c.size for c in self.closures)
+        extra = np.zeros((solver.nrows, columns.shape[1]))
+        extra[:closures] = columns[:closures]
+        return extra
 
     def _drive_frames(self) -> tuple[list, int | None]:
         wheels = [f"{self.prefix(label)}wheel_center" for label in self.labels]

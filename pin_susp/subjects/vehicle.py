@@ -413,10 +413,73 @@ class Vehicle(VehicleExport, VehicleViews, VehicleAssembly):
             theirs += range(other.idx_q, other.idx_q + other.nq)
         return np.array(own, dtype=int), np.array(theirs, dtype=int)
 
-    def measured_at(self, qs: list, tangents: list) -> tuple[list, None]:
-        """Its chassis frame: each configuration with the body's joints at zero, the
-        tangents per driver solved there (the sweep's are along its own targets)."""
-        return self.chassis_configurations(qs), None
+    def measured_at(self, qs: list, tangents: list) -> tuple[list, list | None]:
+        """Its chassis frame: each configuration with the body's joints at zero, and
+        the tangents per driver there (``drive_tangents``) where the sweep's solve kept
+        its own per target at every solved step, else None (label_motion solves them)."""
+        chassis = self.chassis_configurations(qs)
+        return chassis, self.drive_tangents(qs, chassis, tangents)
+
+    def drive_tangents(self, qs: list, chassis: list, tangents) -> list | None:
+        """dq per driver (each corner's wheel-centre z in the chassis frame, the rack, the
+        body's joints, each toe link's length: drive_rhs's columns) at the chassis-frame
+        configurations, from the sweep's tangents per target with each toe link's after
+        them (Assembly.solve_steps, ``tangents_by_targets``), every step at once: the
+        closures do not see the body's joints, so the tangents per target span the
+        drivers' too, D = T·(J_d·T)⁻¹ with J_d the drivers' rows at the chassis frame,
+        and a toe link's is its own less D·(J_d·x). None where a solved step has none
+        (a marched sweep), or where the first step's disagree with the drive solver's
+        own there (to 1e-9 of their size)."""
+        solved = [i for i, q in enumerate(qs) if q is not None]
+        k = self.drive_rhs.shape[1]
+        targets = len(self._drive.targets)
+        if not solved or tangents is None:
+            return None
+        given = [tangents[i] for i in solved]
+        nv = self.model.nv
+        if any(t is None or t.shape[0] != nv for t in given):
+            return None
+        T = np.array(given)
+        extra = k - targets
+        if T.shape[2] < self.mobility + extra:
+            return None
+        per_target, closure = T[:, :, : T.shape[2] - extra], T[:, :, T.shape[2] - extra :]
+        if per_target.shape[2] != targets:  # as many targets as drivers
+            return None
+        Qc = np.array([chassis[i] for i in solved])
+        frames, rack_v = self._drive_frames()
+        if rack_v is None:
+            return None
+        tree = tree_of(self.kin)
+        many = Frames(tree, frames)
+        R, o = tree.placements(Qc)
+        Jc, _ = many.compact(many.positions(R, o), o, tree.axes(R))
+
+        def rows(X):  # the drivers' rows times X (n, nv, c): (n, drivers, c)
+            out = [
+                np.einsum("sn,nsk->nk", Jf[:, :, 2], X[:, cols])
+                for Jf, cols in zip(Jc, many.cols, strict=True)
+            ]
+            out += [X[:, rack_v]] + [X[:, v] for v in self.body_v]
+            return np.stack(out, axis=1)
+
+        across = rows(per_target)
+        try:
+            D = per_target @ np.linalg.inv(across)
+        except np.linalg.LinAlgError:
+            return None
+        if extra:
+            D = np.concatenate([D, closure - D @ rows(closure)], axis=2)
+        if not np.isfinite(D).all():
+            return None
+        self._drive.evaluate(Qc[0])  # the first step's, as label_motion would solve it
+        check = self._drive.tangent(self.drive_rhs)
+        if not np.allclose(D[0], check, rtol=0.0, atol=1e-9 * max(1.0, np.abs(check).max())):
+            return None
+        out = [None] * len(qs)
+        for i, d in zip(solved, D, strict=True):
+            out[i] = d
+        return out
 
     def own_columns(self, sweep, qs: list, plain: dict, columns: dict, tangents=None) -> dict:
         """The body's pose, what the road sees and the rates along the body
@@ -516,10 +579,9 @@ class Vehicle(VehicleExport, VehicleViews, VehicleAssembly):
         targets = self.held_targets(sweep.targets)
         want = [i for i, t in enumerate(targets) if t.quantity in ("heave", "pitch", "roll")]
         Q = np.array([qs[i] for i in solved])
-        shape = (self.model.nv, len(targets))
         given = [None if tangents is None else tangents[i] for i in solved]
-        if all(t is not None and t.shape == shape for t in given):
-            T = np.array(given)[:, :, want]
+        if all(t is not None and t.shape[0] == self.model.nv for t in given):
+            T = np.array(given)[:, :, want]  # each step's per target (its first columns)
         else:
             solver = self.solver_for(sweep.targets, sweep.source)
             rows = rows_of(solver)
