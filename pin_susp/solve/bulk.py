@@ -116,6 +116,12 @@ class Tree:
                 kinds.append((ks, [self.joints[k - 1][5] for k in ks]))
             self._moves.append(tuple(kinds))
 
+    def moved_by(self, joint: int) -> list[int]:
+        """The indices in v of the joints that move a joint (its supports, the universe
+        excluded): revolute, then prismatic."""
+        revolute, prismatic = self._moves[joint]
+        return list(revolute[1]) + list(prismatic[1])
+
     def placements(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """World rotation (njoints, n, 3, 3) and origin (njoints, n, 3) of every joint
         at the n configurations q (n, nq); joint 0 is the universe. (A product with a

@@ -185,7 +185,8 @@ class FrameMotion:
         a = tree.axes(R)
         count, m = len(T), len(self.names)
         pos = np.empty((m, count, 3))
-        rates = [np.empty((m, len(c), count, 3)) for c in columns]
+        # a still point's rates stay 0 (v + w × arm of zeros gives +0)
+        rates = [np.zeros((m, len(c), count, 3)) for c in columns]
         # only the driver columns some list asks for, each list's picked from them
         need = sorted({i for c in columns for i in c})
         picks = [[need.index(i) for i in c] for c in columns]
@@ -193,16 +194,21 @@ class FrameMotion:
         for j, index, local in self.groups:
             if j == 0:  # the chassis: fixed points
                 pos[index] = local[:, None]
-                for out in rates:
-                    out[index] = 0.0
                 continue
             # arms (g, 1, n, 3): each point's offset from its joint's origin
             arms = (R[j].reshape(-1, 3) @ local.T).reshape(count, 3, -1).transpose(2, 0, 1)
             pos[index] = arms + o[j][None]
+            # the lists along whose drivers its joints move (a vehicle's other corners
+            # stay still along one's: their tangents there are zeros)
+            moving = T[:, tree.moved_by(j)]  # (n, s, k)
+            live = [i for i, c in enumerate(picks) if moving[:, :, c].any()]
+            if not live:
+                continue
             v, w = _twist(tree, j, o, a, T)  # (k, n, 3) each
             arms = np.ascontiguousarray(arms)[:, None]
-            for c, out in zip(picks, rates, strict=True):
-                out[index] = v[c][None] + cross(w[c][None], arms)
+            for i in live:
+                c = picks[i]
+                rates[i][index] = v[c][None] + cross(w[c][None], arms)
         if count == n:
             return pos, rates
         out_pos = np.full((m, n, 3), np.nan)
