@@ -596,16 +596,22 @@ class Vehicle(VehicleExport, VehicleViews, VehicleAssembly):
         tree = tree_of(self.kin)
         Qc = np.array(self.chassis_configurations(list(Q)))
         frames = [self.points[f"{label}_wheel_center"].frame_id for label in LABELS]
-        _, Jw = Frames(tree, frames).evaluate(Qc)
-        moving = np.ones(self.model.nv, dtype=bool)
-        moving[self.body_v] = False
+        many = Frames(tree, frames)
+        R, o = tree.placements(Qc)
+        Jc, _ = many.compact(many.positions(R, o), o, tree.axes(R))
+        # each wheel centre's z row in the columns that move it, the body's joints' left out
+        still = set(self.body_v)
+        rows = []
+        for Jf, cols in zip(Jc, many.cols, strict=True):
+            keep = [s for s, v in enumerate(cols) if v not in still]
+            rows.append((Jf[keep, :, 2], cols[keep]))
         out = {}
         for c, i in enumerate(want):
             quantity = targets[i].quantity
             scale, per = (1.0, "mm") if quantity == "heave" else (np.pi / 180.0 * 1e3, "deg")
-            for label, Jf in zip(LABELS, Jw, strict=True):
+            for label, (Jz, cols) in zip(LABELS, rows, strict=True):
                 rate = np.full(n, np.nan)  # chassis-frame wheel-centre z, m per unit
-                rate[solved] = np.einsum("nv,nv->n", Jf[:, 2, moving], T[:, moving, c])
+                rate[solved] = np.einsum("sn,ns->n", Jz, T[:, cols, c])
                 rate = rate * scale  # mm per mm, or mm per deg
                 out[f"deriv_wheel_center_z_wrt_{quantity}_{label}"] = (rate, f"mm/{per}")
                 for name in DERIVED:
