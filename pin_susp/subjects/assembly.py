@@ -79,9 +79,10 @@ class Assembly(Composed, AnalysesSurface):
     step's tangent kept per driver, T·(J_drive·T)⁻¹, whatever the targets (an axle's:
     the numbers it always had, to the last bit; a corner keeps them only when its
     targets are its drivers); ``tangents_by_targets``: the tangent per target (dq per
-    unit of each held target) kept where the sweep is solved at once (bulk.newton_all
-    has it at each solution: a vehicle's rates along its body), for its own columns
-    (``own_columns``), None per step otherwise.
+    unit of each held target), then each closure driver's (a toe link's length, the
+    targets held: ``_closure_drivers``), kept where the sweep is solved at once
+    (bulk.newton_all has them at each solution: a vehicle's rates along its body and
+    its drivers' tangents, Vehicle.measured_at), None per step otherwise.
     """
 
     labels: tuple[str, ...]
@@ -339,8 +340,9 @@ class Assembly(Composed, AnalysesSurface):
         where the solve has it (``tangents_by_drivers``, or the targets are the
         drivers) — it stays empty otherwise. Each solution keeps its own
         (``drive_tangent``). Where ``tangents_by_targets`` instead: each step's tangent
-        per target where the sweep is solved at once (None per step marched: its
-        Jacobian there is the last iterate's), for own_columns alone."""
+        per target, then each closure driver's, where the sweep is solved at once (None
+        per step marched: its Jacobian there is the last iterate's), for its
+        measured_at and own_columns alone (no solution's drive_tangent)."""
         check_held(sweep)
         solver = self.solver_for(sweep.targets, sweep.source)
         values = self.target_values(sweep.targets)
