@@ -390,6 +390,18 @@ class Composed:
         self._drive.evaluate(self.q_design)
         return self._drive.jacobian
 
+    def closure_drivers(self, solver) -> np.ndarray | None:
+        """The drivers that change a closure's value (a toe link's length: drive_rhs's
+        columns after its targets') as right-hand sides of ``solver``'s rows (the
+        closures first, as the drive solver's; the targets held), or None."""
+        columns = self.drive_rhs[:, len(self._drive.targets) :]
+        if not columns.shape[1]:
+            return None
+        closures = sum(c.size for c in self.closures)
+        extra = np.zeros((solver.nrows, columns.shape[1]))
+        extra[:closures] = columns[:closures]
+        return extra
+
     def label_motion(self, qs: list, tangents: list | None = None) -> dict:
         """Every point (prefixed) at each configuration, as a jet.Dual per corner's label:
         its rates along that corner's drivers (``driver_columns``: its hub z, the others

@@ -80,7 +80,7 @@ class Assembly(Composed, AnalysesSurface):
     the numbers it always had, to the last bit; a corner keeps them only when its
     targets are its drivers); ``tangents_by_targets``: the tangent per target (dq per
     unit of each held target), then each closure driver's (a toe link's length, the
-    targets held: ``_closure_drivers``), kept where the sweep is solved at once
+    targets held: ``closure_drivers``), kept where the sweep is solved at once
     (bulk.newton_all has them at each solution: a vehicle's rates along its body and
     its drivers' tangents, Vehicle.measured_at), None per step otherwise.
     """
@@ -349,33 +349,21 @@ class Assembly(Composed, AnalysesSurface):
         q = self.q_design if q_start is None else q_start
         previous = self.values_at(solver, q)
         found = []
+        by_targets = self.tangents_by_targets and tangents is not None
         if self.tangents_by_drivers:
             solver.keep_jacobian = True  # exact tangents: better predictions, the rates
             keep = self._per_driver()
-        elif self.tangents_by_targets and tangents is not None:
-            # the tangents per target of every step solved at once (at each solution,
-            # bulk.newton_all), then each closure driver's (a toe link's length, the
-            # targets held); a marched step's are not kept (keep_jacobian off: the
-            # march as it was, its Jacobian the last iterate's)
-            solutions = march(
-                solver,
-                values,
-                q,
-                previous,
-                progress=progress,
-                step_times=step_times,
-                tangents=found,
-                keep=lambda tangent: tangent if tangent.ndim == 3 else None,
-                bulk=True,
-                extra=self._closure_drivers(solver),
-            )
-            tangents.extend(found)
-            return solutions
+            by_targets = False
+        elif by_targets:  # every step's at once (newton_all's, at each solution), then
+            # each closure driver's; a marched step's not (keep_jacobian off: the march
+            # as it was, its Jacobian the last iterate's)
+            keep = lambda tangent: tangent if tangent.ndim == 3 else None  # noqa: E731
         else:
             order = self.drive_order(sweep.targets) if tangents is not None else None
             solver.keep_jacobian = order is not None
             keep = None if order is None else lambda tangent: tangent[..., order]
             found = None if order is None else found
+        extra = self.closure_drivers(solver) if by_targets else None
         solutions = march(
             solver,
             values,
@@ -386,8 +374,12 @@ class Assembly(Composed, AnalysesSurface):
             tangents=found,
             keep=keep,
             bulk=True,
+            extra=extra,
         )
         if found is None:
+            return solutions
+        if by_targets:
+            tangents.extend(found)
             return solutions
         if self.tangents_by_drivers:
             found = self._through_drivers(solutions, found)
@@ -396,18 +388,6 @@ class Assembly(Composed, AnalysesSurface):
         if tangents is not None:
             tangents.extend(found)
         return solutions
-
-    def _closure_drivers(self, solver: NewtonSolver) -> np.ndarray | None:
-        """The drivers that change a closure's value (a toe link's length: drive_rhs's
-        columns after its targets') as right-hand sides of ``solver``'s rows (the
-        closures first, as the drive solver's; the targets held), or None."""
-        columns = self.drive_rhs[:, len(self._drive.targets) :]
-        if not columns.shape[1]:
-            return None
-        closures = sum(c.size for c in self.closures)
-        extra = np.zeros((solver.nrows, columns.shape[1]))
-        extra[:closures] = columns[:closures]
-        return extra
 
     def _drive_frames(self) -> tuple[list, int | None]:
         wheels = [f"{self.prefix(label)}wheel_center" for label in self.labels]
