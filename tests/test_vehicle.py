@@ -340,3 +340,34 @@ def test_a_vehicles_axle_files_are_its_inputs_and_must_be_axles(tmp_path, capsys
         with pytest.raises(InputError) as got:
             load_vehicle(data | change if "front" not in change else {**data, **change})
         assert got.value.key == key and said in got.value.problem, (key, got.value)
+
+
+def test_a_long_sweep_keeps_its_tangents(car):
+    """A sweep solved at once (bulk.py) keeps its tangents per target and each toe
+    link's (Assembly.solve_steps, ``tangents_by_targets``): the drivers' tangents at the
+    chassis frame from them (Vehicle.drive_tangents) are the drive solver's own, and
+    every column is the one computed without them (label_motion and body_rates solving
+    their own), to 1e-9 of its size."""
+    steps = 201  # solved at once (bulk.MIN_STEPS)
+    sweep = body_sweep(
+        np.linspace(-10, 10, steps), np.linspace(-0.5, 0.5, steps), np.linspace(-2, 2, steps), 30
+    )
+    tangents = []
+    solutions = car.solve_steps(sweep, tangents=tangents)
+    assert len(tangents) == steps and all(t is not None for t in tangents)
+    qs = [s.q for s in solutions]
+    chassis = car.chassis_configurations(qs)
+    drive = car.drive_tangents(qs, chassis, tangents)
+    for i in (0, 100, 200):
+        car._drive.evaluate(chassis[i])
+        own = car._drive.tangent(car.drive_rhs)
+        np.testing.assert_allclose(drive[i], own, rtol=0, atol=1e-9 * np.abs(own).max())
+    kept = car.sweep_results(sweep, solutions, tangents)
+    solved = car.sweep_results(sweep, solutions)  # no tangents: every one solved here
+    assert set(kept.columns) == set(solved.columns)
+    for name, values in solved.columns.items():
+        if np.asarray(values).dtype.kind == "f":
+            size = max(1.0, np.nanmax(np.abs(values), initial=0.0))
+            np.testing.assert_allclose(
+                kept[name], values, rtol=0, atol=1e-9 * size, equal_nan=True, err_msg=name
+            )

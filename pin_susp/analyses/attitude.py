@@ -37,6 +37,7 @@ import numpy as np
 from ..errors import InputError
 from .attitude_file import (  # noqa: F401 (its inputs' names, importable from here)
     Accelerations,
+    check_splits,
     load_accelerations,
     masses_of,
     tyre_rates_of,
@@ -417,7 +418,7 @@ class Attitude:
         last). ``why`` per point: '' where converged, else the reason; a wheel whose
         load falls below zero has lifted: not an equilibrium on four wheels."""
         ax, ay = np.asarray(ax, dtype=float), np.asarray(ay, dtype=float)
-        self.check_splits(ax)
+        check_splits(self.car.vehicle, ax)
         parts = [self.solve(ax[k : k + CHUNK], ay[k : k + CHUNK]) for k in range(0, len(ax), CHUNK)]
         s = {key: np.concatenate([p[key] for p in parts]) for key in ("u", "q", "loads")}
         s |= {key: np.concatenate([p[key] for p in parts]) for key in ("residual", "converged")}
@@ -453,24 +454,6 @@ class Attitude:
         if progress is not None:
             progress(len(ax), len(ax))
         return s
-
-    def check_splits(self, ax: np.ndarray) -> None:
-        """Braking (ax < 0) needs the brakes' front share, driving (ax > 0) the drive's
-        split: without them the tyres' longitudinal forces are unknown (an InputError
-        naming the key, not a car that neither brakes nor drives)."""
-        v = self.car.vehicle
-        if np.any(ax < 0) and v.front_bias is None:
-            raise InputError(
-                v.source,
-                "vehicle_config.brakes.front_bias",
-                "braking (ax < 0) needs the brakes' front share (0…1)",
-            )
-        if np.any(ax > 0) and v.drive_split is None:
-            raise InputError(
-                v.source,
-                "vehicle_config.drive",
-                "accelerating (ax > 0) needs the drive's split (front, rear: shares adding to 1)",
-            )
 
     def run(self, accelerations: Accelerations, progress=None):
         """The attitude at every acceleration (docs/vehicle.md): the vehicle sweep's

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import InputError
 from ..io.yamlio import Reader, load_yaml
 
 ENDS = {"front": ("fl", "fr"), "rear": ("rl", "rr")}
@@ -116,3 +117,21 @@ def tyre_rates_of(v) -> np.ndarray | None:
     if t is None:
         return None
     return np.array([t[c[0]] for c in ("fl", "fr", "rl", "rr")]) * 1e3
+
+
+def check_splits(v, ax: np.ndarray) -> None:
+    """Braking (ax < 0) needs the brakes' front share, driving (ax > 0) the drive's
+    split (``v``: a VehicleGeometry): without them the tyres' longitudinal forces are
+    unknown — an InputError naming the key, not a car that neither brakes nor drives."""
+    if np.any(ax < 0) and v.front_bias is None:
+        raise InputError(
+            v.source,
+            "vehicle_config.brakes.front_bias",
+            "braking (ax < 0) needs the brakes' front share (0…1)",
+        )
+    if np.any(ax > 0) and v.drive_split is None:
+        raise InputError(
+            v.source,
+            "vehicle_config.drive",
+            "accelerating (ax > 0) needs the drive's split (front, rear: shares adding to 1)",
+        )

@@ -61,6 +61,15 @@ class PointTarget(Row):
             if J is not None and len(at.cols[f]):
                 J[:, i, at.cols[f]] = (at.Jc[f] @ self.direction).T
             return
+        cols = at.cols[k[0]] if J is not None else None
+        if cols is not None and len(cols) and all(np.array_equal(at.cols[f], cols) for f in k):
+            # its frames on one body (a contact patch's): the chain rule in their columns
+            p, jac = self.point.from_frames_many(
+                [at.P[f] for f in k], [at.Jc[f].transpose(1, 2, 0) for f in k]
+            )
+            r[:, i] = p @ self.direction - value
+            J[:, i, cols] = np.einsum("i,niv->nv", self.direction, jac)
+            return
         p, jac = self.point.from_frames_many(
             [at.P[f] for f in k], None if J is None else [at.Jp[f] for f in k]
         )

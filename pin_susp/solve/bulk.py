@@ -116,6 +116,12 @@ class Tree:
                 kinds.append((ks, [self.joints[k - 1][5] for k in ks]))
             self._moves.append(tuple(kinds))
 
+    def moved_by(self, joint: int) -> list[int]:
+        """The indices in v of the joints that move a joint (its supports, the universe
+        excluded): revolute, then prismatic."""
+        revolute, prismatic = self._moves[joint]
+        return list(revolute[1]) + list(prismatic[1])
+
     def placements(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """World rotation (njoints, n, 3, 3) and origin (njoints, n, 3) of every joint
         at the n configurations q (n, nq); joint 0 is the universe. (A product with a
@@ -369,16 +375,21 @@ class Rows:
         return out
 
 
-def newton_all(rows: Rows, q: np.ndarray, values: np.ndarray, tolerance: float):
+def newton_all(rows: Rows, q: np.ndarray, values: np.ndarray, tolerance: float, extra=None):
     """Newton iterations for every step at once: (q, tangents, iterations, max |r|) or
-    (None, ...) if any step does not converge to ``tolerance`` (or takes a wild step)."""
+    (None, ...) if any step does not converge to ``tolerance`` (or takes a wild step).
+    ``extra``: more right-hand sides (nrows, e) solved at each solution with the
+    tangents, their columns after the targets' (J·x = e: a closure's value changed by
+    one, the targets held)."""
     n = q.shape[0]
     q = q.copy()
     iterations = np.zeros(n, dtype=int)
     error = np.zeros(n)
-    tangents = np.empty((n, rows.tree.nv, values.shape[1]))
     rhs = np.zeros((rows.nrows, values.shape[1]))
     rhs[rows.first_target :] = np.eye(values.shape[1])
+    if extra is not None:
+        rhs = np.hstack([rhs, extra])
+    tangents = np.empty((n, rows.tree.nv, rhs.shape[1]))
     active = np.arange(n)
     for iteration in range(MAX_ITERATIONS + 1):
         r, J = rows.evaluate(q[active], values[active])

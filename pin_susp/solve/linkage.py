@@ -185,21 +185,30 @@ class FrameMotion:
         a = tree.axes(R)
         count, m = len(T), len(self.names)
         pos = np.empty((m, count, 3))
-        rates = [np.empty((m, len(c), count, 3)) for c in columns]
+        # a still point's rates stay 0 (v + w × arm of zeros gives +0)
+        rates = [np.zeros((m, len(c), count, 3)) for c in columns]
+        # only the driver columns some list asks for, each list's picked from them
+        need = sorted({i for c in columns for i in c})
+        picks = [[need.index(i) for i in c] for c in columns]
+        T = T[:, :, need]
         for j, index, local in self.groups:
             if j == 0:  # the chassis: fixed points
                 pos[index] = local[:, None]
-                for out in rates:
-                    out[index] = 0.0
                 continue
             # arms (g, 1, n, 3): each point's offset from its joint's origin
             arms = (R[j].reshape(-1, 3) @ local.T).reshape(count, 3, -1).transpose(2, 0, 1)
             pos[index] = arms + o[j][None]
-            twist = (tree.twist_jacobian(j, o, a) @ T).transpose(2, 0, 1)  # (k, n, 6)
-            arms = arms[:, None]
-            for c, out in zip(columns, rates, strict=True):
-                tw = twist[c][None]  # (1, k_c, n, 6)
-                out[index] = tw[..., :3] + cross(tw[..., 3:], arms)
+            # the lists along whose drivers its joints move (a vehicle's other corners
+            # stay still along one's: their tangents there are zeros)
+            moving = T[:, tree.moved_by(j)]  # (n, s, k)
+            live = [i for i, c in enumerate(picks) if moving[:, :, c].any()]
+            if not live:
+                continue
+            v, w = _twist(tree, j, o, a, T)  # (k, n, 3) each
+            arms = np.ascontiguousarray(arms)[:, None]
+            for i in live:
+                c = picks[i]
+                rates[i][index] = v[c][None] + cross(w[c][None], arms)
         if count == n:
             return pos, rates
         out_pos = np.full((m, n, 3), np.nan)
@@ -210,6 +219,25 @@ class FrameMotion:
             full[:, :, solved] = r
             out_rates.append(full)
         return out_pos, out_rates
+
+
+def _twist(tree, joint: int, o: np.ndarray, a: np.ndarray, T: np.ndarray) -> tuple:
+    """The velocity of a joint's origin and its angular velocity (k, n, 3) along each
+    tangent column (T: (n, nv, k)): Tree.twist_jacobian times T, in the joints that move
+    it alone (a revolute one k moves the origin at a_k × (o − o_k) and turns it at a_k, a
+    prismatic one moves it at a_k)."""
+    n, _, k = T.shape
+    v, w = np.zeros((k, n, 3)), np.zeros((k, n, 3))
+    revolute, prismatic = tree._moves[joint]
+    if revolute[0]:
+        ks, vs = revolute
+        along = T[:, vs, :]  # (n, s, k)
+        v += np.einsum("snx,nsk->knx", cross(a[ks], o[joint] - o[ks]), along)
+        w += np.einsum("snx,nsk->knx", a[ks], along)
+    if prismatic[0]:
+        ks, vs = prismatic
+        v += np.einsum("snx,nsk->knx", a[ks], T[:, vs, :])
+    return v, w
 
 
 class Composed:
@@ -361,6 +389,18 @@ class Composed:
         first, as many as ``mobility`` fewer than the joints' freedoms)."""
         self._drive.evaluate(self.q_design)
         return self._drive.jacobian
+
+    def closure_drivers(self, solver) -> np.ndarray | None:
+        """The drivers that change a closure's value (a toe link's length: drive_rhs's
+        columns after its targets') as right-hand sides of ``solver``'s rows (the
+        closures first, as the drive solver's; the targets held), or None."""
+        columns = self.drive_rhs[:, len(self._drive.targets) :]
+        if not columns.shape[1]:
+            return None
+        closures = sum(c.size for c in self.closures)
+        extra = np.zeros((solver.nrows, columns.shape[1]))
+        extra[:closures] = columns[:closures]
+        return extra
 
     def label_motion(self, qs: list, tangents: list | None = None) -> dict:
         """Every point (prefixed) at each configuration, as a jet.Dual per corner's label:

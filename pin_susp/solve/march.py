@@ -31,6 +31,7 @@ def march(
     tangents: list | None = None,
     keep=None,
     bulk: bool = False,
+    extra=None,
 ) -> list[Solution]:
     """Solve a sweep's steps (``values``: a row of target values each) in order, each
     from a prediction off the last solutions (halving toward it on failure).
@@ -43,10 +44,11 @@ def march(
     solved for all its steps at once (bulk.solve_sweep: the same solutions, to the
     tolerance), and ``keep`` is then called once with every step's tangent stacked
     (n, nv, k): it must act on the last axes alone; the sweep is marched step by step
-    when that does not apply or any step fails there.
+    when that does not apply or any step fails there; ``extra``: more right-hand sides
+    solved with each tangent there (newton_all's), its columns after the targets'.
     """
     if bulk and step_times is None:
-        solved = solve_sweep(solver, values, q, previous, progress)
+        solved = solve_sweep(solver, values, q, previous, progress, extra)
         if solved is not None:
             solutions, T = solved
             if tangents is not None:
@@ -138,12 +140,15 @@ class Predictor:
         return pin.integrate(self.model, q, T @ step)
 
 
-def solve_sweep(solver, values: np.ndarray, q: np.ndarray, previous: np.ndarray, progress=None):
+def solve_sweep(
+    solver, values: np.ndarray, q: np.ndarray, previous: np.ndarray, progress=None, extra=None
+):
     """Every step of a sweep, or None when it must be marched step by step.
 
     Returns (solutions, tangents (n, nv, ntargets)) with every step converged and on
     its design branches; None when the solver's rows or the model are not of the
-    kinds handled here, the sweep is short, or any step fails here.
+    kinds handled here, the sweep is short, or any step fails here. ``extra``: more
+    right-hand sides (nrows, e), their solutions after the tangents' (newton_all).
     """
     n = values.shape[0]
     if n < MIN_STEPS:
@@ -168,7 +173,7 @@ def solve_sweep(solver, values: np.ndarray, q: np.ndarray, previous: np.ndarray,
     T0 = np.concatenate([start_tangent[None], solved[1]])  # (m + 1, nv, k)
     segment = np.searchsorted(coarse, np.arange(n))  # step i lies in (coarse[s-1], coarse[s]]
     guess = hermite(q0, v0, T0, segment, values)
-    qs, T, iterations, error = newton_all(rows, guess, values, TOLERANCE)
+    qs, T, iterations, error = newton_all(rows, guess, values, TOLERANCE, extra)
     if qs is None:
         return None
     if not on_branches(solver, qs):

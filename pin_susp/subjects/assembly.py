@@ -78,7 +78,11 @@ class Assembly(Composed, AnalysesSurface):
     when it is solved, as an axle's always were); ``tangents_by_drivers``: every
     step's tangent kept per driver, T·(J_drive·T)⁻¹, whatever the targets (an axle's:
     the numbers it always had, to the last bit; a corner keeps them only when its
-    targets are its drivers).
+    targets are its drivers); ``tangents_by_targets``: the tangent per target (dq per
+    unit of each held target), then each closure driver's (a toe link's length, the
+    targets held: ``closure_drivers``), kept where the sweep is solved at once
+    (bulk.newton_all has them at each solution: a vehicle's rates along its body and
+    its drivers' tangents, Vehicle.measured_at), None per step otherwise.
     """
 
     labels: tuple[str, ...]
@@ -96,6 +100,7 @@ class Assembly(Composed, AnalysesSurface):
     refuses: tuple[str, ...] = ()
     checks_counts_first: bool = True
     tangents_by_drivers: bool = False
+    tangents_by_targets: bool = False
     results_class: type = None  # the class of its sweep's Results
     # setup and sensitivity: the subject's own static columns of its corners set
     # together, (column, heading) in mm (an axle's track and roll centre; a corner: none)
@@ -334,21 +339,31 @@ class Assembly(Composed, AnalysesSurface):
         step's exact tangent per driver (dq per unit of each corner's hub z, the rack)
         where the solve has it (``tangents_by_drivers``, or the targets are the
         drivers) — it stays empty otherwise. Each solution keeps its own
-        (``drive_tangent``)."""
+        (``drive_tangent``). Where ``tangents_by_targets`` instead: each step's tangent
+        per target, then each closure driver's, where the sweep is solved at once (None
+        per step marched: its Jacobian there is the last iterate's), for its
+        measured_at and own_columns alone (no solution's drive_tangent)."""
         check_held(sweep)
         solver = self.solver_for(sweep.targets, sweep.source)
         values = self.target_values(sweep.targets)
         q = self.q_design if q_start is None else q_start
         previous = self.values_at(solver, q)
         found = []
+        by_targets = self.tangents_by_targets and tangents is not None
         if self.tangents_by_drivers:
             solver.keep_jacobian = True  # exact tangents: better predictions, the rates
             keep = self._per_driver()
+            by_targets = False
+        elif by_targets:  # every step's at once (newton_all's, at each solution), then
+            # each closure driver's; a marched step's not (keep_jacobian off: the march
+            # as it was, its Jacobian the last iterate's)
+            keep = lambda tangent: tangent if tangent.ndim == 3 else None  # noqa: E731
         else:
             order = self.drive_order(sweep.targets) if tangents is not None else None
             solver.keep_jacobian = order is not None
             keep = None if order is None else lambda tangent: tangent[..., order]
             found = None if order is None else found
+        extra = self.closure_drivers(solver) if by_targets else None
         solutions = march(
             solver,
             values,
@@ -359,8 +374,12 @@ class Assembly(Composed, AnalysesSurface):
             tangents=found,
             keep=keep,
             bulk=True,
+            extra=extra,
         )
         if found is None:
+            return solutions
+        if by_targets:
+            tangents.extend(found)
             return solutions
         if self.tangents_by_drivers:
             found = self._through_drivers(solutions, found)
@@ -501,6 +520,7 @@ class Assembly(Composed, AnalysesSurface):
         solved = [s.q if s.converged else None for s in solutions]
         if tangents is None:
             tangents = [s.drive_tangent for s in solutions]
+        given = tangents
         qs, tangents = self.measured_at(solved, tangents)
         points = self.label_motion(qs, tangents)
         for name, (values, column_unit) in self.metric_columns(points, only).items():
@@ -514,7 +534,9 @@ class Assembly(Composed, AnalysesSurface):
             for name, (values, column_unit) in rate_columns(corner, poses).items():
                 columns[name + self.suffix(label)] = values
                 units[name + self.suffix(label)] = column_unit
-        for name, (values, column_unit) in self.own_columns(sweep, solved, plain, columns).items():
+        for name, (values, column_unit) in self.own_columns(
+            sweep, solved, plain, columns, given
+        ).items():
             columns[name], units[name] = values, column_unit
         for name, (values, column_unit) in point_columns(self.output_points, plain).items():
             if only is None or name in only:
@@ -528,10 +550,13 @@ class Assembly(Composed, AnalysesSurface):
         tangents per driver: the solved ones (a vehicle's: its chassis frame)."""
         return qs, tangents
 
-    def own_columns(self, sweep: Sweep, qs: list, plain: dict, columns: dict) -> dict:
+    def own_columns(
+        self, sweep: Sweep, qs: list, plain: dict, columns: dict, tangents=None
+    ) -> dict:
         """Its columns beyond its corners' and elements' (name → (values, unit)), from the
-        solved configurations ``qs``, the points as measured (``plain``, m) and the
-        columns so far: none (a vehicle's body)."""
+        solved configurations ``qs``, the points as measured (``plain``, m), the columns
+        so far and the sweep's tangents per step (sweep_results', or None): none (a
+        vehicle's body)."""
         return {}
 
     def run_sweep_chunks(self, sweep: Sweep | str | dict, rows: int = CHUNK, progress=None):

@@ -33,7 +33,6 @@ from ..errors import InputError
 from ..maths.vectors import unit
 from ..model.geometry import contact_patch, summary_repr
 from ..model.mechanisms import xml_name
-from ..solve.bulk import Frames, rows_of, solve_all, tree_of
 from ..solve.linkage import RACK_HELD, Linkage
 from .axle_file import AxleGeometry
 from .corner import Results
@@ -53,6 +52,7 @@ from .vehicle_file import (  # noqa: F401 (the vehicle file's names, importable 
     axle_key,
     load_vehicle,
 )
+from .vehicle_tangents import VehicleTangents
 from .vehicle_views import VehicleViews
 
 DERIVED = ("camber", "roadwheel_angle")  # the corner columns rated along heave, pitch, roll
@@ -94,7 +94,7 @@ class AxleElements:
         return out | self.bar.rate_columns(model, points)
 
 
-class Vehicle(VehicleExport, VehicleViews, VehicleAssembly):
+class Vehicle(VehicleExport, VehicleViews, VehicleTangents, VehicleAssembly):
     """Four corners under one sprung body on the road, one Pinocchio model
     (docs/vehicle.md): ``Vehicle("examples/vehicle_fs.yaml")`` or a VehicleGeometry.
 
@@ -131,6 +131,7 @@ class Vehicle(VehicleExport, VehicleViews, VehicleAssembly):
         "arb_twist_rear heave_link_length_front heave_link_length_rear".split()
     )
     held_joints = JOINTS  # a corner's rates: its own height with the body still
+    tangents_by_targets = True  # a sweep solved at once: its tangents, the body's rates
     needs = (
         "the body's heave, pitch and roll, and the steering (steering_wheel or a rack "
         "target); each road_z is 0 unless given"
@@ -355,17 +356,33 @@ class Vehicle(VehicleExport, VehicleViews, VehicleAssembly):
 
     def label_corner(self, label: str, plain: dict, qs: list) -> tuple:
         """A corner of its own for one label's rated spring and its configurations at
-        ``qs`` (chassis frame): solved at its wheel centre's height and the rack's travel,
-        every step at once where the sweep is long (the corner's own march; an axle's
-        label_corner solves one step after another)."""
+        ``qs`` (chassis frame): each its joints' values in the vehicle's configuration
+        (the corner's joints are the vehicle's, prefixed by its label, and the shared
+        rack; the body's at zero, its closures among the vehicle's: the pose at its
+        wheel centre's height and the rack's travel, as a solve of its own would find it
+        to the tolerance). Where a joint of its is not the vehicle's, solved at its
+        wheel centre's height and the rack's travel, every step at once where the sweep
+        is long (the corner's own march; an axle's label_corner solves one step after
+        another). Each label's Corner is built once, at its first sweep."""
         from ..model.sweep import Sweep, Target
         from .corner import Corner
 
         g = self.corners[label]
-        corner = Corner(g, apply_setup=False, warn=False, visuals=False)
+        own = self.__dict__.setdefault("_own_corners", {})  # built once per label
+        if label not in own:
+            own[label] = Corner(g, apply_setup=False, warn=False, visuals=False)
+        corner = own[label]
         solved = [i for i, q in enumerate(qs) if q is not None]
         poses = [None] * len(qs)
         if not solved:
+            return corner, poses
+        mapped = self._joints_in_vehicle(label, corner.model)
+        if mapped is not None:
+            own, theirs = mapped
+            for i in solved:
+                q = np.empty(corner.model.nq)
+                q[own] = qs[i][theirs]
+                poses[i] = q
             return corner, poses
         p = self.prefix(label)
         targets = [
@@ -378,20 +395,23 @@ class Vehicle(VehicleExport, VehicleViews, VehicleAssembly):
             poses[i] = s.q if s.converged else None
         return corner, poses
 
-    def measured_at(self, qs: list, tangents: list) -> tuple[list, None]:
-        """Its chassis frame: each configuration with the body's joints at zero, the
-        tangents per driver solved there (the sweep's are along its own targets)."""
-        return self.chassis_configurations(qs), None
+    def measured_at(self, qs: list, tangents: list) -> tuple[list, list | None]:
+        """Its chassis frame: each configuration with the body's joints at zero, and
+        the tangents per driver there (``drive_tangents``) where the sweep's solve kept
+        its own per target at every solved step, else None (label_motion solves them)."""
+        chassis = self.chassis_configurations(qs)
+        return chassis, self.drive_tangents(qs, chassis, tangents)
 
-    def own_columns(self, sweep, qs: list, plain: dict, columns: dict) -> dict:
+    def own_columns(self, sweep, qs: list, plain: dict, columns: dict, tangents=None) -> dict:
         """The body's pose, what the road sees and the rates along the body
-        (``body_columns``)."""
-        return self.body_columns(sweep, qs, plain, columns)
+        (``body_columns``; ``tangents``: the sweep's per target, where it has them)."""
+        return self.body_columns(sweep, qs, plain, columns, tangents)
 
-    def body_columns(self, sweep, qs: list, plain: dict, columns: dict) -> dict:
+    def body_columns(self, sweep, qs: list, plain: dict, columns: dict, tangents=None) -> dict:
         """The body's heave, pitch, roll and steering-wheel angle; each corner's camber
         to ground; the wheelbase on the road per side; and the exact rates of each
-        corner's camber, toe and wheel-centre height along heave, pitch and roll."""
+        corner's camber, toe and wheel-centre height along heave, pitch and roll
+        (``body_rates``)."""
         pose = np.full((len(qs), 3), np.nan)
         solved = [i for i, q in enumerate(qs) if q is not None]
         if solved:
@@ -430,7 +450,7 @@ class Vehicle(VehicleExport, VehicleViews, VehicleAssembly):
         for label in LABELS:
             out[f"contact_patch_road_z_{label}"] = (contact[label][:, 2] * 1e3, "mm")
         out |= vehicle_columns(self, plain, columns | {k: v[0] for k, v in out.items()})
-        out |= self.body_rates(sweep, qs, columns)
+        out |= self.body_rates(sweep, qs, columns, tangents)
         return out
 
     def bar_energies(self) -> list:
@@ -470,49 +490,6 @@ class Vehicle(VehicleExport, VehicleViews, VehicleAssembly):
         d, g = self.design_positions, self.corners[label]
         a = d[f"{label}_axle_outboard"] - d[f"{label}_axle_inboard"]
         return -g.sign * np.degrees(np.arctan2(a[0], g.sign * a[1]))
-
-    def body_rates(self, sweep, qs: list, columns: dict) -> dict:
-        """d(column)/d(heave) per mm and d/d(pitch), d/d(roll) per deg, the other targets
-        held: the sweep's tangent dq/d(target) at every solved step (its rows' Jacobian,
-        all steps at once), each corner's chassis-frame wheel-centre rate along it, times
-        the corner's own rate along its hub z (its rack held: the steering is a target)."""
-        solved = [i for i, q in enumerate(qs) if q is not None]
-        n = len(qs)
-        if not solved:
-            return {}
-        solver = self.solver_for(sweep.targets, sweep.source)
-        rows = rows_of(solver)
-        targets = self.held_targets(sweep.targets)
-        Q = np.array([qs[i] for i in solved])
-        zero = np.zeros((len(Q), len(targets)))
-        _, J = rows.evaluate(Q, zero)
-        want = [i for i, t in enumerate(targets) if t.quantity in ("heave", "pitch", "roll")]
-        rhs = np.zeros((rows.nrows, len(want)))
-        for c, i in enumerate(want):
-            rhs[rows.first_target + i, c] = 1.0
-        T = solve_all(J, rhs)
-        if T is None:
-            return {}
-        tree = tree_of(self.kin)
-        Qc = np.array(self.chassis_configurations(list(Q)))
-        frames = [self.points[f"{label}_wheel_center"].frame_id for label in LABELS]
-        _, Jw = Frames(tree, frames).evaluate(Qc)
-        moving = np.ones(self.model.nv, dtype=bool)
-        moving[self.body_v] = False
-        out = {}
-        for c, i in enumerate(want):
-            quantity = targets[i].quantity
-            scale, per = (1.0, "mm") if quantity == "heave" else (np.pi / 180.0 * 1e3, "deg")
-            for label, Jf in zip(LABELS, Jw, strict=True):
-                rate = np.full(n, np.nan)  # chassis-frame wheel-centre z, m per unit
-                rate[solved] = np.einsum("nv,nv->n", Jf[:, 2, moving], T[:, moving, c])
-                rate = rate * scale  # mm per mm, or mm per deg
-                out[f"deriv_wheel_center_z_wrt_{quantity}_{label}"] = (rate, f"mm/{per}")
-                for name in DERIVED:
-                    gain = columns.get(f"deriv_{name}_wrt_hub_z_{label}")
-                    if gain is not None:
-                        out[f"deriv_{name}_wrt_{quantity}_{label}"] = (gain * rate, f"deg/{per}")
-        return out
 
 
 class VehicleResults(Results):
