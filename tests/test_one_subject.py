@@ -35,6 +35,7 @@ SUBJECTS = (
     "subjects/corner.py",
     "subjects/axle.py",
     "subjects/axle_file.py",
+    "subjects/vehicle_file.py",
     "subjects/subject.py",
 )
 

@@ -110,8 +110,11 @@ def check_outputs(args, *paths) -> None:
         if at:
             inputs.append(at.rpartition(":")[0])
     inputs = [Path(p) for p in inputs if p]
-    if getattr(args, "geometry", None):  # a vehicle's axle files are its inputs too
-        inputs += referenced_files(args.geometry)
+    geometry = vars(args).get("geometry")
+    if geometry:  # a vehicle's axle files are its inputs too
+        from ..subjects.subject import referenced_files
+
+        inputs += referenced_files(geometry)
     seen = {}
     for path in (p for p in paths if p is not None):
         target = _identity(check_output(path))
@@ -121,22 +124,6 @@ def check_outputs(args, *paths) -> None:
         if target in seen and target[0] != "stream":
             raise PinSuspError(f"{seen[target]} and {path} are one file: give each output its own")
         seen[target] = path
-
-
-def referenced_files(path) -> list[Path]:
-    """The files a geometry file reads besides itself: a vehicle's axle files (its
-    ``front`` and ``rear`` paths, relative to it, docs/vehicle.md); none for a corner or
-    an axle, or for a file that cannot be read (its own error comes when it is loaded)."""
-    from ..io.yamlio import load_yaml
-
-    try:
-        data, _, _ = load_yaml(path)
-    except (PinSuspError, OSError):
-        return []
-    if not isinstance(data, dict) or data.get("scope") != "vehicle":
-        return []
-    here = Path(path).parent
-    return [here / data[end] for end in ("front", "rear") if isinstance(data.get(end), str)]
 
 
 def _identity(path: Path) -> tuple:

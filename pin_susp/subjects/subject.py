@@ -10,8 +10,11 @@ subject is built from its file's data, as a study builds its design and its vari
 from __future__ import annotations
 
 import copy
+from pathlib import Path
+from typing import TYPE_CHECKING
 
-from .assembly import Assembly
+if TYPE_CHECKING:
+    from .assembly import Assembly
 
 
 def is_axle_file(path) -> bool:
@@ -33,6 +36,23 @@ def is_vehicle_file(path) -> bool:
 
     data, _, _ = load_yaml(path)
     return data.get("scope") == "vehicle"
+
+
+def referenced_files(path) -> list[Path]:
+    """The files a geometry file reads besides itself: a vehicle's axle files (its
+    ``front`` and ``rear`` paths, relative to it, docs/vehicle.md); none for a corner or
+    an axle, or for a file that cannot be read (its own error comes when it is loaded)."""
+    from ..errors import PinSuspError
+    from ..io.yamlio import load_yaml
+
+    try:
+        data, _, _ = load_yaml(path)
+    except (PinSuspError, OSError):
+        return []
+    if not isinstance(data, dict) or data.get("scope") != "vehicle":
+        return []
+    here = Path(path).parent
+    return [here / data[end] for end in ("front", "rear") if isinstance(data.get(end), str)]
 
 
 def subject_class(path) -> type[Assembly]:
