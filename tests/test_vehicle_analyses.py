@@ -24,6 +24,7 @@ import numpy as np
 import pytest
 import yaml
 from scipy.spatial.transform import Rotation
+from vehicles import body_sweep
 
 import pin_susp
 from pin_susp.analyses.attitude import Attitude
@@ -47,20 +48,6 @@ FS = EXAMPLES / "vehicle_fs.yaml"
 G = 9.80665
 SIDE = {"fl": "left", "fr": "right", "rl": "left", "rr": "right"}
 BAR_POINTS = ("droplink_rocker", "droplink_u_bar")
-
-
-def body_sweep(heave, pitch, roll, steer=0.0, roads=None) -> Sweep:
-    n = max(len(np.atleast_1d(v)) for v in (heave, pitch, roll, steer, *(roads or {}).values()))
-    full = lambda v: np.broadcast_to(np.asarray(v, dtype=float), (n,)).copy()  # noqa: E731
-    targets = [
-        Target(None, None, full(heave), quantity="heave"),
-        Target(None, None, full(pitch), quantity="pitch"),
-        Target(None, None, full(roll), quantity="roll"),
-        Target(None, None, full(steer), quantity="steering_wheel"),
-    ]
-    for label, z in (roads or {}).items():
-        targets.append(Target(None, None, full(z), side=label, quantity="road_z"))
-    return Sweep(targets, "<test>")
 
 
 def axle_data(end: str) -> dict:
