@@ -348,7 +348,9 @@ def combined_note(results: list[ResultsFile], xname: str) -> str:
         column = input_column(results, kind)[0]
         unit = r.units.get(column, "")
         finite = r[column][np.isfinite(r[column])]
-        parts.append(f"{kind} {finite[0]:.4g} → {finite[-1]:.4g} {unit}".rstrip())
+        tiny = 1e-9 * max(np.abs(finite).max(), 1e-300)  # a solver's roundoff reads 0
+        first, last = (0.0 if abs(v) <= tiny else v for v in (finite[0], finite[-1]))
+        parts.append(f"{kind} {first:.4g} → {last:.4g} {unit}".rstrip())
     return (
         f"A combined sweep: {joined(parts)} move together. Every panel is drawn "
         "against the step (the inputs first): a curve shows what both inputs do at once, "
