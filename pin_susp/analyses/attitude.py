@@ -127,18 +127,7 @@ class Attitude:
 
     def _frames(self, q: np.ndarray) -> tuple[list, list, list]:
         """Every frame's position (n, 3), linear and angular Jacobians (n, 3, nv)."""
-        R, o = self.tree.placements(q)
-        P = self.frames.positions(R, o)
-        linear, angular = self.frames.compact(P, o, self.tree.axes(R), angular=True)
-        n, nv = q.shape[0], self.tree.nv
-        dense = ([], [])
-        for f, cols in enumerate(self.frames.cols):
-            for out, terms in zip(dense, (linear[f], angular[f]), strict=True):
-                J = np.zeros((n, 3, nv))
-                if len(cols):
-                    J[:, :, cols] = terms.transpose(1, 2, 0)
-                out.append(J)
-        return P, dense[0], dense[1]
+        return self.frames.evaluate(q, angular=True)
 
     def _one_by_one(self, q0: np.ndarray, values: np.ndarray):
         """The batch's linkages one at a time (the solver's halving from each start):

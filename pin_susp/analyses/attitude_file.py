@@ -82,31 +82,17 @@ def _g(r: Reader, value, key: str) -> float:
 
 
 def masses_of(v) -> dict:
-    m = v.masses
-    r = Reader(v.source)
-    key = "vehicle_config.masses"
-    r.mapping(
-        m,
-        key,
-        required=("sprung",),
-        optional=("unsprung_front", "unsprung_rear", "sprung_roll_inertia"),
-    )
-    sprung = r.positive(m["sprung"], f"{key}.sprung")
-    out = {"sprung": sprung, "unsprung": {}}
-    for end, labels in ENDS.items():
-        value = m.get(f"unsprung_{end}")
-        if value is None:
-            r.fail(f"{key}.unsprung_{end}", "the attitude needs each corner's unsprung mass (kg)")
-        value = r.number(value, f"{key}.unsprung_{end}")
-        if value < 0:
-            r.fail(f"{key}.unsprung_{end}", f"{value:g} kg is negative")
-        for c in labels:
-            out["unsprung"][c] = value
-    out["total"] = sprung + sum(out["unsprung"].values())
-    inertia = m.get("sprung_roll_inertia")
-    out["roll_inertia"] = (
-        None if inertia is None else r.positive(inertia, f"{key}.sprung_roll_inertia")
-    )
+    """The masses the attitude needs of ``vehicle_config.masses`` (their values checked
+    as the file was read: vehicle_file.py): the sprung mass and each corner's unsprung
+    one, kg (``unsprung``: corner → kg; ``total``), the roll inertia or None."""
+    m, r, key = v.masses, Reader(v.source), "vehicle_config.masses"
+    for name in ("sprung", *(f"unsprung_{end}" for end in ENDS)):
+        if name not in m:
+            r.fail(f"{key}.{name}", "missing key: the attitude needs the sprung mass and each "
+                   "axle's unsprung mass per corner (kg)")  # fmt: skip
+    out = {"sprung": float(m["sprung"]), "roll_inertia": m.get("sprung_roll_inertia")}
+    out["unsprung"] = {c: float(m[f"unsprung_{end}"]) for end, cs in ENDS.items() for c in cs}
+    out["total"] = out["sprung"] + sum(out["unsprung"].values())
     return out
 
 

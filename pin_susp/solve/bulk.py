@@ -255,22 +255,27 @@ class Frames:
             for t in self._terms
         ]
 
-    def evaluate(self, q: np.ndarray, jacobians: bool = True, placed=None):
+    def evaluate(self, q: np.ndarray, jacobians: bool = True, placed=None, angular=False):
         """Positions (list of (n, 3)) and Jacobians (list of (n, 3, nv), or None);
-        ``placed``: Tree.placements(q) when the caller has it already."""
+        ``placed``: Tree.placements(q) when the caller has it already; ``angular``: the
+        angular Jacobians too, a third list (n, 3, nv)."""
         R, o = self.tree.placements(q) if placed is None else placed
         P = self.positions(R, o)
         if not jacobians:
             return P, None
-        Jc, _ = self.compact(P, o, self.tree.axes(R))
-        n, nv = q.shape[0], self.tree.nv
-        J = []
-        for cols, terms in zip(self.cols, Jc, strict=True):
-            dense = np.zeros((n, 3, nv))
+        Jc, Wc = self.compact(P, o, self.tree.axes(R), angular=angular)
+        J = self._dense(Jc, q.shape[0])
+        return (P, J, self._dense(Wc, q.shape[0])) if angular else (P, J)
+
+    def _dense(self, compact: list, n: int) -> list[np.ndarray]:
+        """Each frame's rows from its columns that move it (``compact``'s) into all nv."""
+        out = []
+        for cols, terms in zip(self.cols, compact, strict=True):
+            dense = np.zeros((n, 3, self.tree.nv))
             if len(cols):
                 dense[:, :, cols] = terms.transpose(1, 2, 0)
-            J.append(dense)
-        return P, J
+            out.append(dense)
+        return out
 
     def compact(self, P: list, o: np.ndarray, a: np.ndarray, angular: bool = False):
         """Every frame's Jacobian in the columns that move it (``cols``), all frames' in

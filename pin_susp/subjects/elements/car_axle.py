@@ -15,8 +15,6 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-import numpy as np
-
 from .anti_roll_bar import AntiRollBar
 from .wheel_pair import SIDES, pair_columns, roll_rates
 
@@ -40,8 +38,7 @@ class AxleView:
             for name, at in d.items():  # the corner's points and its bar's ends
                 if name.startswith(f"{label}_"):
                     self.design_positions[side + name.removeprefix(label)] = at
-            a = d[f"{label}_axle_outboard"] - d[f"{label}_axle_inboard"]
-            self.design_steer[side] = -g.sign * np.degrees(np.arctan2(a[0], g.sign * a[1]))
+            self.design_steer[side] = model.design_steer(label)
         self.bar = AntiRollBar(None) if bar is None else bar
         self.elements = []
 
