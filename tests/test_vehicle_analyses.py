@@ -24,7 +24,7 @@ import numpy as np
 import pytest
 import yaml
 from scipy.spatial.transform import Rotation
-from vehicles import body_sweep
+from vehicles import axle_alone, body_sweep
 
 import pin_susp
 from pin_susp.analyses.attitude import Attitude
@@ -116,16 +116,9 @@ def test_each_corners_forces_are_its_axles_own(fs):
     assert forces["solver_converged"].all()
     compared = 0
     for end, (first, second) in AXLES.items():
-        model = AxleModel(getattr(fs.vehicle, end))
-        targets = [
-            Target("wheel_center", "z", forces[f"{label}_wheel_center_z"], "absolute", side=side)
-            for label, side in ((first, "left"), (second, "right"))
-        ]
-        if model.model.existJointName("rack_slide"):
-            rack = forces[f"{first}_trackrod_inboard_y"]
-            targets.append(Target("trackrod_inboard", "y", rack, "absolute", side="left"))
+        model, sweep = axle_alone(fs, end, forces)
         own = member_forces(
-            model, Sweep(targets, "<own>"), [AxleLoadCase("mixed", case.wheel(first),
+            model, sweep, [AxleLoadCase("mixed", case.wheel(first),
                                                             case.wheel(second))]
         )  # fmt: skip
         assert own["solver_converged"].all()

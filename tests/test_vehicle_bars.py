@@ -19,11 +19,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from vehicles import body_sweep
+from vehicles import axle_alone, body_sweep
 
 from pin_susp.errors import InputError
 from pin_susp.io.yamlio import load_yaml
-from pin_susp.model.sweep import Sweep, Target, load_sweep
+from pin_susp.model.sweep import load_sweep
 from pin_susp.subjects.axle import AxleModel
 from pin_susp.subjects.vehicle import AXLES, Vehicle
 
@@ -76,16 +76,8 @@ def rolled(car):
 def alone(car, end: str, results) -> tuple:
     """That axle's AxleModel swept on its own at the vehicle's chassis-frame wheel-centre
     heights (and its rack's travel)."""
-    model = AxleModel(getattr(car.vehicle, end))
-    first, second = AXLES[end]
-    targets = [
-        Target("wheel_center", "z", results[f"{label}_wheel_center_z"], "absolute", side=side)
-        for label, side in ((first, "left"), (second, "right"))
-    ]
-    if model.model.existJointName("rack_slide"):
-        rack = results[f"{first}_trackrod_inboard_y"]
-        targets.append(Target("trackrod_inboard", "y", rack, "absolute", side="left"))
-    own = model.run_sweep(Sweep(targets, "<alone>"))
+    model, sweep = axle_alone(car, end, results)
+    own = model.run_sweep(sweep)
     assert own["solver_converged"].all()
     return model, own
 

@@ -23,3 +23,22 @@ def body_sweep(heave, pitch, roll, steer=0.0, roads=None) -> Sweep:
     for label, z in (roads or {}).items():
         targets.append(Target(None, None, full(z), side=label, quantity="road_z"))
     return Sweep(targets, "<test>")
+
+
+def axle_alone(car, end: str, results):
+    """That axle's own model (its AxleModel, from the car's AxleGeometry) and the sweep
+    that holds it at the vehicle's chassis-frame wheel-centre heights (and the rack's
+    travel) of ``results``: an independent model of the same axle."""
+    from pin_susp.subjects.axle import AxleModel
+    from pin_susp.subjects.vehicle import AXLES
+
+    model = AxleModel(getattr(car.vehicle, end))
+    first, second = AXLES[end]
+    targets = [
+        Target("wheel_center", "z", results[f"{label}_wheel_center_z"], "absolute", side=side)
+        for label, side in ((first, "left"), (second, "right"))
+    ]
+    if model.model.existJointName("rack_slide"):
+        rack = results[f"{first}_trackrod_inboard_y"]
+        targets.append(Target("trackrod_inboard", "y", rack, "absolute", side="left"))
+    return model, Sweep(targets, "<alone>")
