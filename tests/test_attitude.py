@@ -724,6 +724,10 @@ def test_the_splits_a_longitudinal_acceleration_needs_and_a_grids_size(tmp_path)
         del given["vehicle_config"][key]
         attitude = Attitude(pin_susp.Vehicle(given))
         attitude.equilibria(np.array([0.0]), np.array([1.0]))  # lateral alone: no split needed
+        gradients = attitude.gradients()  # the one without its split blank, not ~0
+        gone = "pitch_gradient_braking" if key == "brakes" else "pitch_gradient_traction"
+        kept = "pitch_gradient_traction" if key == "brakes" else "pitch_gradient_braking"
+        assert np.isnan(gradients[gone]) and gradients[kept] > 0.5
         with pytest.raises(InputError, match=f"vehicle_config.{key}"):
             attitude.equilibria(np.array([ax]), np.array([0.0]))
     big = tmp_path / "big.yaml"

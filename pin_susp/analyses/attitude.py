@@ -91,13 +91,10 @@ class Attitude:
         labels = car.labels
         targets = [Target(None, None, [0.0], quantity=q) for q in ("heave", "pitch", "roll")]
         targets += [Target(None, None, [0.0], side=c, quantity="road_z") for c in labels]
-        self.targets = targets
         self.solver = car.solver_for(targets, source)
         self.rows = rows_of(self.solver)
-        held = car.held_targets(targets)
         self.values0 = car.values_at(self.solver, car.q_design)  # the rack's, held
         self.nu = 3 + len(labels)  # the coordinates: h, θ, φ, z per corner
-        assert len(held) >= self.nu
         names = []
         for c in labels:  # per corner: FRAMES
             names += [f"{c}_{name}" for name in FRAMES]
@@ -262,8 +259,6 @@ class Attitude:
         xt = (m["sprung"] * xg + sum(m["unsprung"][c] * xw[c] for c in labels)) / m["total"]
         front = (xt - xr) / (xf - xr)
         self.lateral_share = {"front": front, "rear": 1.0 - front}
-        self.x_axle = {"front": xf, "rear": xr}
-        self.cg_total_x = xt
         # static weights: left = right per axle; vertical and pitch balance (exact)
         moment = sum(m["unsprung"][c] * G * (xw[c] - xg) for c in labels)
         A = np.array([[2.0, 2.0], [2.0 * (xf - xg), 2.0 * (xr - xg)]])
@@ -526,7 +521,8 @@ class Attitude:
         """roll_gradient (deg/g, at ay → 0), pitch_gradient_braking and
         _traction (deg/g, + nose down per g of braking, of forward acceleration), the
         differences of the equilibria at ±SMALL g (second order one-sided for the pitch:
-        the brake and drive splits differ)."""
+        the brake and drive splits differ). A pitch gradient is blank (NaN) where its
+        split is not given: without it the tyres' longitudinal force is unknown."""
         h = SMALL
         ax = np.array([0.0, 0.0, -h, -2 * h, h, 2 * h, 0.0])
         ay = np.array([h, -h, 0.0, 0.0, 0.0, 0.0, 0.0])
@@ -534,10 +530,13 @@ class Attitude:
         roll = np.degrees(s["u"][:, 2])
         pitch = np.degrees(s["u"][:, 1])
         p0 = pitch[6]
+        v = self.car.vehicle
+        braking = (4 * pitch[2] - pitch[3] - 3 * p0) / (2 * h)
+        traction = -(4 * pitch[4] - pitch[5] - 3 * p0) / (2 * h)
         return {
             "roll_gradient": (roll[0] - roll[1]) / (2 * h),
-            "pitch_gradient_braking": (4 * pitch[2] - pitch[3] - 3 * p0) / (2 * h),
-            "pitch_gradient_traction": -(4 * pitch[4] - pitch[5] - 3 * p0) / (2 * h),
+            "pitch_gradient_braking": np.nan if v.front_bias is None else braking,
+            "pitch_gradient_traction": np.nan if v.drive_split is None else traction,
         }
 
     def frequencies(self) -> dict:

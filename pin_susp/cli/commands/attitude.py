@@ -109,10 +109,15 @@ def _summary(args, results) -> None:
     first = int(np.flatnonzero(ok)[0]) if ok.any() else None
     if first is not None:
         c = results.columns
+
+        def pitch(name: str, given: str) -> str:  # blank without its split
+            v = c[name][first]
+            return f"{v:.3f} deg/g" if np.isfinite(v) else f"(blank: no {given})"
+
         print(
             f"  roll gradient {c['roll_gradient'][first]:.3f} deg/g, pitch gradient "
-            f"{c['pitch_gradient_braking'][first]:.3f} deg/g braking, "
-            f"{c['pitch_gradient_traction'][first]:.3f} deg/g accelerating"
+            f"{pitch('pitch_gradient_braking', 'brakes.front_bias')} braking, "
+            f"{pitch('pitch_gradient_traction', 'drive')} accelerating"
         )
         line = (
             f"  ride frequency {c['ride_frequency_front'][first]:.2f} Hz front, "
