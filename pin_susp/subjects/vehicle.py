@@ -422,35 +422,43 @@ class Vehicle(VehicleExport, VehicleViews, VehicleTangents, VehicleAssembly):
             "pitch": (np.degrees(pitch), "deg"),
             "roll": (np.degrees(roll), "deg"),
         }
+        world = {}
+        for label in LABELS:
+            for k in ("wheel_center", "axle_inboard", "axle_outboard"):
+                name = f"{label}_{k}"
+                world[name] = self.body.to_world(plain[name], heave, pitch, roll)
+        out |= self.seen_from_road(world, plain)
+        out |= vehicle_columns(self, plain, columns | {k: v[0] for k, v in out.items()})
+        out |= self.body_rates(sweep, qs, columns, tangents)
+        return out
+
+    def seen_from_road(self, world: dict, chassis: dict) -> dict:
+        """What the road sees (name → (values (n,), unit)): the rack's travel and the
+        steering-wheel angle from the chassis-frame points ``chassis``; each corner's
+        camber to ground, the wheelbase on the road per side and each contact patch's
+        height from its wheel centre and axle ends in the road's frame (``world``; both
+        name → (n, 3), m)."""
+        out = {}
         end = f"fl_{rack.INBOARD}"
-        travel = None
-        if end in plain:  # the rack's travel along y from design
-            travel = plain[end][:, 1] - self.design_positions[end][1]
+        if end in chassis and self.corners["fl"].steering == "rack":
+            travel = chassis[end][:, 1] - self.design_positions[end][1]  # along y
             out["rack_displacement"] = (travel * 1e3, "mm")
-        if travel is not None and self.body.c_factor is not None:
-            angle = self.body.steer_sense * travel * 1e3 / self.body.c_factor * 360.0
-            out["steering_wheel_angle"] = (angle, "deg")
+            if self.body.c_factor is not None:
+                out["steering_wheel_angle"] = (self.body.steering_wheel_angle(travel), "deg")
         contact = {}
         for label in LABELS:
             p = f"{label}_"
-            w = {
-                k: self.body.to_world(plain[p + k], heave, pitch, roll)
-                for k in ("wheel_center", "axle_inboard", "axle_outboard")
-            }
-            spin = unit(w["axle_outboard"] - w["axle_inboard"])
+            spin = unit(world[p + "axle_outboard"] - world[p + "axle_inboard"])
             s = self.corners[label].sign  # the corner's camber, of its spin axis on the road
             ground = -np.degrees(np.arctan2(spin[:, 2], s * spin[:, 1]))
             out[f"camber_to_ground_{label}"] = (ground, "deg")
-            contact[label] = contact_patch(
-                w["wheel_center"], spin, self.corners[label].wheel.radius
-            )
+            radius = self.corners[label].wheel.radius
+            contact[label] = contact_patch(world[p + "wheel_center"], spin, radius)
         for side in ("left", "right"):
             f, r = ("fl", "rl") if side == "left" else ("fr", "rr")
             out[f"wheelbase_{side}"] = ((contact[f][:, 0] - contact[r][:, 0]) * 1e3, "mm")
         for label in LABELS:
             out[f"contact_patch_road_z_{label}"] = (contact[label][:, 2] * 1e3, "mm")
-        out |= vehicle_columns(self, plain, columns | {k: v[0] for k, v in out.items()})
-        out |= self.body_rates(sweep, qs, columns, tangents)
         return out
 
     def bar_energies(self) -> list:

@@ -21,8 +21,6 @@ import numpy as np
 
 from .. import __version__
 from ..io.yamlio import Reader
-from ..maths.vectors import unit
-from ..model.geometry import contact_patch
 from ..model.tree import BodyPose, Tree
 from ..model.urdf import tree_to_urdf
 from .vehicle_columns import vehicle_columns
@@ -31,7 +29,6 @@ BODY = ("heave", "pitch", "roll")
 BODY_STEP = 1e-4  # m, rad: the body's step for the engines' rates along it (±h, ±2h)
 DERIVED = ("camber", "roadwheel_angle")  # the corner columns rated along the body: vehicle.py's
 AXLE_PAIRS = (("fl", "fr"), ("rl", "rr"))  # each axle's left and right corner
-SIDE_PAIRS = {"left": ("fl", "rl"), "right": ("fr", "rr")}  # each side's front and rear
 Y = np.array([0.0, 1.0, 0.0])
 Z = np.array([0.0, 0.0, 1.0])
 
@@ -135,26 +132,9 @@ class VehicleExport:
         first = self.labels[0]
         chassis = {name: p[first].val[0] for name, p in points.items()}
         out = self._pose_columns(road, chassis)
-        end = self.prefix(first) + "trackrod_inboard"
-        if end in chassis and self.corners[first].steering == "rack":
-            travel = chassis[end][1] - self.design_positions[end][1]
-            out["rack_displacement"] = (np.array([travel * 1e3]), "mm")
-            if self.body.c_factor is not None:
-                angle = self.body.steer_sense * travel * 1e3 / self.body.c_factor * 360.0
-                out["steering_wheel_angle"] = (np.array([angle]), "deg")
-        contact = {}
-        for label in self.labels:
-            p = self.prefix(label)
-            spin = unit(road[p + "axle_outboard"] - road[p + "axle_inboard"])  # on the road
-            s = self.corners[label].sign  # the corner's camber, of its spin axis on the road
-            ground = -np.degrees(np.arctan2(spin[2], s * spin[1]))
-            out[f"camber_to_ground_{label}"] = (np.array([ground]), "deg")
-            radius = self.corners[label].wheel.radius
-            contact[label] = contact_patch(road[p + "wheel_center"], spin, radius)
-        for side, (f, r) in SIDE_PAIRS.items():
-            out[f"wheelbase_{side}"] = (np.array([(contact[f][0] - contact[r][0]) * 1e3]), "mm")
-        for label in self.labels:
-            out[f"contact_patch_road_z_{label}"] = (np.array([contact[label][2] * 1e3]), "mm")
+        out |= self.seen_from_road(
+            {n: at[None] for n, at in road.items()}, {n: at[None] for n, at in chassis.items()}
+        )
         # the whole car's (the roll axis, the pitch centre, the anti %, the turning radius):
         # vehicle_columns of the engine's chassis-frame points and its columns
         values = {k: v[0] for k, v in (columns | out).items()}

@@ -121,6 +121,11 @@ class BodyOnRoad:
             return np.zeros_like(v)
         return self.steer_sense * v / 360.0 * self.c_factor * 1e-3
 
+    def steering_wheel_angle(self, travel: np.ndarray) -> np.ndarray:
+        """The steering wheel's angle (deg, + turning left) for the rack's travel (m):
+        ``value``'s inverse."""
+        return self.steer_sense * travel * 1e3 / self.c_factor * 360.0
+
     def columns_of(self, model, points: dict, sides: dict) -> dict:
         """None of its own among the corners': the vehicle writes the body's (vehicle.py)."""
         return {}
