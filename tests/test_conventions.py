@@ -291,3 +291,41 @@ def test_a_studys_variants_min_and_max_swap_where_the_sign_flips():
     assert out.column("camber_min").to_pylist() == [-2.0, -1.0]
     lotus = in_convention(table, Output("lotus"))
     assert lotus.column("d_trackrod_inboard_y").to_pylist() == [-1.0, 2.0]
+
+
+def test_a_study_in_lotus_axes_is_the_iso_one_turned(tmp_path):
+    from pin_susp.study import load_study, run_study
+
+    body = {
+        "version": 1,
+        "geometry": str(EXAMPLES / "double_wishbone.yaml"),
+        "sweep": str(EXAMPLES / "bump_rack_held.yaml"),
+        "variables": [{"point": "trackrod_inboard", "axis": "y", "range": [-5, 5]}],
+        "kind": "doe",
+        "doe": {"method": "latin_hypercube", "samples": 3, "seed": 3},
+        "summary": ["camber", "roadwheel_angle", "wheel_center_x"],
+    }
+    tables = {}
+    for name in ("iso", "lotus"):
+        path = tmp_path / f"{name}.yaml"
+        path.write_text(yaml.safe_dump(body | {"conventions": name}))
+        out = tmp_path / name
+        run_study(load_study(path), out, scheduler=None, steps=True)
+        tables[name] = (
+            pq.read_table(out / "variants.parquet"),
+            pd.read_parquet(out / "steps.parquet"),
+        )
+    (iso, iso_steps), (lotus, lotus_steps) = tables["iso"], tables["lotus"]
+    assert lotus.schema.metadata[b"convention"] == b"lotus"
+    assert b"convention" not in iso.schema.metadata
+    col = lambda t, n: np.asarray(t.column(n).to_pylist(), dtype=float)  # noqa: E731
+    np.testing.assert_array_equal(
+        col(lotus, "d_trackrod_inboard_y"), -col(iso, "d_trackrod_inboard_y")
+    )
+    # x rearward: the wheel centre's x flips, its min and max swap; toe and camber stay
+    np.testing.assert_array_equal(col(lotus, "wheel_center_x_min"), -col(iso, "wheel_center_x_max"))
+    np.testing.assert_array_equal(col(lotus, "wheel_center_x_max"), -col(iso, "wheel_center_x_min"))
+    np.testing.assert_array_equal(col(lotus, "camber_min"), col(iso, "camber_min"))
+    for c, s in (("wheel_center_x", -1), ("wheel_center_y", -1), ("wheel_center_z", 1)):
+        np.testing.assert_array_equal(lotus_steps[c], s * iso_steps[c])
+    np.testing.assert_array_equal(lotus_steps["roadwheel_angle"], iso_steps["roadwheel_angle"])
