@@ -88,6 +88,40 @@ def run_arguments(parser, output: str, plot: str, cases: bool = False) -> None:
     )
     parser.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
     parser.add_argument("--plot", metavar="OUT.png", help=plot)
+    output_arguments(parser)
+
+
+# io.conventions' names, said here so that --help imports nothing (a test keeps them one)
+CONVENTIONS = ("iso", "sae", "lotus", "optimumk")
+UNITS = ("mm", "in")
+
+
+def output_arguments(parser, study: bool = False) -> None:
+    """--convention and --units: the sign convention and units of the columns written
+    (docs/results.md, "Output conventions and units"; the run itself is ISO, mm)."""
+    given = "default: the study file's conventions:, else iso" if study else "default iso"
+    parser.add_argument(
+        "--convention",
+        choices=tuple(CONVENTIONS),
+        metavar="|".join(CONVENTIONS),
+        help=f"the columns' sign convention and axes ({given}: x forward, y left, z up)",
+    )
+    parser.add_argument(
+        "--units",
+        choices=UNITS,
+        metavar="mm|in",
+        help="the columns' units: mm (default: mm, deg, N) or in (inches, deg, lbf: "
+        "every length, force and rate converted)",
+    )
+
+
+def output_form(args, convention: str | None = None):
+    """The Output (io.conventions) that --convention and --units ask for; ``convention``:
+    the default when --convention is not given (a study file's)."""
+    from ..io.conventions import DEFAULT, Output
+
+    chosen = getattr(args, "convention", None) or convention or DEFAULT
+    return Output(chosen, getattr(args, "units", None) or "mm")
 
 
 def check_image(path) -> None:

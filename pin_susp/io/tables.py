@@ -17,6 +17,7 @@ import numpy as np
 
 from .. import __version__
 from .atomic import atomic_write
+from .conventions import ISO_MM, Output
 
 
 def format_cell(value) -> str:
@@ -51,13 +52,16 @@ FAST_CELLS = 86_000
 _BLOCK_ROWS = 16_384  # rows formatted at once by the compiled style (bounded memory)
 
 
-def csv_header(units: dict, meta: dict, names) -> str:
-    """The ``#`` comment lines (version, sources, units) and the header row."""
+def csv_header(units: dict, meta: dict, names, output: Output = ISO_MM) -> str:
+    """The ``#`` comment lines (version, sources, the output's convention and units
+    unless ISO in mm, units) and the header row; ``units``: the Results' (ISO, mm)."""
     lines = [f"# pin_susp {__version__}"]
     for what in ("geometry", "sweep"):
         source, sha = meta[what]
         lines.append(f"# {what}: {source}" + (f" sha256={sha}" if sha else ""))
-    lines.append("# units: " + json.dumps(units))
+    if output.header():
+        lines.append(output.header())
+    lines.append("# units: " + json.dumps(output.column_units(units)))
     lines.append(",".join(names))
     return "\n".join(lines) + "\n"
 
@@ -67,20 +71,21 @@ def fast_style(rows: int, columns: int) -> bool:
     return rows * columns >= FAST_CELLS
 
 
-def csv_text(results) -> str:
-    """Results as CSV text: ``#`` comment lines, one header row, one row per step."""
+def csv_text(results, output: Output = ISO_MM) -> str:
+    """Results as CSV text: ``#`` comment lines, one header row, one row per step;
+    ``output``: the sign convention and units (io.conventions)."""
     names = list(results.columns)
-    columns = [results.columns[n] for n in names]
-    head = csv_header(results.units, results.meta, names)
+    columns = _chunk_columns(results, names, output, results.units)
+    head = csv_header(results.units, results.meta, names, output)
     if not fast_style(_rows(results), len(names)):
         return head + _repr_rows(columns)
     return head + b"".join(_fast_rows(columns)).decode()
 
 
-def write_csv(results, path: str | Path) -> None:
+def write_csv(results, path: str | Path, output: Output = ISO_MM) -> None:
     """Results as a CSV file (the text of csv_text), whole or not at all."""
     names = list(results.columns)
-    with CsvStream(path, results.units, results.meta, names, _rows(results)) as out:
+    with CsvStream(path, results.units, results.meta, names, _rows(results), output) as out:
         out.write(results)
 
 
@@ -92,9 +97,11 @@ class _Stream:
     """A file written a chunk of rows at a time through atomic_write (whole or not at
     all); ``names``: its columns, in order."""
 
-    def __init__(self, path, columns_order):
+    def __init__(self, path, columns_order, units: dict, output: Output):
         self.path = path
         self.names = list(columns_order)
+        self.units = units  # the Results' (ISO, mm): what ``output`` converts from
+        self.output = output
         self.rows = 0
         self._stack = None
         self._file = None
@@ -120,9 +127,11 @@ class CsvStream(_Stream):
     others); an exception or interrupt leaves neither.
     """
 
-    def __init__(self, path, units: dict, meta: dict, columns_order, total_rows: int):
-        super().__init__(path, columns_order)
-        self.head = csv_header(units, meta, self.names)
+    def __init__(
+        self, path, units: dict, meta: dict, columns_order, total_rows: int, output=ISO_MM
+    ):
+        super().__init__(path, columns_order, units, output)
+        self.head = csv_header(units, meta, self.names, output)
         self.fast = fast_style(total_rows, len(self.names))
 
     def __enter__(self):
@@ -136,7 +145,7 @@ class CsvStream(_Stream):
 
     def write(self, results) -> None:
         """Append the rows of a chunk (its columns: this file's, in any order)."""
-        columns = _chunk_columns(results, self.names)
+        columns = _chunk_columns(results, self.names, self.output, self.units)
         if self.fast:
             for part in _fast_rows(columns):
                 self._file.write(part)
@@ -149,11 +158,13 @@ class CsvStream(_Stream):
         return self._stack.__exit__(*exc)
 
 
-def _chunk_columns(results, names: list) -> list:
+def _chunk_columns(results, names: list, output: Output = ISO_MM, units=None) -> list:
+    """The chunk's columns in the file's order, in the output's convention and units."""
     if set(results.columns) != set(names):
         odd = sorted(set(results.columns) ^ set(names))
         raise ValueError(f"a chunk's columns differ from the file's: {odd}")
-    return [np.asarray(results.columns[n]) for n in names]
+    units = units or {}
+    return [np.asarray(output.values(n, results.columns[n], units.get(n))) for n in names]
 
 
 def _repr_rows(columns: list) -> str:
@@ -258,20 +269,23 @@ def _float_cells(text, whole: np.ndarray, pa, pc):
 ROW_GROUP = 65_536  # rows per Parquet row group: what a ParquetStream holds at most
 
 
-def write_parquet(results, path: str | Path) -> None:
+def write_parquet(results, path: str | Path, output: Output = ISO_MM) -> None:
     """Results as a Parquet file (pyarrow), whole or not at all: the CSV's columns, an
     undefined value (a blank CSV cell) as a null, the units, the sources and the
     pin_susp version in the schema's metadata; row groups of ROW_GROUP rows."""
-    with ParquetStream(path, results.units, results.meta, list(results.columns)) as out:
+    names = list(results.columns)
+    with ParquetStream(path, results.units, results.meta, names, None, output) as out:
         out.write(results)
 
 
-def parquet_metadata(units: dict, meta: dict) -> dict:
-    """The schema's metadata: pin_susp's version, the units, the sources."""
-    out = {"pin_susp": __version__, "units": json.dumps(units)}
+def parquet_metadata(units: dict, meta: dict, output: Output = ISO_MM) -> dict:
+    """The schema's metadata: pin_susp's version, the units, the sources; unless ISO in
+    mm, the convention and units (``convention``, ``output_units``)."""
+    out = {"pin_susp": __version__, "units": json.dumps(output.column_units(units))}
     for what in ("geometry", "sweep"):
         source, sha = meta[what]
         out[what] = json.dumps({"source": str(source), "sha256": sha})
+    out.update(output.metadata())
     return out
 
 
@@ -281,9 +295,11 @@ class ParquetStream(_Stream):
     the one write_parquet makes of all the rows at once, byte for byte. ``total_rows``
     is accepted for CsvStream's signature; Parquet does not need it."""
 
-    def __init__(self, path, units: dict, meta: dict, columns_order, total_rows=None):
-        super().__init__(path, columns_order)
-        self.metadata = parquet_metadata(units, meta)
+    def __init__(
+        self, path, units: dict, meta: dict, columns_order, total_rows=None, output=ISO_MM
+    ):
+        super().__init__(path, columns_order, units, output)
+        self.metadata = parquet_metadata(units, meta, output)
         self._held = []  # tables not yet written: fewer than ROW_GROUP rows in all
         self._held_rows = 0
         self._schema = None
@@ -299,8 +315,8 @@ class ParquetStream(_Stream):
         """Append the rows of a chunk (its columns: this file's, in any order)."""
         import pyarrow as pa
 
-        _chunk_columns(results, self.names)
-        table = pa.table({n: arrow_column(results.columns[n]) for n in self.names})
+        columns = _chunk_columns(results, self.names, self.output, self.units)
+        table = pa.table({n: arrow_column(c) for n, c in zip(self.names, columns, strict=True)})
         table = table.replace_schema_metadata(self.metadata)
         if self._schema is None:
             self._schema = table.schema

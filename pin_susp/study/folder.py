@@ -14,6 +14,7 @@ import yaml
 
 from .. import __version__
 from ..errors import PinSuspError
+from ..io.conventions import Output
 from .spec import MANIFEST, PARTS, Study, batches
 from .tasks import from_ipc
 from .variants import variant_data
@@ -205,15 +206,66 @@ def assemble(study: Study, outdir: Path, parts: Path, n: int, steps: bool):
         "study": json.dumps(_fingerprint(study, steps)),
         "variables": json.dumps([v.__dict__ for v in study.variables]),
     }
-    variants = variants.replace_schema_metadata(meta)
+    form = Output(study.convention)
+    variants = in_convention(variants, form).replace_schema_metadata(meta | form.metadata())
     if steps and any(parts.glob("steps-*.parquet")):  # (no variant solved: no steps)
         folder = outdir / "steps.parquet"
         folder.mkdir(exist_ok=True)
         for i in range(n):
             part = parts / f"steps-{i:06d}.parquet"
+            if part.exists() and not form.identity:  # the parts are ISO: converted here
+                write_parquet(steps_in_convention(pq.read_table(part), form), part)
             if part.exists():
                 os.replace(part, folder / f"part-{i:06d}.parquet")
     return variants
+
+
+STATISTICS = ("_static", "_min", "_max", "_linear")  # a variants column: a metric's
+
+
+def in_convention(variants, form):
+    """The variants' table in ``form``'s convention (the study's ``conventions:``): each
+    metric's statistics and each variable (``d_<point>_<axis>``) by the column's sign,
+    a metric's min and max swapped where the sign is −1."""
+    import pyarrow as pa
+    import pyarrow.compute as pc
+
+    if form.identity:
+        return variants
+    from ..io.conventions import CONVENTIONS, sign
+
+    convention = CONVENTIONS[form.convention]
+    columns = {}
+    for name in variants.column_names:
+        column = variants.column(name)
+        base = next((name.removesuffix(s) for s in STATISTICS if name.endswith(s)), name)
+        base = base.removeprefix("d_")
+        if not pa.types.is_floating(column.type) or sign(base, convention) == 1:
+            columns[name] = column
+            continue
+        if name.endswith(("_min", "_max")):  # −max is the new min
+            other = base + ("_max" if name.endswith("_min") else "_min")
+            column = variants.column(other) if other in variants.column_names else column
+        columns[name] = pc.negate(column)
+    return pa.table(columns, schema=None).replace_schema_metadata(variants.schema.metadata)
+
+
+def steps_in_convention(table, form):
+    """A steps part (its units in the schema's ``units``) in ``form``'s convention."""
+    import pyarrow as pa
+
+    units = json.loads((table.schema.metadata or {}).get(b"units", b"{}"))
+    columns = {}
+    for name in table.column_names:
+        column = table.column(name)
+        if pa.types.is_floating(column.type):
+            values = column.to_numpy(zero_copy_only=False)
+            column = pa.array(form.values(name, values, units.get(name)), from_pandas=True)
+        columns[name] = column
+    meta = dict(table.schema.metadata or {}) | {
+        k.encode(): v.encode() for k, v in form.metadata().items()
+    }
+    return pa.table(columns).replace_schema_metadata(meta)
 
 
 def drop_parts(parts: Path) -> None:

@@ -33,6 +33,7 @@ STUDY_KEYS = (
     "optimise",
     "summary",
     "batch_size",
+    "conventions",
 )
 MANIFEST = "study.json"
 PARTS = ".parts"
@@ -59,6 +60,7 @@ class Study:
     starts: int = 1
     summary: list[str] = field(default_factory=list)
     batch_size: int | None = None
+    convention: str = "iso"  # conventions: the outputs' sign convention (io.conventions)
     max_evaluations: int = 60
     geometry_sha256: str | None = None  # of the files as read
     sweep_sha256: str | None = None
@@ -184,6 +186,10 @@ def _load_study(source: str | Path) -> Study:
     for i, m in enumerate(summary):
         design.check_column(r.text(m, f"summary[{i}]"), f"summary[{i}]", r)
     study.summary = list(dict.fromkeys(summary))
+    if "conventions" in data:  # one name: the convention of variants.parquet, steps.parquet
+        from ..io.conventions import CONVENTIONS
+
+        study.convention = r.choice(data["conventions"], "conventions", tuple(CONVENTIONS))
     if "batch_size" in data:
         if kind == "optimise":
             r.fail("batch_size", "an optimisation runs one start per task: no batch_size")

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import sys
 
-from ..options import check_image, check_outputs, geometry_argument
+from ..options import check_image, check_outputs, geometry_argument, output_arguments, output_form
 from ..report import progress_bar
 
 DESCRIPTION = (
@@ -38,6 +38,7 @@ def arguments(parser) -> None:
         metavar="OUT.png",
         help="also draw the g-g plot: TLLTD, roll, pitch and each corner's camber to ground",
     )
+    output_arguments(parser)
 
 
 def run(args) -> int:
@@ -83,9 +84,9 @@ def _write(args, results, name: str) -> None:
         if is_parquet(args.output):
             from ...io.tables import write_parquet
 
-            write_parquet(results, args.output)
+            write_parquet(results, args.output, output_form(args))
         else:
-            write_csv(results, args.output)
+            write_csv(results, args.output, output_form(args))
         if args.plot is not None and results["solver_converged"].any():
             from ...plots import save_figure
             from ...plots.attitude import gg_figure

@@ -4,7 +4,7 @@ results, report, drawing, 3D replay and URDF written into one folder."""
 from __future__ import annotations
 
 from ...errors import PinSuspError
-from ..options import check_outputs
+from ..options import check_outputs, output_arguments, output_form
 from ..report import Digest, progress_bar, report_failures, summary, warn_transmission
 
 DESCRIPTION = (
@@ -25,6 +25,7 @@ def arguments(parser) -> None:
         metavar="DIR",
         help="output folder (default: ./pin_susp_demo)",
     )
+    output_arguments(parser)
 
 
 def run(args) -> int:
@@ -73,8 +74,9 @@ def run(args) -> int:
         for name, text in inputs.items():
             write_text(text, out / name)
         write_text(corner.urdf, files["URDF"])
-        text = csv_text(results)
-        write_text(text, files["results"])
+        text = csv_text(results)  # the report's: ISO, mm
+        form = output_form(args)
+        write_text(text if form.identity else csv_text(results, form), files["results"])
         _demo_pictures(corner, results, files, text)
     print(f"pin_susp demo: {corner.geometry.name}, {sweep.steps}-step bump + steer sweep")
     summary(digest, files["results"])

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from ... import __version__
 from ...errors import PinSuspError
-from ..options import check_outputs, count, geometry_argument
+from ..options import check_outputs, count, geometry_argument, output_arguments, output_form
 from ..report import progress_bar, report_failures
 
 DESCRIPTION = (
@@ -47,6 +47,7 @@ def arguments(parser) -> None:
         "rear_P)",
     )
     parser.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
+    output_arguments(parser)  # the CSV's; the printed table is ISO, mm
 
 
 def run(args) -> int:
@@ -134,7 +135,7 @@ def _sensitivity_report(
     from ...analyses.sensitivity import POINT_GROUPS
 
     if args.output is not None:
-        _sensitivity_csv(states, geometry.source, args.output, csv_notes)
+        _sensitivity_csv(states, geometry.source, args.output, csv_notes, output_form(args))
     status = 0 if results is None else report_failures(results, "have no sensitivities")
     if args.quiet or not states:
         return status
@@ -188,20 +189,28 @@ def _sensitivity_table(s, names, top: int, points: set) -> None:
         print(f"  undefined here (blank in the results): {', '.join(undefined)}")
 
 
-def _sensitivity_csv(states, source: str, path, notes=()) -> None:
+def _sensitivity_csv(states, source: str, path, notes=(), form=None) -> None:
+    """The long-format CSV; ``form``: its convention and units (io.conventions): a
+    value's sign is the metric's times its coordinate's axis', d(metric)/d(coordinate)
+    read as the derivative column ``deriv_<metric>_wrt_<axis>``."""
     from ...io.atomic import atomic_write
+    from ...io.conventions import ISO_MM
     from ...io.tables import format_cell
 
+    form = form or ISO_MM
+    per = form.unit("mm")
     with atomic_write(path) as f:
         f.write(f"# pin_susp {__version__} hardpoint sensitivities of {source}\n")
-        f.write("# value = d(metric)/d(hardpoint coordinate), per mm of the coordinate\n")
+        f.write(f"# value = d(metric)/d(hardpoint coordinate), per {per} of the coordinate\n")
+        if form.header():
+            f.write(form.header() + "\n")
         f.writelines(f"# {note}\n" for note in notes)
         f.write("step_index,metric,hardpoint,axis,value,unit\n")
         for s in states:
             for name, values in s.values.items():
+                unit = form.unit(s.units[name])
                 for i, hardpoint in enumerate(s.hardpoints):
                     for a, axis in enumerate("xyz"):
-                        f.write(
-                            f"{s.step},{name},{hardpoint},{axis},"
-                            f"{format_cell(values[i, a])},{s.units[name]}\n"
-                        )
+                        as_column = f"deriv_{name}_wrt_{axis}"  # its sign: metric's · axis'
+                        value = form.values(as_column, values[i, a], s.units[name])
+                        f.write(f"{s.step},{name},{hardpoint},{axis},{format_cell(value)},{unit}\n")

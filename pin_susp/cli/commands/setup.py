@@ -7,7 +7,15 @@ from __future__ import annotations
 
 from ... import __version__
 from ...errors import PinSuspError
-from ..options import check_outputs, finite, geometry_argument, numbers, positive
+from ..options import (
+    check_outputs,
+    finite,
+    geometry_argument,
+    numbers,
+    output_arguments,
+    output_form,
+    positive,
+)
 from ..report import wrote
 
 DESCRIPTION = (
@@ -89,6 +97,7 @@ def arguments(parser) -> None:
         "one corner (fl, fr, rl, rr: its axle with its own right points) or one axle "
         "(front, rear)",
     )
+    output_arguments(parser)  # the --csv sheet's; targets and -o SET.yaml stay ISO, mm
 
 
 SHEET_METRICS = (  # column, unit, short heading
@@ -189,6 +198,7 @@ def run(args) -> int:
                 args.csv,
                 link,
                 [statics[i] for _, i in rows_of],
+                output_form(args),
             )
     wrote(*(path for path, _ in written), args.csv)
     return 0
@@ -271,20 +281,31 @@ def _sensitivities(state, geometry, pitch) -> None:
         )
 
 
-def _sheet_csv(rows, labels, path, link: str = "trackrod", extra=None) -> None:
-    """The sheet's rows; ``extra``: per row, more columns (name → value), e.g. an
-    axle's track and roll centre."""
+def _sheet_csv(rows, labels, path, link: str = "trackrod", extra=None, form=None) -> None:
+    """The sheet's rows; ``extra``: per row, more columns (name → value, mm), e.g. an
+    axle's track and roll centre; ``form``: the convention and units (io.conventions)."""
     from ...io.atomic import atomic_write
+    from ...io.conventions import ISO_MM
     from ...io.tables import format_cell
 
+    form = form or ISO_MM
     setup_columns = [c.replace("trackrod", link.replace(" ", "_")) for c in SETUP_COLUMNS]
     names = ["row", *setup_columns] + [name for name, _, _ in SHEET_METRICS]
     extra = extra or [{}] * len(rows)
+    units = dict.fromkeys(setup_columns, "mm") | {n: u for n, u, _ in SHEET_METRICS}
+    units |= dict.fromkeys(extra[0], "mm")
+
+    def cell(name, value) -> str:
+        return format_cell(form.values(name, value, units[name]))
+
+    lengths = form.unit("mm")
     with atomic_write(path) as f:
-        f.write(f"# pin_susp {__version__} setup sheet; lengths mm, angles deg\n")
+        f.write(f"# pin_susp {__version__} setup sheet; lengths {lengths}, angles deg\n")
+        if form.header():
+            f.write(form.header() + "\n")
         f.write(",".join(names + list(extra[0])) + "\n")
         for label, row, more in zip(labels, rows, extra, strict=True):
-            cells = [label, *map(format_cell, row.setup)]
-            cells += [format_cell(row.metrics[name]) for name, _, _ in SHEET_METRICS]
-            cells += [format_cell(v) for v in more.values()]
+            cells = [label, *(cell(n, v) for n, v in zip(setup_columns, row.setup, strict=True))]
+            cells += [cell(name, row.metrics[name]) for name, _, _ in SHEET_METRICS]
+            cells += [cell(n, v) for n, v in more.items()]
             f.write(",".join(cells) + "\n")

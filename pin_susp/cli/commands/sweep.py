@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import sys
 
-from ..options import check_image, check_outputs, run_arguments
+from ..options import check_image, check_outputs, output_form, run_arguments
 from ..report import (
     Digest,
     progress_bar,
@@ -83,8 +83,9 @@ def _sweep_streamed(args, corner, sweep) -> int:
     first = next(parts)
     digest = Digest.of(first)
     kind = ParquetStream if is_parquet(args.output) else CsvStream
+    form = output_form(args)
     with (
-        kind(args.output, first.units, first.meta, list(first.columns), sweep.steps) as out,
+        kind(args.output, first.units, first.meta, list(first.columns), sweep.steps, form) as out,
         ThreadPoolExecutor(1) as writer,
     ):
         pending = writer.submit(out.write, first)
@@ -102,23 +103,25 @@ def _sweep_streamed(args, corner, sweep) -> int:
 
 
 def write_results(args, results) -> bool:
-    """The CSV (Parquet for an OUT ending .parquet) and, with --plot, the report: both or
-    neither; whether it was drawn."""
+    """The CSV (Parquet for an OUT ending .parquet; in --convention and --units) and,
+    with --plot, the report (from the ISO, mm columns): both or neither; whether it was
+    drawn."""
     from ...io.atomic import all_or_none, write_text
     from ...io.tables import csv_text, is_parquet, write_csv
 
+    form = output_form(args)
     plot = args.plot is not None and results["solver_converged"].any()
     text = csv_text(results) if plot else None  # the report reads the CSV's text
     with all_or_none():
         if is_parquet(args.output):
             from ...io.tables import write_parquet
 
-            write_parquet(results, args.output)
-        elif text is None:
-            write_csv(results, args.output)
+            write_parquet(results, args.output, form)
+        elif text is None or not form.identity:
+            write_csv(results, args.output, form)
         else:
             write_text(text, args.output)
-        if plot:  # drawn from the CSV's text: the output may be a stream
+        if plot:  # drawn from the ISO CSV's text: the output may be a stream
             from ...plots import ResultsFile, report_figure, save_figure
 
             written = ResultsFile(args.output, raw=text.encode())
