@@ -308,6 +308,10 @@ def _axle(src: Source, chosen: dict, flip, offset: float, want: Wanted, side: st
             notes.append(
                 f"default   static {what} = 0 deg (the file has no spindle point; give --{what})"
             )
+        elif getattr(want, what) is None:
+            notes.append(
+                f"from file static {what} = {value:g} deg (the spin axis: no spindle point)"
+            )
     c, t = math.radians(camber or 0.0), math.radians(toe or 0.0)
     axis = np.array([math.sin(t) * math.cos(c), sign * math.cos(t) * math.cos(c), -math.sin(c)])
     outboard = wc + offset * axis

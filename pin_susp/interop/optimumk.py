@@ -3,8 +3,8 @@
 One row per point: a name column and X, Y, Z columns, found by their headers (the
 first header starting with X, Y, Z — ``X``, ``X (mm)``, ``x [m]`` —, the name the
 first other column); the unit from those headers' brackets (mm, m, in) or
-``--units``, else mm (said). The axes are given by ``--axes``: the ISO axis each of
-the file's X, Y, Z is, default ``x,y,z`` (ISO 8855: x forward, y left, z up).
+``--units``, else mm (said). The axes are given by ``--axes``: where the file's X,
+Y, Z point, default ``forward,left,up`` (ISO 8855).
 """
 
 from __future__ import annotations
@@ -69,15 +69,28 @@ def vocabulary(extra: dict | None = None) -> dict[str, str]:
     return out
 
 
+DIRECTIONS = {
+    "forward": (0, 1.0),
+    "rearward": (0, -1.0),
+    "left": (1, 1.0),
+    "right": (1, -1.0),
+    "up": (2, 1.0),
+    "down": (2, -1.0),
+}
+
+
 def parse_axes(text: str) -> tuple[np.ndarray, np.ndarray]:
-    """``-x,-y,z`` (the ISO axis of the file's X, Y, Z) → (index, sign) per file axis."""
+    """``rearward,right,up`` (where the file's X, Y, Z point) → (ISO index, sign) of each."""
     parts = [p.strip().lower() for p in text.split(",")]
-    if len(parts) != 3 or any(not re.fullmatch(r"[+-]?[xyz]", p) for p in parts):
-        raise ValueError(f"expected three signed ISO axes such as x,y,z or -x,-y,z, got {text!r}")
-    index = np.array(["xyz".index(p[-1]) for p in parts])
+    if len(parts) != 3 or any(p not in DIRECTIONS for p in parts):
+        raise ValueError(
+            f"expected where X, Y, Z point, three of {', '.join(DIRECTIONS)} "
+            f"(e.g. forward,left,up), got {text!r}"
+        )
+    index = np.array([DIRECTIONS[p][0] for p in parts])
     if sorted(index) != [0, 1, 2]:
-        raise ValueError(f"each of x, y, z once, got {text!r}")
-    return index, np.array([-1.0 if p.startswith("-") else 1.0 for p in parts])
+        raise ValueError(f"X, Y, Z must point along three different axes, got {text!r}")
+    return index, np.array([DIRECTIONS[p][1] for p in parts])
 
 
 def to_iso(xyz: np.ndarray, axes) -> np.ndarray:

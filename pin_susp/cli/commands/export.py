@@ -21,9 +21,9 @@ def arguments(parser) -> None:
     )
     parser.add_argument(
         "--axes",
-        default="x,y,z",
-        metavar="AX,AY,AZ",
-        help="optimumk: the ISO axis of the table's X, Y, Z (default x,y,z)",
+        default="forward,left,up",
+        metavar="X,Y,Z",
+        help="optimumk: where the table's X, Y, Z point (default forward,left,up: ISO 8855)",
     )
 
 

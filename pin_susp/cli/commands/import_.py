@@ -72,10 +72,10 @@ def arguments(parser) -> None:
     )
     parser.add_argument(
         "--axes",
-        default="x,y,z",
-        metavar="AX,AY,AZ",
-        help="OptimumK: the ISO axis of the table's X, Y, Z (default x,y,z: ISO 8855; "
-        "e.g. -x,-y,z for X rearward, Y right)",
+        default="forward,left,up",
+        metavar="X,Y,Z",
+        help="OptimumK: where the table's X, Y, Z point (default forward,left,up: ISO "
+        "8855; e.g. rearward,right,up)",
     )
     parser.add_argument(
         "--units", choices=("mm", "m", "in"), help="OptimumK: the table's length unit"
@@ -109,9 +109,7 @@ def run(args) -> int:
         args.axes = parse_axes(args.axes)
         tyre = None if args.tyre is None else parse_tyre(args.tyre)
     except ValueError as exc:
-        raise PinSuspError(
-            f"--{'axes' if 'axes' in str(exc) or 'ISO' in str(exc) else 'tyre'}: {exc}"
-        ) from None
+        raise PinSuspError(f"--{'tyre' if 'tyre' in str(exc) else 'axes'}: {exc}") from None
     args.map = dict(_pair(m) for m in args.map)
     try:
         raw = Path(args.source).read_bytes()
@@ -159,5 +157,12 @@ def _pair(text: str) -> tuple[str, str]:
     if not eq or not name.strip() or not point.strip():
         raise PinSuspError(
             f"--map {text}: expected NAME=POINT, e.g. 'LCA Front=lower_wishbone_inboard_front'"
+        )
+    from ...interop.optimumk import NAMES
+
+    known = (*NAMES, "axle_inboard", "axle_outboard")
+    if point.strip() not in known:
+        raise PinSuspError(
+            f"--map {text}: {point.strip()!r} is not a pin_susp point (one of {', '.join(known)})"
         )
     return name.strip(), point.strip()
