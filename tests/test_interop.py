@@ -383,3 +383,23 @@ def test_export_refuses_other_mechanisms(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "type multilink: these formats carry double_wishbone and macpherson corners" in err
     assert not (tmp_path / "o.shk").exists()
+
+
+def test_lotus_report_layout_and_a_damper_on_the_upper_wishbone(tmp_path, capsys):
+    """Lotus' printed report: x y z before each name; a type pin_susp reads but whose
+    damper it has no place for (on the upper wishbone): its points ignored, said."""
+    lines = ["LOTUS SUSPENSION ANALYSIS v5.01", "TYPE 6 Double Wishbone, damper to upper wishbone"]
+    lines += ["X Y Z", "(mm) (mm) (mm)"]
+    for i, (name, xyz) in enumerate(LOTUS_RIGHT, start=1):
+        lines.append(f"{xyz[0]:.2f} {xyz[1]:.2f} {xyz[2]:.2f} POINT:{i} {name}")
+    lines += ["0.00 0.00 0.00 POINT:0", "STATIC VALUES", "Camber Angle (deg): 0.00"]
+    (tmp_path / "report.txt").write_text("\n".join(lines) + "\n")
+    assert main(["import", "report.txt", "--format", "shk", "-o", "out.yaml", *OPTIONS]) == 0
+    g = quiet_load(tmp_path / "out.yaml")
+    assert g.spring == "none"
+    assert_points(g, {k: v for k, v in ISO_RIGHT.items() if not k.startswith("strut_")})
+    out = capsys.readouterr().out
+    why = "pin_susp has no damper or pushrod on the upper wishbone"
+    assert f"ignored   Damper wishbone end (line 11): {why}" in out
+    assert f"ignored   Upper spring pivot point (line 15): {why}" in out
+    assert "used      Wheel centre point (line 17) as wheel_center" in out

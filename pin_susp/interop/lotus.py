@@ -67,8 +67,16 @@ ACTUATION_POINTS = set(LOWER_MOUNTED) | {
 }
 
 
+# a line of Lotus' printed report: "x y z POINT ( 1 ) = name" or "x y z POINT:1 name"
+REPORT_LINE = re.compile(
+    r"\s*(\S+)\s+(\S+)\s+(\S+)\s+POINT\s*(?:\(\s*\d+\s*\)\s*=|:\s*\d+)\s*(.*?)\s*$", re.I
+)
+
+
 def read(path: str, text: str, options) -> Source:
     lines = text.splitlines()
+    if any(REPORT_LINE.fullmatch(t) for t in lines):
+        return _read_report(path, lines)
     start = next(
         (
             i + 1
@@ -107,6 +115,32 @@ def read(path: str, text: str, options) -> Source:
         said=said,
         described=repr(type_line),
         label=labels(kind, said),
+    )
+
+
+def _read_report(path: str, lines: list[str]) -> Source:
+    """Lotus' printed report (``TYPE 1 Double Wishbone, ...`` then one line per point,
+    its x y z before its name); its first table of points only (the static one)."""
+    at = next((i for i, t in enumerate(lines) if re.match(r"\s*TYPE\s+\d+\s+\S", t, re.I)), None)
+    if at is None:
+        raise _error(path, None, "a Lotus report without its 'TYPE n ...' line")
+    type_line = re.sub(r"^\s*TYPE\s+\d+\s+", "", lines[at], flags=re.I).strip()
+    kind, said = _type(path, type_line, at + 1)
+    points, seen = [], False
+    for no, t in enumerate(lines[at + 1 :], start=at + 2):
+        m = REPORT_LINE.fullmatch(t)
+        if m is None:
+            if seen and t.strip().upper().startswith("STATIC VALUES"):
+                break
+            continue
+        seen = True
+        if m.group(4):  # "POINT:0", unnamed, ends some reports' lists
+            points.append(_point(path, m.group(4), (no, no), " ".join(m.groups()[:3]), kind, said))
+    if not points:
+        raise _error(path, at + 1, f"no points after the type line {type_line!r}")
+    label = labels(kind, said)
+    return Source(
+        path, FORMAT, points, kind=kind, said=said, described=repr(type_line), label=label
     )
 
 

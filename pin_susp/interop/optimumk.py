@@ -133,7 +133,9 @@ def read(path: str, raw: bytes, options) -> Source:
     if not points:
         raise PinSuspError(f"{path}: no points under the header (row {first})")
     src = Source(path, FORMAT, points, said=said, label=labels())
-    src.described = unit_note
+    given = getattr(options, "axes_given", True)
+    axes_note = "" if given else " (the default, ISO 8855: check OptimumK's options, give --axes)"
+    src.described = f"lengths in {unit_note}; X, Y, Z point {options.axes_text}{axes_note}"
     return src
 
 

@@ -72,7 +72,6 @@ def arguments(parser) -> None:
     )
     parser.add_argument(
         "--axes",
-        default="forward,left,up",
         metavar="X,Y,Z",
         help="OptimumK: where the table's X, Y, Z point (default forward,left,up: ISO "
         "8855; e.g. rearward,right,up)",
@@ -106,7 +105,9 @@ def run(args) -> int:
                 )
     fmt = args.format or _format(args.source)
     try:
-        args.axes = parse_axes(args.axes)
+        args.axes_given = args.axes is not None
+        args.axes_text = args.axes or "forward,left,up"
+        args.axes = parse_axes(args.axes_text)
         tyre = None if args.tyre is None else parse_tyre(args.tyre)
     except ValueError as exc:
         raise PinSuspError(f"--{'tyre' if 'tyre' in str(exc) else 'axes'}: {exc}") from None
