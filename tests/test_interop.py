@@ -403,3 +403,16 @@ def test_lotus_report_layout_and_a_damper_on_the_upper_wishbone(tmp_path, capsys
     assert f"ignored   Damper wishbone end (line 11): {why}" in out
     assert f"ignored   Upper spring pivot point (line 15): {why}" in out
     assert "used      Wheel centre point (line 17) as wheel_center" in out
+
+
+@pytest.mark.parametrize(
+    "axes, said",
+    [
+        ("up,left,forward", "--axes: up,left,forward is a left-handed frame"),
+        ("up,up,up", "--axes: X, Y, Z must point along three different axes"),
+        ("-x,y,z", "--axes: expected where X, Y, Z point"),
+    ],
+)
+def test_optimumk_axes_that_are_no_car_frame(tmp_path, capsys, axes, said):
+    argv = ["import", str(INTEROP / "fs_front_optimumk.csv"), "-o", "out.yaml", f"--axes={axes}"]
+    refused(capsys, tmp_path, argv + list(OPTIONS), said)

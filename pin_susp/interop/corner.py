@@ -89,7 +89,9 @@ def parse_tyre(text: str) -> tuple[float, float, float]:
 
 def side_of(points: list[Found]) -> str:
     """The side the file's points are on: the wheel centre's (else the mean y's)."""
-    ys = [p.xyz[1] for p in points if p.role == WHEEL_CENTER] or [p.xyz[1] for p in points]
+    ys = [p.xyz[1] for p in points if p.role == WHEEL_CENTER] or [
+        p.xyz[1] for p in points if p.role is not None
+    ]
     return "left" if (ys and float(np.mean(ys)) >= 0.0) else "right"
 
 
@@ -322,6 +324,8 @@ def _config(tdata: dict, want: Wanted, steering: str, offset: float, path: str) 
     config = dict(tdata.get("config") or {})
     config["steering"] = dict(config.get("steering") or {}, type=steering)
     wheel = dict(config.get("wheel") or {})
+    for key in ("center", "static_camber", "static_toe"):  # the axle points say the wheel
+        wheel.pop(key, None)
     wheel["offset"] = offset
     if want.tyre is not None:
         section, aspect, rim = want.tyre

@@ -90,7 +90,14 @@ def parse_axes(text: str) -> tuple[np.ndarray, np.ndarray]:
     index = np.array([DIRECTIONS[p][0] for p in parts])
     if sorted(index) != [0, 1, 2]:
         raise ValueError(f"X, Y, Z must point along three different axes, got {text!r}")
-    return index, np.array([DIRECTIONS[p][1] for p in parts])
+    sign = np.array([DIRECTIONS[p][1] for p in parts])
+    frame = np.zeros((3, 3))
+    frame[index, [0, 1, 2]] = sign  # column k: the file's axis k in ISO
+    if np.linalg.det(frame) < 0:
+        raise ValueError(
+            f"{text} is a left-handed frame (a mirror image of the car): check the axes"
+        )
+    return index, sign
 
 
 def to_iso(xyz: np.ndarray, axes) -> np.ndarray:
