@@ -1,166 +1,418 @@
-"""Robotics interop: MJCF in MuJoCo and Pinocchio, URDF used without pin_susp, validate."""
+"""Other tools' files (issue 27, 7; docs/interop.md): `pin-susp import` of a Lotus
+SHARK .shk, an OptimumK table (CSV, Excel) and an Adams/Car property file, and
+`pin-susp export --format shk|optimumk`.
 
-import importlib.util
-import sys
+The fixtures are written here from the layouts docs/interop.md describes (no
+binary file committed: the Excel one is made with openpyxl); the expected points
+are written by hand in ISO axes (x forward, y left, z up), so the axis conversion
+is checked against numbers that do not come from the converter.
+"""
 
-import mujoco
+import warnings
+
 import numpy as np
-import pinocchio as pin
 import pytest
-import yaml
-from conftest import EXAMPLES, ROOT, example
+from conftest import EXAMPLES
 
-import pin_susp
 from pin_susp.cli import main
-from pin_susp.model.mjcf import tree_to_mjcf
+from pin_susp.model.geometry import load_geometry
 
-CASES = [
-    ("double_wishbone.yaml", "bump_steer.yaml"),
-    ("camber_shim.yaml", "bump_steer.yaml"),
-    ("pushrod_rocker.yaml", "bump_steer.yaml"),
-    ("fixed_toe_link.yaml", "bump.yaml"),
+INTEROP = EXAMPLES / "interop"
+CORNERS = ("double_wishbone", "camber_shim", "fixed_toe_link", "macpherson", "pushrod_rocker")
+
+# A right front corner as Lotus writes it: X rearward, Y outboard of the right
+# wheel, Z up (mm) ...
+LOTUS_RIGHT = [
+    ("Lower wishbone front pivot", (-200, 250, 120)),
+    ("Lower wishbone rear pivot", (220, 260, 110)),
+    ("Lower wishbone outer ball joint", (5, 560, 115)),
+    ("Upper wishbone front pivot", (-180, 300, 290)),
+    ("Upper wishbone rear pivot", (200, 300, 280)),
+    ("Upper wishbone outer ball joint", (-10, 540, 330)),
+    ("Damper wishbone end", (0, 480, 130)),
+    ("Damper body end", (20, 280, 420)),
+    ("Outer track rod ball joint", (60, 550, 150)),
+    ("Inner track rod ball joint", (70, 230, 160)),
+    ("Upper spring pivot point", (20, 281, 419)),
+    ("Wheel spindle point", (0, 520, 228.6)),
+    ("Wheel centre point", (0, 600, 228.6)),
+    ("Part 1 C of G", (30, 400, 200)),
 ]
+# ... and the same corner in ISO axes, by hand (x = -X, y = -Y, z = Z), with a
+# 10 mm wheel offset: the hub face 10 mm outboard of the wheel centre.
+ISO_RIGHT = {
+    "lower_wishbone_inboard_front": (200, -250, 120),
+    "lower_wishbone_inboard_rear": (-220, -260, 110),
+    "lower_wishbone_outboard": (-5, -560, 115),
+    "upper_wishbone_inboard_front": (180, -300, 290),
+    "upper_wishbone_inboard_rear": (-200, -300, 280),
+    "upper_wishbone_outboard": (10, -540, 330),
+    "strut_bottom": (0, -480, 130),
+    "strut_top": (-20, -280, 420),
+    "trackrod_outboard": (-60, -550, 150),
+    "trackrod_inboard": (-70, -230, 160),
+    "axle_inboard": (0, -520, 228.6),
+    "axle_outboard": (0, -610, 228.6),
+}
+OPTIONS = ("--tyre", "180/50R13", "--offset", "10")
 
 
-@pytest.mark.parametrize(("geometry", "sweep"), CASES, ids=[c[0][:-5] for c in CASES])
-def test_validate_agrees_with_mujoco_and_the_pointwise_solver(geometry, sweep, capsys):
-    assert main(["validate", str(EXAMPLES / geometry), str(EXAMPLES / sweep)]) == 0
+def shk(type_line: str, points, heading: bool = True) -> str:
+    """A .shk as docs/interop.md describes it: a heading, the type line, then per
+    point a name line, five definition lines (any text), the x y z line and lines
+    of flags; a heading in capitals after the points."""
+    lines = ["LOTUS SUSPENSION ANALYSIS", "FRONT SUSPENSION"] if heading else []
+    lines.append(type_line)
+    for name, xyz in points:
+        lines += [name, "1", "Part 1 to part 2", "0 0 0", "-", "definition"]
+        lines.append(xyz if isinstance(xyz, str) else "  ".join(str(v) for v in xyz))
+        lines += ["0 0 0 0 0 0 0 0 0", "0 0 0 0 0 0 0"]
+    lines += ["STATIC VALUES", "CAMBER ANGLE (deg): 0.00"]
+    return "\n".join(lines) + "\n"
+
+
+def quiet_load(path):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return load_geometry(path)
+
+
+def assert_points(g, expected: dict, tol: float = 1e-9):
+    assert set(g.hardpoints) == set(expected)
+    for name, xyz in expected.items():
+        assert np.max(np.abs(g.hardpoints_mm[name] - np.array(xyz, float))) <= tol, name
+
+
+def refused(capsys, tmp_path, argv, *said):
+    """The command exits 2 with one line naming the problem, writes nothing."""
+    assert main(argv) == 2
+    out, err = capsys.readouterr()
+    assert err.count("\n") == 1 and err.startswith("pin-susp: error: ") and "Traceback" not in err
+    for text in said:
+        assert text in err, (text, err)
+    assert not (tmp_path / "out.yaml").exists()
+    return err
+
+
+# --------------------------------------------------------------------------- round trip
+
+
+@pytest.mark.parametrize("name", CORNERS)
+@pytest.mark.parametrize(
+    "fmt, suffix", [("shk", ".shk"), ("optimumk", ".csv"), ("optimumk", ".xlsx")]
+)
+def test_import_of_export_is_the_corner(tmp_path, capsys, name, fmt, suffix):
+    source = str(EXAMPLES / f"{name}.yaml")
+    g = quiet_load(source)
+    out = str(tmp_path / f"corner{suffix}")
+    assert main(["export", source, "--format", fmt, "-o", out]) == 0
+    back = str(tmp_path / "back.yaml")
+    assert main(["import", out, "-o", back, "--template", source, "-q"]) == 0
+    h = quiet_load(back)
+    assert_points(h, g.hardpoints_mm)
+    assert h.choices() == g.choices() and h.wheel == g.wheel and h.type == g.type
+    assert h.spring_rate == g.spring_rate and (h.camber_shim is None) == (g.camber_shim is None)
+    # without a template the choices come from the file and the options
+    w = g.wheel
+    tyre = f"{w.section_width * 1e3:g}/{w.aspect_ratio * 100:g}R{w.rim_diameter / 0.0254:g}"
+    again = ["import", out, "-o", back, "--tyre", tyre, "--offset", f"{w.offset * 1e3!r}", "-q"]
+    steering = ["--steering", "none"] if g.steering == "none" and fmt == "shk" else []
+    assert main(again + steering) == 0
+    h = quiet_load(back)
+    assert_points(h, g.hardpoints_mm)
+    assert h.choices() == g.choices() and h.actuation_mount == g.actuation_mount
+
+
+def test_a_left_corner_imported_as_the_right_is_its_mirror(tmp_path):
+    source = str(EXAMPLES / "pushrod_rocker.yaml")
+    g = quiet_load(source)
+    assert main(["export", source, "--format", "shk", "-o", "c.shk"]) == 0
+    assert main(["import", "c.shk", "-o", "r.yaml", "--template", source, "--side", "right"]) == 0
+    h = quiet_load("r.yaml")
+    assert h.side == "right"
+    assert_points(h, {k: v * np.array([1, -1, 1]) for k, v in g.hardpoints_mm.items()})
+
+
+# ------------------------------------------------------------------------ Lotus SHARK
+
+
+def test_lotus_axes_to_iso_on_a_hand_written_corner(tmp_path, capsys):
+    (tmp_path / "car.shk").write_text(
+        shk("TYPE 1 Double Wishbone, damper to lower wishbone", LOTUS_RIGHT)
+    )
+    assert main(["import", "car.shk", "-o", "out.yaml", *OPTIONS]) == 0
+    g = quiet_load(tmp_path / "out.yaml")
+    assert g.side == "right" and g.spring == "coilover" and g.actuation_mount == "lower_wishbone"
+    assert_points(g, ISO_RIGHT)
     out = capsys.readouterr().out
-    assert "mujoco: agrees within 1e-06" in out and "pointwise: agrees within 1e-06" in out
-
-
-@pytest.mark.parametrize("geometry", [c[0] for c in CASES])
-def test_mjcf_loads_in_mujoco_and_in_pinocchio(geometry, tmp_path):
-    out = tmp_path / "corner.xml"
-    assert main(["mjcf", str(EXAMPLES / geometry), "-o", str(out)]) == 0
-    corner = pin_susp.Corner(EXAMPLES / geometry)
-    m = mujoco.MjModel.from_xml_path(str(out))
-    d = mujoco.MjData(m)
-    mujoco.mj_forward(m, d)
-    assert m.neq == len(corner.closures)
-    assert d.nefc == 3 * len(corner.closures)
-    assert np.max(np.abs(d.efc_pos[: d.nefc])) < 1e-15  # closed at the design state
-    # a rod adds two hinges and turns one distance row into three: the mobility stays
-    assert m.nv - 3 * m.neq == corner.mobility
-    model, constraints, *_ = pin.buildModelAndConstraintsFromMJCF(str(out))
-    assert model.nv == m.nv
-    assert [type(c).__name__ for c in constraints] == ["PointAnchorConstraintModel"] * m.neq
-    # every site of MuJoCo is where pin_susp has its point
-    for name, p in corner.design_positions.items():
-        if name != "contact_patch_center":
-            site = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, name)
-            np.testing.assert_allclose(d.site_xpos[site], p, atol=1e-15)
-
-
-def plain_script():
-    spec = importlib.util.spec_from_file_location("plain", EXAMPLES / "urdf_without_pin_susp.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-def test_urdf_round_trips_through_the_plain_script(tmp_path):
-    urdf = tmp_path / "corner.urdf"
+    assert main(["import", "car.shk", "-o", "left.yaml", "--side", "left", *OPTIONS]) == 0
+    left = quiet_load(tmp_path / "left.yaml")
+    assert_points(left, {k: (x, -y, z) for k, (x, y, z) in ISO_RIGHT.items()})
+    # what it used, as which point, and what it ignored, and why
+    lines = out.splitlines()
+    assert "used      Lower wishbone front pivot (line 4) as lower_wishbone_inboard_front" in lines
+    assert "used      Damper body end (line 67) as strut_top" in lines
+    assert "used      Wheel spindle point (line 103) as wheel_spindle" in lines
     assert (
-        main(
+        "ignored   Upper spring pivot point (line 94): strut_top is given by "
+        "'Damper body end' (line 67)"
+    ) in lines
+    assert "ignored   Part 1 C of G (line 121): not a point pin_susp's corner has" in lines
+    assert sum(line.startswith(("used ", "ignored ")) for line in lines) == len(LOTUS_RIGHT)
+    assert any(line.startswith("default   config.steering.type = rack") for line in lines)
+    assert lines[-1] == "wrote out.yaml"
+
+
+def test_an_imported_corner_sweeps_as_the_one_it_came_from(tmp_path):
+    source, bump = str(EXAMPLES / "double_wishbone.yaml"), str(EXAMPLES / "bump.yaml")
+    shk_file = str(INTEROP / "fs_front.shk")
+    assert main(["import", shk_file, "-o", "g.yaml", "--template", source, "-q"]) == 0
+    assert main(["sweep", "g.yaml", bump, "-o", "a.csv", "-q"]) == 0
+    assert main(["sweep", source, bump, "-o", "b.csv", "-q"]) == 0
+    import pandas as pd
+
+    a, b = (pd.read_csv(p, comment="#", skiprows=0) for p in ("a.csv", "b.csv"))
+    numbers = a.select_dtypes("number").columns
+    assert len(a) > 5 and "camber" in numbers
+    assert np.allclose(
+        a[numbers].to_numpy(float), b[numbers].to_numpy(float), atol=1e-9, equal_nan=True
+    )
+
+
+@pytest.mark.parametrize(
+    "change, said",
+    [
+        (("type", "Semi Trailing Arm"), ["car.shk: line 3: suspension type 'Semi Trailing Arm'"]),
+        (
+            ("drop", "Upper wishbone rear pivot"),
             [
-                "urdf",
-                str(EXAMPLES / "pushrod_rocker.yaml"),
-                "-o",
-                str(urdf),
-                "--at",
-                f"{EXAMPLES / 'bump_steer.yaml'}:30",
-            ]
-        )
+                "car.shk: missing point for a double_wishbone corner",
+                "'Upper wishbone rear pivot' (upper_wishbone_inboard_rear)",
+            ],
+        ),
+        (
+            ("drop", "Wheel centre point"),
+            ["car.shk: missing point", "'Wheel centre point' (wheel_center)"],
+        ),
+        (
+            ("number", "Lower wishbone outer ball joint"),
+            [
+                "car.shk: line 28: 'Lower wishbone outer ball joint': "
+                "expected x y z (three numbers, mm), got '5 five 115'"
+            ],
+        ),
+    ],
+)
+def test_lotus_refusals(tmp_path, capsys, change, said):
+    kind, what = change
+    points = [
+        (n, "5 five 115" if kind == "number" and n == what else xyz) for n, xyz in LOTUS_RIGHT
+    ]
+    points = [p for p in points if not (kind == "drop" and p[0] == what)]
+    type_line = what if kind == "type" else "Double Wishbone, damper to lower wishbone"
+    (tmp_path / "car.shk").write_text(shk(type_line, points))
+    refused(capsys, tmp_path, ["import", "car.shk", "-o", "out.yaml", *OPTIONS], *said)
+
+
+def test_what_the_files_do_not_carry_is_asked_for(tmp_path, capsys):
+    (tmp_path / "car.shk").write_text(shk("Double Wishbone, damper to lower wishbone", LOTUS_RIGHT))
+    refused(
+        capsys, tmp_path, ["import", "car.shk", "-o", "out.yaml"], "car.shk: the tyre", "--tyre"
+    )
+
+
+# --------------------------------------------------------------------------- OptimumK
+
+
+def optimumk_rows(scale: float = 1.0):
+    """The Lotus corner's rows in X rearward, Y right (mm · scale), OptimumK-style names."""
+    names = {
+        "Lower wishbone front pivot": "Lower Wishbone Front Pivot",
+        "Lower wishbone rear pivot": "Lower Wishbone Rear Pivot",
+        "Lower wishbone outer ball joint": "Lower Ball Joint",
+        "Upper wishbone front pivot": "Upper Wishbone Front Pivot",
+        "Upper wishbone rear pivot": "Upper Wishbone Rear Pivot",
+        "Upper wishbone outer ball joint": "Upper Ball Joint",
+        "Damper wishbone end": "Damper Wishbone",
+        "Damper body end": "Damper Inboard",
+        "Outer track rod ball joint": "Tie Rod Outboard",
+        "Inner track rod ball joint": "Tie Rod Inboard",
+        "Wheel spindle point": "Spindle Point",
+        "Wheel centre point": "Wheel Center",
+        "Part 1 C of G": "Mystery Bracket",
+    }
+    return [(names[n], *(v * scale for v in xyz)) for n, xyz in LOTUS_RIGHT if n in names]
+
+
+def test_optimumk_csv_in_metres_with_its_axes(tmp_path, capsys):
+    rows = ["Name,X (m),Y (m),Z (m)"] + [
+        ",".join([n, *map(repr, v)]) for n, *v in optimumk_rows(1e-3)
+    ]
+    (tmp_path / "car.csv").write_text("\n".join(rows) + "\n")
+    assert (
+        main(["import", "car.csv", "-o", "out.yaml", "--axes", "rearward,right,up", *OPTIONS]) == 0
+    )
+    assert_points(quiet_load(tmp_path / "out.yaml"), ISO_RIGHT, tol=1e-9)
+    out = capsys.readouterr().out
+    assert "used      Damper Wishbone (row 8) as strut_bottom" in out
+    assert "ignored   Mystery Bracket (row 14): not a point pin_susp's corner has" in out
+    assert "m (from the header)" in out.splitlines()[0]
+
+
+def test_optimumk_excel_written_with_openpyxl(tmp_path, capsys):
+    import openpyxl
+
+    book = openpyxl.Workbook()
+    sheet = book.active
+    sheet.append(["Front suspension, right"])  # a title above the header
+    sheet.append(["Point", "X", "Y", "Z"])
+    for name, x, y, z in optimumk_rows():  # in ISO axes: the default --axes x,y,z
+        sheet.append([name, -x, -y, z])
+    book.save(tmp_path / "car.xlsx")
+    assert main(["import", "car.xlsx", "-o", "out.yaml", *OPTIONS]) == 0
+    assert_points(quiet_load(tmp_path / "out.yaml"), ISO_RIGHT)
+    out = capsys.readouterr().out
+    assert "used      Lower Ball Joint (row 5) as lower_wishbone_outboard" in out
+    assert "mm (the header gives no unit; give --units)" in out
+
+
+def test_optimumk_refusals(tmp_path, capsys):
+    rows = ["Name,X,Y,Z"] + [",".join([n, *map(str, v)]) for n, *v in optimumk_rows()]
+    rows[3] = "Lower Ball Joint,5,56O,115"  # a letter O for a zero
+    (tmp_path / "car.csv").write_text("\n".join(rows) + "\n")
+    refused(
+        capsys,
+        tmp_path,
+        ["import", "car.csv", "-o", "out.yaml", *OPTIONS],
+        "car.csv: row 4 ('Lower Ball Joint'): Y: expected a number, got '56O'",
+    )
+    argv = ["import", "car.csv", "-o", "out.yaml", "--map", "Lower Ball Joint=lbj", *OPTIONS]
+    refused(capsys, tmp_path, argv, "--map Lower Ball Joint=lbj: 'lbj' is not a pin_susp point")
+    del rows[3]
+    (tmp_path / "car.csv").write_text("\n".join(rows) + "\n")
+    refused(
+        capsys,
+        tmp_path,
+        ["import", "car.csv", "-o", "out.yaml", *OPTIONS],
+        "car.csv: missing point",
+        "'Lower Ball Joint' (lower_wishbone_outboard)",
+    )
+
+
+# -------------------------------------------------------------------------- Adams/Car
+
+
+def test_adams_example_is_the_example_corner(tmp_path, capsys):
+    source = str(INTEROP / "fs_front_adams.sub")
+    assert main(["import", source, "-o", "out.yaml", "--tyre", "270/55R13"]) == 0
+    g, h = quiet_load(EXAMPLES / "double_wishbone.yaml"), quiet_load(tmp_path / "out.yaml")
+    assert_points(
+        h,
+        {k: v for k, v in g.hardpoints_mm.items() if k != "axle_inboard"}
+        | {"axle_inboard": h.hardpoints_mm["axle_inboard"]},
+    )
+    axis = h.hardpoints_mm["axle_outboard"] - h.hardpoints_mm["axle_inboard"]
+    assert np.allclose(
+        axis / np.linalg.norm(axis), np.array([0, 150, 5]) / np.hypot(150, 5), atol=1e-12
+    )
+    out = capsys.readouterr().out
+    assert "ignored   hpr_lca_front (line 29): the right side's" in out
+    assert "ignored   hps_rack_house_mount (line 38): a single (centreline) point" in out
+    assert "from file static camber = -1.90915 deg" in out
+    assert main(["sweep", "out.yaml", str(EXAMPLES / "bump.yaml"), "-o", "b.csv", "-q"]) == 0
+
+
+def test_adams_units_and_right_side(tmp_path, capsys):
+    """A right corner in metres: Adams' axes are Lotus' (x rearward, y right, z up)."""
+    adams = {
+        "Lower wishbone front pivot": "lca_front",
+        "Lower wishbone rear pivot": "lca_rear",
+        "Lower wishbone outer ball joint": "lca_outer",
+        "Upper wishbone front pivot": "uca_front",
+        "Upper wishbone rear pivot": "uca_rear",
+        "Upper wishbone outer ball joint": "uca_outer",
+        "Damper wishbone end": "lower_strut",
+        "Damper body end": "top_mount",
+        "Outer track rod ball joint": "tierod_outer",
+        "Inner track rod ball joint": "tierod_inner",
+        "Wheel centre point": "wheel_center",
+    }
+    lines = [
+        "[UNITS]",
+        " LENGTH = 'meter'",
+        "[HARDPOINT]",
+        "{hardpoint_name x_value y_value z_value}",
+    ]
+    for name, xyz in LOTUS_RIGHT:
+        if name in adams:
+            lines.append(f" 'hpr_{adams[name]}' " + " ".join(repr(v / 1000) for v in xyz))
+    (tmp_path / "car.sub").write_text("\n".join(lines) + "\n")
+    argv = ["import", "car.sub", "-o", "ok.yaml", "--side", "right", "--camber", "0", "--toe", "0"]
+    assert main(argv + list(OPTIONS)) == 0
+    want = dict(ISO_RIGHT, axle_inboard=(0, -610 + 50, 228.6))  # 50 mm inboard along the axis
+    assert_points(quiet_load(tmp_path / "ok.yaml"), want)
+    lines[1] = " LENGTH = 'furlong'"
+    (tmp_path / "car.sub").write_text("\n".join(lines) + "\n")
+    refused(
+        capsys,
+        tmp_path,
+        ["import", "car.sub", "-o", "out.yaml", *OPTIONS],
+        "car.sub: line 2: [UNITS] LENGTH 'furlong'",
+    )
+
+
+# ---------------------------------------------------------------------- the examples
+
+
+@pytest.mark.parametrize(
+    "fmt, name", [("shk", "fs_front.shk"), ("optimumk", "fs_front_optimumk.csv")]
+)
+def test_committed_examples_are_what_the_exporter_writes(tmp_path, fmt, name):
+    """examples/interop is kept in sync: regenerate with the command in docs/interop.md."""
+    out = tmp_path / name
+    assert (
+        main(["export", str(EXAMPLES / "double_wishbone.yaml"), "--format", fmt, "-o", str(out)])
         == 0
     )
-    source = (EXAMPLES / "urdf_without_pin_susp.py").read_text()
-    assert "import pin_susp" not in source and "from pin_susp" not in source
-    plain = plain_script()
-    model, closures, lengths = plain.load(urdf)
-    assert [(n, k) for n, k, _ in closures] == [
-        ("upper_ball_joint", "ball"),
-        ("trackrod", "distance"),
-        ("pushrod", "distance"),
-    ]
-    # the sidecar's joint values put yourdfpy and Pinocchio on pin_susp's solved frames
-    pose = yaml.safe_load(urdf.with_suffix(".pose.yaml").read_text())
-    assert pose["step"] == 30
-    corner = pin_susp.Corner(EXAMPLES / "pushrod_rocker.yaml")
-    results = corner.run_sweep(EXAMPLES / "bump_steer.yaml")
-    names = [n for n in corner.point_names if n != "contact_patch_center"]
-    frames = plain.yourdfpy_frames(urdf, pose["joints"], names)
-    q = np.array([pose["joints"][model.names[j]] for j in range(1, model.njoints)])
-    data = model.createData()
-    pin.framesForwardKinematics(model, data, q)
-    for name in names:
-        ours = [results[f"{name}_{a}"][30] for a in "xyz"]
-        np.testing.assert_allclose(frames[name] * 1e3, ours, atol=1e-9, err_msg=name)
-        np.testing.assert_allclose(
-            data.oMf[model.getFrameId(name)].translation * 1e3, ours, atol=1e-9
-        )
-    # and the plain script's own Newton solve lands on pin_susp's pose
-    q = plain.solve_pose(model, closures, lengths, wheel_center_dz=0.02, rack=0.0)
-    data = model.createData()
-    pin.framesForwardKinematics(model, data, q)
-    pose = corner.solve_pose(
-        [pin_susp.Target("wheel_center", "z", 20.0), pin_susp.Target("trackrod_inboard", "y", 0.0)]
-    )
-    for name in names:
-        np.testing.assert_allclose(
-            data.oMf[model.getFrameId(name)].translation * 1e3, pose.points[name], atol=1e-9
-        )
+    assert out.read_bytes() == (INTEROP / name).read_bytes()
 
 
-def test_plain_script_runs_on_the_committed_urdf(capsys):
-    plain_script().main(ROOT / "urdf" / "double_wishbone.urdf")
-    assert "2 loop closures" in capsys.readouterr().out
+def test_export_refuses_other_mechanisms(tmp_path, capsys):
+    argv = ["export", str(EXAMPLES / "multilink_rear.yaml"), "--format", "shk", "-o", "o.shk"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert "type multilink: these formats carry double_wishbone and macpherson corners" in err
+    assert not (tmp_path / "o.shk").exists()
 
 
-def test_validate_fails_when_a_hardpoint_moved_after_export(tmp_path, capsys):
-    exported = tmp_path / "corner.xml"
-    assert main(["mjcf", str(EXAMPLES / "double_wishbone.yaml"), "-o", str(exported)]) == 0
-    moved = example("double_wishbone.yaml")
-    moved["hardpoints"]["upper_wishbone_outboard"]["z"] += 2.0
-    path = tmp_path / "moved.yaml"
-    path.write_text(yaml.safe_dump(moved))
-    code = main(["validate", str(path), str(EXAMPLES / "bump_steer.yaml"), "--mjcf", str(exported)])
+def test_lotus_report_layout_and_a_damper_on_the_upper_wishbone(tmp_path, capsys):
+    """Lotus' printed report: x y z before each name; a type pin_susp reads but whose
+    damper it has no place for (on the upper wishbone): its points ignored, said."""
+    lines = ["LOTUS SUSPENSION ANALYSIS v5.01", "TYPE 6 Double Wishbone, damper to upper wishbone"]
+    lines += ["X Y Z", "(mm) (mm) (mm)"]
+    for i, (name, xyz) in enumerate(LOTUS_RIGHT, start=1):
+        lines.append(f"{xyz[0]:.2f} {xyz[1]:.2f} {xyz[2]:.2f} POINT:{i} {name}")
+    lines += ["0.00 0.00 0.00 POINT:0", "STATIC VALUES", "Camber Angle (deg): 0.00"]
+    (tmp_path / "report.txt").write_text("\n".join(lines) + "\n")
+    assert main(["import", "report.txt", "--format", "shk", "-o", "out.yaml", *OPTIONS]) == 0
+    g = quiet_load(tmp_path / "out.yaml")
+    assert g.spring == "none"
+    assert_points(g, {k: v for k, v in ISO_RIGHT.items() if not k.startswith("strut_")})
     out = capsys.readouterr().out
-    assert code == 1
-    assert "mujoco: DISAGREES" in out and "camber" in out.split("mujoco: DISAGREES")[1]
-    assert "pointwise: agrees" in out
+    why = "pin_susp has no damper or pushrod on the upper wishbone"
+    assert f"ignored   Damper wishbone end (line 11): {why}" in out
+    assert f"ignored   Upper spring pivot point (line 15): {why}" in out
+    assert "used      Wheel centre point (line 17) as wheel_center" in out
 
 
-def test_validate_without_mujoco_says_how_to_install_and_still_checks(monkeypatch, capsys):
-    monkeypatch.setitem(sys.modules, "mujoco", None)
-    assert (
-        main(["validate", str(EXAMPLES / "fixed_toe_link.yaml"), str(EXAMPLES / "bump.yaml")]) == 0
-    )
-    out = capsys.readouterr().out
-    assert "pip install 'pin_susp[validate]'" in out and "pointwise: agrees" in out
-
-
-def test_mjcf_of_a_pushrod_corner_has_rod_bodies():
-    corner = pin_susp.Corner(EXAMPLES / "pushrod_rocker.yaml")
-    text = tree_to_mjcf(corner.tree)
-    for name in ("trackrod_rod", "pushrod_rod", "rocker"):
-        assert f'<body name="{name}"' in text
-
-
-@pytest.mark.parametrize("name", sorted(p.stem for p in (ROOT / "urdf").glob("*.urdf")))
-def test_plain_script_solves_every_mechanisms_urdf_as_pin_susp_does(name):
-    """The URDF alone (no pin_susp) solves the pose that pin_susp solves: wheel centre
-    20 mm up, rack at design where there is one."""
-    plain = plain_script()
-    model, closures, lengths = plain.load(ROOT / "urdf" / f"{name}.urdf")
-    q = plain.solve_pose(model, closures, lengths, wheel_center_dz=0.02)
-    data = model.createData()
-    pin.framesForwardKinematics(model, data, q)
-    corner = pin_susp.Corner(EXAMPLES / f"{name}.yaml")
-    targets = [pin_susp.Target("wheel_center", "z", 20.0)]
-    if corner.geometry.steering == "rack":
-        targets.append(pin_susp.Target("trackrod_inboard", "y", 0.0))
-    pose = corner.solve_pose(targets)
-    for point in ("wheel_center", "axle_inboard", "axle_outboard"):
-        theirs = data.oMf[model.getFrameId(point)].translation * 1e3
-        np.testing.assert_allclose(theirs, pose.points[point], atol=1e-9, err_msg=point)
+@pytest.mark.parametrize(
+    "axes, said",
+    [
+        ("up,left,forward", "--axes: up,left,forward is a left-handed frame"),
+        ("up,up,up", "--axes: X, Y, Z must point along three different axes"),
+        ("-x,y,z", "--axes: expected where X, Y, Z point"),
+    ],
+)
+def test_optimumk_axes_that_are_no_car_frame(tmp_path, capsys, axes, said):
+    argv = ["import", str(INTEROP / "fs_front_optimumk.csv"), "-o", "out.yaml", f"--axes={axes}"]
+    refused(capsys, tmp_path, argv + list(OPTIONS), said)

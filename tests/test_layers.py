@@ -448,7 +448,7 @@ LAYERS = (
     ("solve", ("solve",)),  # Pinocchio models, Newton, the batched path, the march
     ("subjects", ("subjects",)),  # the one Assembly, its corners and elements
     ("analyses", ("analyses",)),  # setup, loads, sensitivities, the point-based solve
-    ("outputs", ("validate", "study", "plots", "viz")),
+    ("outputs", ("validate", "study", "plots", "viz", "interop")),
     ("cli", ("cli",)),
 )
 # Imports that go up a layer, each with its reason (a ratchet: none may be added).

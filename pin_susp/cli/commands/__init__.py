@@ -57,6 +57,14 @@ COMMANDS = {
         "pin_susp.cli.commands.study",
         "many variants of a geometry on Dask: DOE, tolerance Monte Carlo, optimisation",
     ),
+    "import": (  # the module's name has an underscore: import is a Python keyword
+        "pin_susp.cli.commands.import_",
+        "another tool's hardpoints (Lotus .shk, OptimumK CSV/Excel, Adams/Car) as a geometry",
+    ),
+    "export": (
+        "pin_susp.cli.commands.export",
+        "a corner's hardpoints as a Lotus .shk or an OptimumK table",
+    ),
 }
 
 

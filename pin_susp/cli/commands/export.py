@@ -1,0 +1,54 @@
+"""`pin-susp export`: a corner's hardpoints in another tool's layout — a Lotus SHARK
+.shk or an OptimumK table (CSV, or Excel for an .xlsx name) (docs/interop.md)."""
+
+from __future__ import annotations
+
+from ..options import check_outputs, geometry_argument
+
+DESCRIPTION = (
+    "Write the hardpoints of GEOMETRY (a double wishbone or MacPherson corner) as a Lotus "
+    "SHARK .shk point file or an OptimumK hardpoint table, with its wheel centre and "
+    "spindle point; `pin-susp import` reads either back to the same corner (with "
+    "--template GEOMETRY for what those files do not carry)."
+)
+
+
+def arguments(parser) -> None:
+    geometry_argument(parser)
+    parser.add_argument("--format", required=True, choices=("shk", "optimumk"), help="the layout")
+    parser.add_argument(
+        "-o", "--output", required=True, metavar="FILE", help="file to write (.shk; .csv or .xlsx)"
+    )
+    parser.add_argument(
+        "--axes",
+        default="forward,left,up",
+        metavar="X,Y,Z",
+        help="optimumk: where the table's X, Y, Z point (default forward,left,up: ISO 8855)",
+    )
+
+
+def run(args) -> int:
+    from ...errors import PinSuspError
+    from ...interop import reader
+    from ...interop.corner import corner_points
+    from ...interop.optimumk import parse_axes
+    from ...io.atomic import atomic_write
+    from ...model.geometry import load_geometry
+
+    check_outputs(args, args.output)
+    try:
+        axes = parse_axes(args.axes)
+    except ValueError as exc:
+        raise PinSuspError(f"--axes: {exc}") from None
+    g = load_geometry(args.geometry)
+    points = corner_points(g)
+    module = reader(args.format)
+    out = (
+        module.write(g, points)
+        if args.format == "shk"
+        else module.write(g, points, args.output, axes)
+    )
+    with atomic_write(args.output, binary=isinstance(out, bytes)) as f:
+        f.write(out)
+    print(f"wrote {args.output}")
+    return 0
