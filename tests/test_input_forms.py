@@ -333,6 +333,9 @@ def test_a_corner_sweep_and_loads_in_other_units_are_the_same(tmp_path, units, f
     for t in converted["targets"]:
         t["values"] = [v / k for v in t["values"]]
     loads = yaml.safe_load(LOADS.read_text())
+    loads["cases"][0]["moment"] = {"mx": 50.0, "my": -20.0, "mz": 10.0}  # N·m
+    in_n = write(tmp_path / "loads_n.yaml", loads)
+    loads = copy.deepcopy(loads)
     f = LBF if force == "lbf" else 1.0
     loads["force_units"] = force
     for case in loads["cases"]:
@@ -343,7 +346,7 @@ def test_a_corner_sweep_and_loads_in_other_units_are_the_same(tmp_path, units, f
     mm = pin_susp.Corner(write(tmp_path / "mm.yaml", g))
     other = pin_susp.Corner(write(tmp_path / "other.yaml", in_units(g, units, force)))
     assert_same(mm.run_sweep(bump), other.run_sweep(converted), atol=1e-9)
-    one = member_forces(mm, bump, LOADS)
+    one = member_forces(mm, bump, in_n)
     assert_same(one, member_forces(other, converted, write(tmp_path / "l.yaml", loads)))
 
 
@@ -391,3 +394,68 @@ def test_an_unknown_unit_is_named(tmp_path):
     assert "units: expected one of millimeters, meters, inches" in errors(tmp_path, g)
     g["units"], g["force_units"] = "meters", "kgf"
     assert "force_units: expected one of N, lbf" in errors(tmp_path, g)
+
+
+def test_a_study_in_inches_is_the_same(tmp_path):
+    """A study in inches over a geometry in inches by its wheel centre and a sweep in
+    inches: the same variables (mm), targets on a length column (mm, a curve over
+    wheel_travel), and a variant that sweeps as the mm study's."""
+    from pin_susp.study.spec import load_study
+    from pin_susp.study.variants import build, variant_data
+
+    k = 25.4
+    geometry = by_centre(example("macpherson.yaml"))
+    inches = copy.deepcopy(geometry)
+    inches["units"] = "inches"
+    inches["hardpoints"] = {
+        n: {a: v / k for a, v in p.items()} for n, p in geometry["hardpoints"].items()
+    }
+    w = inches["config"]["wheel"]
+    w["center"] = [v / k for v in w["center"]]
+    w["offset"] /= k
+    c = inches["config"]
+    c["cg_position"] = {a: v / k for a, v in c["cg_position"].items()}
+    c["wheelbase"] /= k
+    bump = yaml.safe_load((EXAMPLES / "bump_rack_held.yaml").read_text())
+    bump_in = copy.deepcopy(bump) | {"units": "inches"}
+    for t in bump_in["targets"]:
+        t["start"], t["stop"] = t["start"] / k, t["stop"] / k
+
+    def study(name, units, geometry, sweep, f):
+        data = {
+            "version": 1,
+            "geometry": str(write(tmp_path / f"{name}_g.yaml", geometry)),
+            "sweep": str(write(tmp_path / f"{name}_s.yaml", sweep)),
+            "variables": [{"point": "trackrod_inboard", "axis": "z", "range": [-20 / f, 20 / f]}],
+            "kind": "optimise",
+            "optimise": {
+                "objective": [
+                    {"metric": "half_track", "target": 700.0 / f},
+                    {
+                        "metric": "camber",
+                        "curve": {
+                            "x": "wheel_travel",
+                            "points": [[-25.4 / f, 0.5], [25.4 / f, -1]],
+                        },
+                    },
+                ]  # fmt: skip
+            },
+        }
+        if units:
+            data["units"] = units
+        return load_study(write(tmp_path / f"{name}.yaml", data))
+
+    mm = study("mm", None, geometry, bump, 1.0)
+    other = study("in", "inches", inches, bump_in, k)
+    np.testing.assert_allclose([mm.low, mm.high], [other.low, other.high], rtol=1e-12)
+    assert mm.low[0] == pytest.approx(-20.0)
+    assert other.terms[0].target == pytest.approx(700.0, rel=1e-12)
+    np.testing.assert_allclose(other.terms[1].curve, mm.terms[1].curve, rtol=1e-12)
+    np.testing.assert_allclose(other.terms[1].curve, [[-25.4, 0.5], [25.4, -1.0]], rtol=1e-12)
+    one, two = (
+        build(variant_data(s.geometry_data, s.variables, [5.0]), "variant", True).run_sweep(
+            s.sweep_data
+        )
+        for s in (mm, other)
+    )
+    assert_same(one, two)
