@@ -263,6 +263,12 @@ RACK = {"point": "trackrod_inboard", "side": "left", "direction": {"axis": "y"},
         "values": [0.0, 3.0, -2.0]}  # fmt: skip
 
 
+def axle_sweep(roll) -> dict:
+    """The rack, heave and ``roll`` (deg), three steps."""
+    heave = {"quantity": "heave", "values": [-10.0, 0.0, 12.0]}
+    return {"version": 1, "targets": [RACK, heave, {"quantity": "roll", "values": roll}]}
+
+
 def test_an_axle_by_wheel_centre_and_rocker_pivot_sweeps_as_its_points(tmp_path):
     """A mirrored axle (one left side): the wheel by its centre in axle_config.wheel,
     the rocker by its pivot and the plane; and an axle with both sides written out."""
@@ -276,9 +282,7 @@ def test_an_axle_by_wheel_centre_and_rocker_pivot_sweeps_as_its_points(tmp_path)
     )["hardpoints"]
     forms["axle_config"]["wheel"] = centre["config"]["wheel"]
     forms["axle_config"]["actuation"]["bearing_spacing"] = 200.0
-    heave = {"version": 1, "targets": [RACK,
-                                       {"quantity": "heave", "values": [-10.0, 0.0, 12.0]},
-                                       {"quantity": "roll", "values": [0.0, 0.0, 1.0]}]}  # fmt: skip
+    heave = axle_sweep([0.0, 0.0, 1.0])
     one, other = (
         pin_susp.Axle(write(tmp_path / f"{n}.yaml", d)).run_sweep(heave)
         for n, d in (("points", axle), ("forms", forms))
@@ -362,9 +366,7 @@ def test_an_axle_and_a_vehicle_in_meters_and_lbf_are_the_same(tmp_path):
         a: v / 1000 for a, v in axle["vehicle_config"]["cg_position"].items()
     }
     metres["vehicle_config"]["wheelbase"] /= 1000
-    heave = {"version": 1, "targets": [RACK,
-                                       {"quantity": "heave", "values": [-10.0, 0.0, 12.0]},
-                                       {"quantity": "roll", "values": [0.0, 0.5, 1.0]}]}  # fmt: skip
+    heave = axle_sweep([0.0, 0.5, 1.0])
     one, other = (
         pin_susp.Axle(write(tmp_path / f"{n}.yaml", d)).run_sweep(heave)
         for n, d in (("mm", axle), ("m", metres))
@@ -380,10 +382,9 @@ def test_an_axle_and_a_vehicle_in_meters_and_lbf_are_the_same(tmp_path):
     c["tyres"]["vertical"] /= LBF / 25.4
     for end in ("front", "rear"):
         v[end] = str(EXAMPLES / v[end])
-    body = {"version": 1, "targets": [{"quantity": "heave", "values": [-5.0, 8.0]},
-                                      {"quantity": "pitch", "values": [0.0, 0.3]},
-                                      {"quantity": "roll", "values": [0.0, 1.0]},
-                                      {"quantity": "steering_wheel", "values": [0.0, 20.0]}]}  # fmt: skip
+    body = {"version": 1, "targets": [{"quantity": q, "values": v} for q, v in (
+        ("heave", [-5.0, 8.0]), ("pitch", [0.0, 0.3]), ("roll", [0.0, 1.0]),
+        ("steering_wheel", [0.0, 20.0]))]}  # fmt: skip
     one = pin_susp.Vehicle(EXAMPLES / "vehicle_fs.yaml").run_sweep(body)
     assert_same(one, pin_susp.Vehicle(write(tmp_path / "car.yaml", v)).run_sweep(body))
 
@@ -459,3 +460,13 @@ def test_a_study_in_inches_is_the_same(tmp_path):
         for s in (mm, other)
     )
     assert_same(one, two)
+
+
+def test_the_wheel_centre_example_sweeps_and_loads_as_the_pushrod_rocker(tmp_path):
+    """examples/wheel_centre.yaml is examples/pushrod_rocker.yaml by its wheel centre,
+    its tyre by diameter (2·(6.5 in + 0.55·270 mm) = 627.2 mm) and its rocker by pivot
+    and plane: the same columns and loads, but for its own spindle points."""
+    corners = [pin_susp.Corner(EXAMPLES / n) for n in ("pushrod_rocker.yaml", "wheel_centre.yaml")]
+    bump = sweep(example("pushrod_rocker.yaml"))
+    assert_same(*(c.run_sweep(bump) for c in corners), skip=SPINDLE_COLUMNS)
+    assert_same(*(member_forces(c, bump, LOADS) for c in corners), skip=SPINDLE_COLUMNS)

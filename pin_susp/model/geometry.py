@@ -321,7 +321,6 @@ def parse_geometry(data: dict, r: Reader, sha: str | None) -> Geometry:
         for key in (k for k in keys if k in data and declared != scope):
             r.fail("scope", needs.format(key=key))
     r.mapping(data, "", required=("hardpoints",), optional=CORNER_KEYS)
-    data = canonical_corner(data, r)  # mm and N, spindle points, rocker_axis_a/b (forms.py)
     legacy = data.get("type")
     if isinstance(legacy, str) and legacy.endswith("_axle"):
         r.fail(
@@ -335,6 +334,7 @@ def parse_geometry(data: dict, r: Reader, sha: str | None) -> Geometry:
     scope = r.choice(data.get("scope", SCOPES[0]), "scope", SCOPES)
     if scope in OTHER_SCOPES:
         r.fail("scope", OTHER_SCOPES[scope][0])
+    data = canonical_corner(data, r)  # mm and N, spindle points, rocker_axis_a/b (forms.py)
     side = r.choice(data.get("side", "left"), "side", ("left", "right"))
     name = r.text(data.get("name", "unnamed corner"), "name")
     if "version" in data:
