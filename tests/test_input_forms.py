@@ -386,7 +386,11 @@ def test_an_axle_and_a_vehicle_in_meters_and_lbf_are_the_same(tmp_path):
         ("heave", [-5.0, 8.0]), ("pitch", [0.0, 0.3]), ("roll", [0.0, 1.0]),
         ("steering_wheel", [0.0, 20.0]))]}  # fmt: skip
     one = pin_susp.Vehicle(EXAMPLES / "vehicle_fs.yaml").run_sweep(body)
-    assert_same(one, pin_susp.Vehicle(write(tmp_path / "car.yaml", v)).run_sweep(body))
+    car = write(tmp_path / "car.yaml", v)
+    assert_same(one, pin_susp.Vehicle(car).run_sweep(body))
+    tyres = pin_susp.load_vehicle(car).tyres
+    assert tyres == pytest.approx(pin_susp.load_vehicle(EXAMPLES / "vehicle_fs.yaml").tyres)
+    assert tyres["f"] == pytest.approx(120.0, rel=1e-12)  # N/mm
 
 
 def test_an_unknown_unit_is_named(tmp_path):
