@@ -65,7 +65,7 @@ def test_a_missing_size_names_the_block_and_its_synonym(tmp_path):
 def test_an_unknown_tyre_key_lists_the_size_and_the_rate(tmp_path):
     text = read_error(wheel(tmp_path, tire={**SIZE, "stiffness": 120}))
     assert "config.wheel.tire.stiffness: unknown key" in text
-    assert "aspect_ratio, rate, rim_diameter, section_width" in text
+    assert "aspect_ratio, diameter, loaded_radius, rate, rim_diameter, section_width, width" in text
 
 
 def test_a_bad_tyre_value_is_named_where_it_was_written(tmp_path):

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..io.yamlio import Reader, load_yaml
+from ..model.units import Units, read_units
 
 CASE_KEYS = ("contact_patch", "wheel_center", "moment")
 SIDES = ("left", "right")  # an axle's corners: a block of loads each
@@ -92,7 +93,8 @@ def load_cases(
     steady = ACCELERATION_KEYS if accelerations else ()
     data, name, _ = load_yaml(source)
     r = Reader(name)
-    r.mapping(data, "", required=("cases",), optional=("version",))
+    r.mapping(data, "", required=("cases",), optional=("version", "units", "force_units"))
+    u = read_units(data, r)  # forces N or lbf, moments N·m or lbf·in (no lengths yet)
     if "version" in data and data["version"] != 1:
         r.fail("version", f"expected 1 (this file format's version), got {data['version']!r}")
     cases = data["cases"]
@@ -116,7 +118,7 @@ def load_cases(
             out.append(_acceleration(case, key, title, (*CASE_KEYS, *blocks), r))
             continue
         if not blocks:
-            out.append(_wheel_loads(case, key, title, r))
+            out.append(_wheel_loads(case, key, title, r, u))
             continue
         for part in CASE_KEYS:
             if part in case:
@@ -127,7 +129,7 @@ def load_cases(
             r.fail(key, f"{who} case needs a {either} block of loads{also}")
         wheels = {
             b: _wheel_loads(r.mapping(case.get(b, {}), f"{key}.{b}", optional=CASE_KEYS),
-                            f"{key}.{b}", str(title), r)
+                            f"{key}.{b}", str(title), r, u)
             for b in blocks
         }  # fmt: skip
         if blocks == SIDES:
@@ -154,7 +156,7 @@ def _acceleration(case: dict, key: str, title: str, others: tuple, r: Reader) ->
     return AccelerationCase(title, *values)
 
 
-def _wheel_loads(case: dict, key: str, title: str, r: Reader) -> LoadCase:
+def _wheel_loads(case: dict, key: str, title: str, r: Reader, u: Units) -> LoadCase:
     """One wheel's loads: each block given in full (a block left out: no such load)."""
     vectors = {}
     for part, axes in (("contact_patch", "f"), ("wheel_center", "f"), ("moment", "m")):
@@ -164,6 +166,7 @@ def _wheel_loads(case: dict, key: str, title: str, r: Reader) -> LoadCase:
             case.get(part, {}), f"{key}.{part}", required=names if given else (), optional=names
         )
         vectors[part] = np.array([_load(block.get(n, 0.0), f"{key}.{part}.{n}", r) for n in names])
+        vectors[part] = vectors[part] * (u.moment if axes == "m" else u.force)  # N, N·m
     return LoadCase(title, **vectors)
 
 

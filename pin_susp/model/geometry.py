@@ -21,9 +21,14 @@ import numpy as np
 from ..errors import PlausibilityWarning
 from ..io.yamlio import MAX_LENGTH_MM, Reader, load_yaml
 from ..maths.vectors import COINCIDENT, direction, unit
-
-MM = 1e-3
-INCH = 0.0254
+from .units import INCH as INCH
+from .units import MM as MM
+from .wheel import Wheel as Wheel
+from .wheel import contact_patch as contact_patch
+from .wheel import read_wheel
+from .wheel import size as _size
+from .wheel import wheel_down as wheel_down
+from .wheel import wheel_points as wheel_points
 
 # Points computed from the upright's hardpoints and the wheel (docs/geometry.md, "Derived
 # points").
@@ -48,27 +53,6 @@ PLAUSIBLE = {
     "config.front_brake_bias": (0.4, 0.85, ""),
     "distance from the wheel centre": (0.0, 2000.0, "mm"),
 }
-
-
-@dataclass(frozen=True)
-class Wheel:
-    """Wheel offset and tyre size, in metres."""
-
-    offset: float
-    section_width: float
-    aspect_ratio: float
-    rim_diameter: float
-    tyre_rate: float | None = None  # N/mm (config.wheel.tyre.rate), for the ride rate
-    # each size's key as the file wrote it (tyre: or its synonym tire:), for warnings
-    keys: dict = field(default_factory=dict, compare=False, repr=False)
-
-    def key(self, name: str) -> str:
-        return self.keys.get(name, f"config.wheel.tyre.{name}")
-
-    @property
-    def radius(self) -> float:
-        """Unloaded tyre radius R = (rim + 2·aspect·section) / 2."""
-        return 0.5 * self.rim_diameter + self.aspect_ratio * self.section_width
 
 
 @dataclass(frozen=True)
@@ -147,6 +131,13 @@ class Geometry:
         from . import mechanisms
 
         return mechanisms.get(self.type)
+
+    @property
+    def design_ride_height(self) -> float:
+        """The wheel centre's height above the road at design (m): the tyre's loaded
+        radius (docs/geometry.md, "The wheel by its centre") in the wheel plane."""
+        p = self.design_points()
+        return float(p["wheel_center"][2] - p["contact_patch_center"][2])
 
     @property
     def has_pushrod(self) -> bool:
@@ -241,45 +232,6 @@ def summary_repr(obj, parts) -> str:
         return f"<{kind}>"
 
 
-def wheel_points(
-    axle_inboard: np.ndarray, axle_outboard: np.ndarray, wheel: Wheel
-) -> dict[str, np.ndarray]:
-    """Derived points fixed to the upright: works on (3,) or (n, 3) arrays.
-
-    â = unit(axle_outboard − axle_inboard); wheel_center = axle_outboard − offset·â;
-    wheel_inboard/outboard = wheel_center ∓ (section_width/2)·â; the contact
-    patch centre is added too (it is not fixed to the upright).
-    """
-    a = unit(axle_outboard - axle_inboard)
-    center = axle_outboard - wheel.offset * a
-    half = 0.5 * wheel.section_width * a
-    return {
-        "axle_midpoint": 0.5 * (axle_inboard + axle_outboard),
-        "wheel_center": center,
-        "wheel_inboard": center - half,
-        "wheel_outboard": center + half,
-        "contact_patch_center": contact_patch(center, a, wheel.radius),
-    }
-
-
-def wheel_down(spin_axis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """d̂ = unit(−Ẑ − ((−Ẑ)·â)â) and the length of the vector before normalising.
-
-    World down projected into the wheel plane; the contact patch is R·d̂ from
-    the wheel centre. Works on (3,) or (n, 3), and on jet.Dual points.
-    """
-    a = spin_axis
-    u = a * a[..., 2:3] - np.array([0.0, 0.0, 1.0])
-    norm = np.linalg.norm(u, axis=-1, keepdims=True)
-    return u / norm, norm
-
-
-def contact_patch(wheel_center: np.ndarray, spin_axis: np.ndarray, radius: float) -> np.ndarray:
-    """Lowest point of a thin disc of radius R in the wheel plane."""
-    down, _ = wheel_down(spin_axis)
-    return wheel_center + radius * down
-
-
 def load_geometry(source: str | Path | dict) -> Geometry:
     """Read and validate a geometry file (path) or an already-loaded dict.
 
@@ -307,11 +259,11 @@ def warn_implausible(g: Geometry) -> None:
     """A PlausibilityWarning for each value outside PLAUSIBLE (a unit slip, often)."""
     w = g.wheel
     values = {
-        "config.wheel.tyre.rim_diameter": w.rim_diameter / INCH,
+        "config.wheel.tyre.rim_diameter": np.nan if w.diameter else w.rim_diameter / INCH,
         "config.wheel.tyre.section_width": w.section_width / MM,
-        "config.wheel.tyre.aspect_ratio": w.aspect_ratio,
+        "config.wheel.tyre.aspect_ratio": np.nan if w.diameter else w.aspect_ratio,
         "config.wheel.offset": w.offset / MM,
-        "tyre radius": w.radius / MM,
+        "tyre radius": w.unloaded_radius / MM,
     }
     if g.wheelbase is not None:
         values["config.wheelbase"] = g.wheelbase / MM
@@ -352,7 +304,8 @@ OTHER_SCOPES = {
     ),
 }
 SCOPES = ("corner", *OTHER_SCOPES)
-CORNER_KEYS = ("type", "scope", "side", "name", "version", "units", "actuation", "spring", "config")
+CORNER_KEYS = ("type", "scope", "side", "name", "version", "units", "force_units")
+CORNER_KEYS += ("actuation", "spring", "config")
 
 
 def parse_geometry(data: dict, r: Reader, sha: str | None) -> Geometry:
@@ -361,6 +314,7 @@ def parse_geometry(data: dict, r: Reader, sha: str | None) -> Geometry:
     warnings: :func:`load_geometry` adds them, and an axle's corners or a study's
     variants, read from data they hold, warn (or not) for themselves."""
     from . import mechanisms
+    from .forms import canonical_corner
 
     for scope, (_, keys, needs) in OTHER_SCOPES.items() if isinstance(data, dict) else ():
         declared = r.choice(data.get("scope", "corner"), "scope", (*SCOPES, "vehicle"))
@@ -380,11 +334,11 @@ def parse_geometry(data: dict, r: Reader, sha: str | None) -> Geometry:
     scope = r.choice(data.get("scope", SCOPES[0]), "scope", SCOPES)
     if scope in OTHER_SCOPES:
         r.fail("scope", OTHER_SCOPES[scope][0])
+    data = canonical_corner(data, r)  # mm and N, spindle points, rocker_axis_a/b (forms.py)
     side = r.choice(data.get("side", "left"), "side", ("left", "right"))
     name = r.text(data.get("name", "unnamed corner"), "name")
     if "version" in data:
         r.text(data["version"], "version")
-    r.choice(data.get("units", "millimeters"), "units", ("millimeters",))
 
     config = r.mapping(
         data.get("config"),
@@ -422,7 +376,7 @@ def parse_geometry(data: dict, r: Reader, sha: str | None) -> Geometry:
     steering = r.choice(
         steer_map.get("type", mech.STEERING[0]), "config.steering.type", mech.STEERING
     )
-    wheel = _wheel(config["wheel"], r)
+    wheel = read_wheel(config["wheel"], r)
     options = Options(kind, side, steering, actuation, mount, spring)
 
     names = mech.hardpoint_names(options)
@@ -564,63 +518,6 @@ def _spring_rate(spring_map: dict, spring: str, strut, r: Reader) -> tuple:
         r.positive(spring_map["rate"], "spring.rate"),
         r.number(spring_map.get("preload", 0.0), "spring.preload"),
     )
-
-
-TYRE_SIZE = ("aspect_ratio", "section_width", "rim_diameter")
-TYRE_KEYS = (*TYRE_SIZE, "rate")
-
-
-def _wheel(value, r: Reader) -> Wheel:
-    """config.wheel: its offset and the tyre — one key, ``tyre:`` (``tire:`` read as its
-    synonym) with the size and the rate. A file may still split them between the two
-    (the size under tire:, the rate under tyre:, as before): they are read as one, and
-    a value given under both is an error that names each."""
-    w = r.mapping(value, "config.wheel", optional=("offset", "tyre", "tire"))
-    given = [k for k in ("tyre", "tire") if k in w]
-    if not given:
-        r.fail(
-            "config.wheel.tire",
-            "missing key: the tyre, as tire: or tyre: (one key, either spelling) with its "
-            "size {aspect_ratio, section_width, rim_diameter} and, for the ride rate, its rate",
-        )
-    tyre, keys = {}, {}
-    for name in given:
-        block = r.mapping(w[name], f"config.wheel.{name}", optional=TYRE_KEYS)
-        for k, v in block.items():
-            if k in tyre:
-                r.fail(
-                    f"config.wheel.{name}.{k}",
-                    f"given also as {keys[k]}: tire: is a synonym of tyre:, one tyre — "
-                    "give each value once (best all under tyre:)",
-                )
-            tyre[k], keys[k] = v, f"config.wheel.{name}.{k}"
-    for k in TYRE_SIZE:
-        if k not in tyre:
-            holder = next((n for n in given if any(s in w[n] for s in TYRE_SIZE)), given[0])
-            other = {"tyre": "tire", "tire": "tyre"}[holder]
-            r.fail(
-                f"config.wheel.{holder}.{k}",
-                f"missing key (the tyre's size: {', '.join(TYRE_SIZE)}; "
-                f"{other}: is the same key, read as one with {holder}:)",
-            )
-    tyre_rate = None if "rate" not in tyre else r.positive(tyre["rate"], keys["rate"])
-    return Wheel(
-        offset=r.length(w.get("offset", 0.0), "config.wheel.offset") * MM,
-        section_width=_size(tyre["section_width"], keys["section_width"], r) * MM,
-        aspect_ratio=_size(tyre["aspect_ratio"], keys["aspect_ratio"], r, limit=100.0),
-        rim_diameter=_size(tyre["rim_diameter"], keys["rim_diameter"], r, INCH / MM) * INCH,
-        tyre_rate=tyre_rate,
-        keys=keys,
-    )
-
-
-def _size(value, key: str, r: Reader, per_mm: float = 1.0, limit: float | None = None) -> float:
-    """A size > 0 within the hard limit on lengths (``per_mm``: mm per unit of the value)."""
-    x = r.positive(value, key)
-    limit = MAX_LENGTH_MM / per_mm if limit is None else limit
-    if x > limit:
-        r.fail(key, f"{x:g} is beyond the hard limit of {limit:g} for any car")
-    return x
 
 
 def _fraction(value, r: Reader) -> float:

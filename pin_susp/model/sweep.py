@@ -16,6 +16,7 @@ import numpy as np
 from ..errors import InputError
 from ..io.yamlio import Reader, load_yaml, short_repr
 from .geometry import direction
+from .units import read_units
 
 # Memory a solved step holds while a sweep is held whole (configuration, tangents,
 # every column, the CSV's text), bytes: measured 12.5 KB on a 200 000-step sweep.
@@ -30,6 +31,7 @@ QUANTITIES = ("heave", "roll")  # an axle's own targets: heave mm, roll deg
 # ``corner:``), the steering wheel (deg)
 VEHICLE_QUANTITIES = ("pitch", "road_z", "steering_wheel", "rack")
 CORNERS = ("fl", "fr", "rl", "rr")  # a vehicle's corners
+LENGTH_TARGETS = (None, "heave", "road_z", "rack")  # a point's (None) and these: mm
 
 
 @dataclass(frozen=True)
@@ -88,7 +90,8 @@ def load_sweep(source: str | Path | dict) -> Sweep:
     """Read and validate a sweep file (path) or an already-loaded dict."""
     data, name, sha = load_yaml(source)
     r = Reader(name)
-    r.mapping(data, "", required=("targets",), optional=("version", "steps", "name"))
+    r.mapping(data, "", required=("targets",), optional=("version", "steps", "name", "units"))
+    length = read_units(data, r).length  # mm per unit of the file's lengths
     steps = None
     if "steps" in data:
         steps = data["steps"]
@@ -101,6 +104,11 @@ def load_sweep(source: str | Path | dict) -> Sweep:
     if not isinstance(raw_targets, list) or not raw_targets:
         r.fail("targets", "expected a non-empty list of targets")
     targets = [_target(t, f"targets[{i}]", steps, r) for i, t in enumerate(raw_targets)]
+    if length != 1.0:  # a point's or a length quantity's values in mm (angles stay deg)
+        targets = [
+            replace(t, values=t.values * length) if t.quantity in LENGTH_TARGETS else t
+            for t in targets
+        ]
     lengths = {len(t.values) for t in targets}
     if len(lengths) > 1:
         detail = ", ".join(f"targets[{i}]: {len(t.values)}" for i, t in enumerate(targets))

@@ -11,6 +11,8 @@ from pathlib import Path
 import numpy as np
 
 from ..io.yamlio import Reader, load_yaml, read_once
+from ..model.units import read_units
+from ..subjects.subject import kind_of
 from .data import AXES, Job, Term, Variable
 from .variants import at_design, build
 
@@ -34,6 +36,8 @@ STUDY_KEYS = (
     "summary",
     "batch_size",
     "conventions",
+    "units",
+    "force_units",
 )
 MANIFEST = "study.json"
 PARTS = ".parts"
@@ -110,8 +114,10 @@ def _load_study(source: str | Path) -> Study:
     geometry_path = str(here / r.text(data["geometry"], "geometry"))
     sweep_path = str(here / r.text(data["sweep"], "sweep"))
     geometry_data, _, geometry_sha = load_yaml(geometry_path)
+    geometry_data = kind_of(geometry_data).in_mm(geometry_data, geometry_path)  # variants' mm
     sweep_data, _, sweep_sha = load_yaml(sweep_path)
     design = _Design(geometry_data, geometry_path, sweep_path)
+    design.units = read_units(data, r)  # the study's own lengths, forces and rates
     variables = _variables(data, design, r)
     study = Study(
         source=name,
@@ -238,6 +244,12 @@ class _Design:
         self.sides = tuple(label for label in subject.labels if label)
         self.columns = [c for c in self.results.columns if c != "step_index"]
 
+    def factor(self, column: str) -> float:
+        """What one unit of the study's number on ``column`` is in the column's own unit
+        (mm, N, N/mm; angles and the rest as they are)."""
+        u, unit = self.units, self.results.units.get(column)
+        return {"mm": u.length, "N": u.force, "N/mm": u.rate, "N·m": u.moment}.get(unit, 1.0)
+
     def check_defined(self, name: str, key: str, r: Reader) -> None:
         """A target's column must have a value at the design state (not a blank cell)."""
         if not np.isfinite(np.asarray(self.results[name], dtype=float)[0]):
@@ -262,6 +274,7 @@ def _variables(data: dict, design: _Design, r: Reader) -> list[Variable]:
         r.mapping(raw, "variables", required=("all_hardpoints",))
         block = r.mapping(raw["all_hardpoints"], "variables.all_hardpoints", ("tolerance",))
         tol = r.positive(block["tolerance"], "variables.all_hardpoints.tolerance")
+        tol *= design.units.length
         return [
             Variable(p, a, -tol, tol, side)
             for side, names in design.points.items()
@@ -289,8 +302,8 @@ def _variables(data: dict, design: _Design, r: Reader) -> list[Variable]:
         span = v["range"]
         if not isinstance(span, list) or len(span) != 2:
             r.fail(f"{key}.range", "expected [low, high] in mm from design")
-        low = r.length(span[0], f"{key}.range[0]")
-        high = r.length(span[1], f"{key}.range[1]")
+        low = r.length(span[0], f"{key}.range[0]") * design.units.length
+        high = r.length(span[1], f"{key}.range[1]") * design.units.length
         if not high > low:
             r.fail(f"{key}.range", f"empty range [{low:g}, {high:g}]: low must be below high")
         variable = Variable(point, axis, low, high, side)
@@ -319,9 +332,8 @@ def _terms(raw, design: _Design, r: Reader) -> list[Term]:
         if ("target" in t) == ("curve" in t):
             r.fail(key, "give one of target (a value) or curve ({x, points})")
         if "target" in t:
-            out.append(
-                Term(metric, weight, relative, target=r.number(t["target"], f"{key}.target"))
-            )
+            target = r.number(t["target"], f"{key}.target") * design.factor(metric)
+            out.append(Term(metric, weight, relative, target=target))
             continue
         c = r.mapping(t["curve"], f"{key}.curve", required=("x", "points"))
         x = r.text(c["x"], f"{key}.curve.x")
@@ -335,7 +347,7 @@ def _terms(raw, design: _Design, r: Reader) -> list[Term]:
             if not isinstance(p, list) or len(p) != 2:
                 r.fail(f"{key}.curve.points[{j}]", "expected [x, value]")
             rows.append([r.number(p[k], f"{key}.curve.points[{j}][{k}]") for k in (0, 1)])
-        curve = np.array(sorted(rows))
+        curve = np.array(sorted(rows)) * [design.factor(x), design.factor(metric)]
         if np.any(np.diff(curve[:, 0]) <= 0.0):
             r.fail(f"{key}.curve.points", "the x values must differ")
         out.append(Term(metric, weight, relative, curve_x=x, curve=curve))

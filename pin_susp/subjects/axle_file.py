@@ -14,6 +14,7 @@ from ..errors import InputError
 from ..io.yamlio import Reader, load_yaml
 from ..model.compose import SHARED, compose_tree
 from ..model.deadcentre import warn_dead_centres
+from ..model.forms import canonical_axle
 from ..model.geometry import MM, Geometry, summary_repr
 from .assembly import Assembly
 from .elements import elements_of
@@ -142,13 +143,13 @@ def load_axle(source, warn_as: str | None = None) -> AxleGeometry:
         data,
         "",
         required=("hardpoints", "axle_config"),
-        optional=("type", "scope", "name", "version", "units", "vehicle_config"),
+        optional=("type", "scope", "name", "version", "units", "force_units", "vehicle_config"),
     )
+    data = canonical_axle(data, r)  # mm and N, spindle points, rocker axes (model/forms.py)
     if r.choice(data.get("scope", "corner"), "scope", ("corner", "axle")) != "axle":
         r.fail("scope", "this is a corner file (scope: corner): load it with load_geometry")
     if "version" in data:
         r.text(data["version"], "version")
-    r.choice(data.get("units", "millimeters"), "units", ("millimeters",))
     vehicle = r.mapping(data.get("vehicle_config", {}), "vehicle_config", optional=VEHICLE_KEYS)
     config = r.mapping(
         data["axle_config"], "axle_config", required=("axle_position", "wheel"), optional=AXLE_KEYS

@@ -114,6 +114,14 @@ class SubjectKind:
         ``data["hardpoints"]``)."""
         return copy.deepcopy(data)
 
+    def in_mm(self, data: dict, source: str) -> dict:
+        """The data in mm and N, each wheel by its spindle points and each rocker by
+        rocker_axis_a/b (model/forms.py): what its variants move (errors name ``source``)."""
+        from ..io.yamlio import Reader
+        from ..model.forms import canonical_corner
+
+        return canonical_corner(data, Reader(source))
+
 
 class _CornerKind(SubjectKind):
     def build(self, data: dict, source: str, variant: bool = False) -> Assembly:
@@ -132,6 +140,12 @@ class _AxleKind(SubjectKind):
         from .axle import AxleModel, load_axle
 
         return AxleModel(load_axle(data, None if variant else source))
+
+    def in_mm(self, data: dict, source: str) -> dict:
+        from ..io.yamlio import Reader
+        from ..model.forms import canonical_axle
+
+        return canonical_axle(data, Reader(source))
 
     def variant_data(self, data: dict) -> dict:
         out = super().variant_data(data)

@@ -16,6 +16,7 @@ import numpy as np
 from ..errors import InputError
 from ..io.yamlio import Reader, load_yaml
 from ..model.geometry import Geometry
+from ..model.units import vehicle_in_mm
 from .axle_file import AxleGeometry, load_axle
 
 LABELS = ("fl", "fr", "rl", "rr")
@@ -86,10 +87,10 @@ def load_vehicle(source) -> VehicleGeometry:
         data,
         "",
         required=("scope", "vehicle_config", "front", "rear"),
-        optional=("name", "version", "units"),
+        optional=("name", "version", "units", "force_units"),
     )
     r.choice(data["scope"], "scope", ("vehicle",))
-    r.choice(data.get("units", "millimeters"), "units", ("millimeters",))
+    data = vehicle_in_mm(data, r)  # mm and N (model/units.py)
     config = r.mapping(
         data["vehicle_config"], "vehicle_config", required=("wheelbase", "cg"), optional=CONFIG_KEYS
     )

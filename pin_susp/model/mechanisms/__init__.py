@@ -157,7 +157,14 @@ def visuals(g, p, body_of: dict[str, str], rods: list[tuple], material=None) -> 
     out = [Visual(body, "rod", mat, a, b, ROD) for body, mat, a, b in rods]
     wheel_body = body_of["wheel_center"]
     out.append(
-        Visual(wheel_body, "rod", "tyre", p["wheel_inboard"], p["wheel_outboard"], g.wheel.radius)
+        Visual(
+            wheel_body,
+            "rod",
+            "tyre",
+            p["wheel_inboard"],
+            p["wheel_outboard"],
+            g.wheel.unloaded_radius,
+        )
     )
     for name, body in body_of.items():
         if name in g.hardpoints:
