@@ -176,7 +176,10 @@ def test_each_variant_equals_a_direct_sweep_of_its_geometry(tmp_path, capsys):
             if a.dtype.kind == "f" or b.dtype.kind == "f":
                 a, b = a.astype(float), b.astype(float)
                 assert np.array_equal(np.isnan(a), np.isnan(b)), c
-                assert np.allclose(a, b, rtol=0, atol=1e-9, equal_nan=True), c
+                # a kinematic instant centre, a pole through infinity in bump (7.9 km
+                # out here): its last digits relative to its size (validate/scopes.py)
+                rtol = 1e-9 if "instant_center" in c else 0.0
+                assert np.allclose(a, b, rtol=rtol, atol=1e-9, equal_nan=True), c
             else:
                 assert (a == b).all(), c
         static_csv = tmp_path / f"static{vid}.csv"

@@ -371,6 +371,8 @@ AXLE_COLUMNS = (
     "track",
     "roll_center_y",
     "roll_center_z",
+    "kinematic_roll_center_y",
+    "kinematic_roll_center_z",
     "deriv_roll_center_y_wrt_roll",
     "deriv_roll_center_z_wrt_roll",
     "ackermann",
@@ -436,7 +438,14 @@ def test_axle_columns_are_the_axles_own(name):
             np.testing.assert_allclose(
                 df[f"steer_angle_{label}"], own[f"steer_angle_{side}"], rtol=0, atol=1e-9
             )
-        for column in ("heave", "roll", "track", "roll_center_y", "roll_center_z"):
+        for column in (
+            "heave",
+            "roll",
+            "track",
+            "roll_center_y",
+            "roll_center_z",
+            "kinematic_roll_center_z",
+        ):
             assert np.isfinite(df[f"{column}_{end}"]).all(), column  # compared, not blanks
         if "roll_stiffness" in own:
             assert np.isfinite(df[f"roll_stiffness_{end}"]).all()
@@ -549,10 +558,12 @@ def test_roll_centres_mirror_in_roll(name):
     roll = np.array([-2.0, -1.0, 0.0, 1.0, 2.0])
     df = pin_susp.Vehicle(CARS[name]).run_sweep(body(0.0, roll=roll)).to_pandas()
     for end in ENDS:
-        z, y = df[f"roll_center_z_{end}"].to_numpy(), df[f"roll_center_y_{end}"].to_numpy()
-        np.testing.assert_allclose(z, z[::-1], rtol=0, atol=1e-9)
-        np.testing.assert_allclose(y, -y[::-1], rtol=0, atol=1e-9)
-        assert np.abs(y[0]) > 10.0 and np.ptp(z) > 0.1  # it does migrate
+        for kind in ("", "kinematic_"):
+            z = df[f"{kind}roll_center_z_{end}"].to_numpy()
+            y = df[f"{kind}roll_center_y_{end}"].to_numpy()
+            np.testing.assert_allclose(z, z[::-1], rtol=0, atol=1e-9)
+            np.testing.assert_allclose(y, -y[::-1], rtol=0, atol=1e-9)
+            assert np.abs(y[0]) > 10.0 and np.ptp(z) > 0.1  # it does migrate
 
 
 def test_the_axles_roll_rates_and_the_bodys_are_both_written():

@@ -9,7 +9,8 @@ rad); NaN where the metric is undefined. The same code runs on
 
 The registry ``METRICS`` gives each column's name, unit, label, the
 conversion to output units and the drivers it has derivative columns for;
-it alone decides which columns a sweep writes and in what order.
+it alone decides which columns a sweep writes and in what order (an entry is a
+registry.Metric; the columns other tools report, and their entries, are other_tools.py's).
 
 Why one module of ~700 lines: the registry and the functions it names are read
 together (each entry next to the function whose column it declares, in the CSV's
@@ -23,7 +24,6 @@ CP = contact patch.
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -31,10 +31,10 @@ import numpy as np
 from ..maths.jet import Dual, cross, value
 from ..maths.jet import rate as jet_rate
 from ..model.geometry import Geometry, unit
+from . import other_tools
+from .registry import BOTH, HUB_Z, RACK, STEERING_AXIS_FLAT, Metric  # noqa: F401 (as they were)
 
-STEERING_AXIS_FLAT = 1e-6  # |k_z| below this: the axis never meets the ground
 PARALLEL_PLANES = 1e-12  # |n₁ × n₂|² below this (unit normals): no instant axis
-HUB_Z, RACK = "hub_z", "rack_displacement"
 TOE_LINK = "toe_link_length"  # steers a toe-link corner (no derivative columns)
 X, Y, Z = 0, 1, 2
 EYE = np.eye(3)
@@ -384,10 +384,6 @@ def anti_squat(ps: PointSet):
     return 100.0 * _wheelbase_over_height(ps) * (z - wc[..., Z]) / run
 
 
-def _always(g: Geometry) -> bool:
-    return True
-
-
 def _rack(g: Geometry) -> bool:
     return g.steering == "rack"
 
@@ -411,33 +407,6 @@ def _anti_squat_applies(g: Geometry) -> bool:
     return g.axle_position is not None and _anti(g.axle_position, False)(g)
 
 
-@dataclass(frozen=True)
-class Metric:
-    """A column: name, output unit, label, function; ``drivers`` it has derivatives for.
-
-    ``applies`` says whether the metric is defined for a corner; ``always_written``
-    columns appear (empty) even where it is not, as docs/results.md asks.
-    """
-
-    name: str
-    unit: str  # "deg", "mm", "mm/rad" or "%"
-    label: str
-    function: Callable[[PointSet], np.ndarray]
-    applies: Callable[[Geometry], bool] = field(default=_always)
-    drivers: tuple[str, ...] = ()
-    always_written: bool = False
-    written: bool = True  # False: a point coordinate, already a column, for its derivative
-    needs: str = ""  # the inputs an always-written column needs to have values
-    plausible: tuple[float, float] | None = None  # at design, in output units (a warning)
-    rates: bool = False  # computed from the points' rates (a twist), not positions alone
-
-    @property
-    def scale(self) -> float:
-        """SI → output unit."""
-        return {"deg": 180.0 / np.pi, "mm": 1e3, "mm/rad": 1e3, "%": 1.0}[self.unit]
-
-
-BOTH = (HUB_Z, RACK)
 METRICS = (
     Metric("camber", "deg", "Camber", camber, drivers=BOTH, plausible=(-10.0, 10.0)),
     Metric("caster", "deg", "Caster", caster, drivers=BOTH, plausible=(-10.0, 20.0)),
@@ -476,6 +445,7 @@ METRICS = (
         scrub_radius,
         drivers=BOTH,
     ),
+    *other_tools.AT_HUB,  # Lotus' offset and trails at the hub, spatial camber
     Metric(
         "wheel_center_x", "mm", "Wheel centre x", wheel_center_x, drivers=(HUB_Z,), written=False
     ),
@@ -542,6 +512,7 @@ METRICS = (
     Metric("svic_z", "mm", "Side-view IC z", svic_z, always_written=True),
     Metric("fvic_y", "mm", "Front-view IC y", fvic_y, always_written=True),
     Metric("fvic_z", "mm", "Front-view IC z", fvic_z, always_written=True),
+    *other_tools.KINEMATIC,  # the bump twist's front-view pole (OptimumK's kinematic IC)
     Metric("svsa_length", "mm", "Side-view swing arm length", svsa_length, always_written=True),
     Metric("fvsa_length", "mm", "Front-view swing arm length", fvsa_length, always_written=True),
     Metric("svsa_angle", "deg", "Side-view swing arm angle", svsa_angle, always_written=True),

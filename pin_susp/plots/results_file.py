@@ -163,17 +163,18 @@ class ResultsFile:
 def corner_labels(columns) -> tuple[str, ...]:
     """The corners' labels a results table's columns carry, in their order: the suffix
     of each camber column (``camber_left`` → ``left``; ``camber_to_ground_left`` is the
-    axle's, not a corner's), ``""`` for an unsuffixed one (and for a table with no
-    camber: a corner's, read as such)."""
+    axle's, not a corner's, and ``camber_spatial`` another metric), ``""`` for an
+    unsuffixed one (and for a table with no camber: a corner's, read as such)."""
     labels = tuple(
         name.removeprefix("camber").removeprefix("_")
         for name in columns
-        if name == "camber" or (name.startswith("camber_") and not name.startswith(GROUND))
+        if name == "camber" or (name.startswith("camber_") and not name.startswith(NOT_LABELS))
     )
     return labels or ("",)
 
 
 GROUND = "camber_to_ground"  # an axle's or a vehicle's column, not a corner's camber
+NOT_LABELS = (GROUND, "camber_spatial")  # camber_…: not a corner's camber suffixed
 
 
 def _cell(text: str) -> float:

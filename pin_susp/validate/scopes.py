@@ -50,9 +50,11 @@ class Scope:
         for pair in (
             ("roll_center_y", "roll_center_z"),
             ("deriv_roll_center_y_wrt_roll", "deriv_roll_center_z_wrt_roll"),
+            ("kinematic_roll_center_y", "kinematic_roll_center_z"),
         )
         for name in pair
     }
+    KINEMATIC_IC = ("kinematic_instant_center_y", "kinematic_instant_center_z")
 
     def __init__(self, subject):
         self.subject = subject
@@ -170,11 +172,18 @@ class Scope:
         they are nearly parallel (instant centres a hundred metres out) it lies at
         |RC| ≫ track, and a rounding δ in a line's slope moves it by (|RC|²/track)·δ:
         a relative error |RC|/track times larger than its inputs', in either
-        coordinate and in its rates alike.
+        coordinate and in its rates alike. A corner's kinematic instant centre, the pole
+        v/ω_x of its bump twist, likewise: its vector's length times |IC| / half track.
         """
+        for base in self.KINEMATIC_IC:
+            if name.startswith(base):
+                suffix = name.removeprefix(base)
+                ic = np.hypot(*(results[f"{b}{suffix}"][i] for b in self.KINEMATIC_IC))
+                return ic * max(1.0, ic / results[f"half_track{suffix}"][i])
         if name not in self.ROLL_CENTRE:
             return abs(results[name][i])
-        rc = np.hypot(results["roll_center_y"][i], results["roll_center_z"][i])
+        kind = "kinematic_" if name.startswith("kinematic_") else ""
+        rc = np.hypot(results[f"{kind}roll_center_y"][i], results[f"{kind}roll_center_z"][i])
         lever = max(1.0, rc / results["track"][i])
         return np.hypot(*(results[n][i] for n in self.ROLL_CENTRE[name])) * lever
 

@@ -74,7 +74,8 @@ class AxleOfCar:
                     key = side + name.removeprefix(label)
                     plain[key] = motion[label].val
                     own[key] = {s: motion[at] for s, at in view.labels.items()}
-        out = pair_columns(view, plain, by_side) | roll_rates(view, own, by_side)
+        cps = {s: own[f"{s}_contact_patch_center"][s] for s in SIDES}
+        out = pair_columns(view, plain, by_side, cps) | roll_rates(view, own, by_side)
         if model.corners[left].steering != "rack":
             out.pop("ackermann", None)
         return self.suffixed(out)

@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...columns.metrics import PointSet, fvic_y, fvic_z
+from ...columns.other_tools import kinematic_roll_centre
 from ...constraints import HeaveTarget, RollTarget
 from ...errors import InputError
 from ...maths.jet import Dual
@@ -59,7 +60,8 @@ class WheelPair:
         (``points``: name → {side: jet.Dual}) and each side's corner columns
         (``sides``: side → its metric columns, unsuffixed)."""
         plain = {k: v["left"].val for k, v in points.items()}
-        return pair_columns(model, plain, sides) | roll_rates(model, points, sides)
+        cps = {s: points[f"{s}_contact_patch_center"][s] for s in SIDES}
+        return pair_columns(model, plain, sides, cps) | roll_rates(model, points, sides)
 
     @staticmethod
     def value(t) -> np.ndarray:
@@ -140,9 +142,11 @@ def roll_stiffness(model, sides: dict, rates: dict, per_rad: dict) -> dict:
     return out
 
 
-def pair_columns(model, p: dict, sides: dict) -> dict:
-    """heave, roll, body_roll, camber to ground, ride height, track, roll centre, rack,
-    steer angles and Ackermann, the U-bar's arm angles and twist, the heave link."""
+def pair_columns(model, p: dict, sides: dict, cps: dict) -> dict:
+    """heave, roll, body_roll, camber to ground, ride height, track, roll centre (the
+    geometric one, and the kinematic one from ``cps``: side → its contact patch's
+    motion along its own hub z, other_tools.kinematic_roll_centre), rack, steer angles
+    and Ackermann, the U-bar's arm angles and twist, the heave link."""
     d = {k: v[None] for k, v in model.design_positions.items()}
     dz = {s: p[f"{s}_wheel_center"][:, 2] - d[f"{s}_wheel_center"][:, 2] for s in SIDES}
     cp = {s: p[f"{s}_contact_patch_center"] for s in SIDES}
@@ -167,6 +171,7 @@ def pair_columns(model, p: dict, sides: dict) -> dict:
         ]
     )
     out["roll_center_y"], out["roll_center_z"] = (rc[0], "mm"), (rc[1], "mm")
+    out |= kinematic_roll_centre(cps)
     travel = rack.travel(p, d)
     out |= rack.columns(travel)
     steer = {}
