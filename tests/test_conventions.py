@@ -90,6 +90,11 @@ def test_points_and_angles_against_the_axes(bump, name):
     np.testing.assert_array_equal(out["roadwheel_angle"], TOE[name] * iso["roadwheel_angle"])
     for same in ("camber", "caster", "kpi", "scrub_radius", "mechanical_trail", "half_track"):
         np.testing.assert_array_equal(out[same], iso[same])
+    # Lotus' castor trail (hub) reads + the other way (two Lotus reports, docs/results.md)
+    hub = -1 if name == "lotus" else 1
+    np.testing.assert_array_equal(out["caster_trail_at_hub"], hub * iso["caster_trail_at_hub"])
+    d = "deriv_caster_trail_at_hub_wrt_hub_z"  # d/d hub_z: hub_z flips with z
+    np.testing.assert_array_equal(out[d], hub * sz * iso[d])
     np.testing.assert_array_equal(out["wheel_travel"], sz * iso["wheel_travel"])
     np.testing.assert_array_equal(out["rack_displacement"], sy * iso["rack_displacement"])
     np.testing.assert_array_equal(out["step_index"], iso["step_index"])
@@ -157,8 +162,10 @@ def test_column_families_by_rule_including_the_new_columns():
     assert (
         sign("kinematic_roll_center_z", sae) == -1 and sign("kinematic_roll_center_z", lotus) == 1
     )
-    for same in ("kingpin_offset_at_hub", "caster_trail_at_hub", "normal_trail", "camber_spatial"):
+    for same in ("kingpin_offset_at_hub", "normal_trail", "camber_spatial"):
         assert all(sign(same, c) == 1 for c in CONVENTIONS.values())
+    hub = {n: sign("caster_trail_at_hub_fl", c) for n, c in CONVENTIONS.items()}
+    assert hub == {"iso": 1, "sae": 1, "lotus": -1, "optimumk": 1}  # Lotus' the other way
     assert sign("trail_in_wheel_axes", ok) == 1 and sign("scrub_in_wheel_axes_left", sae) == 1
     assert sign("steering_wheel_angle", sae) == -1 and sign("steering_wheel_torque", sae) == -1
     assert sign("steering_ratio", sae) == 1 and sign("rack_force", lotus) == -1

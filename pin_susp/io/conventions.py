@@ -41,6 +41,8 @@ class Convention:
     toe: int  # + toe-in (1) or + toe-out (-1)
     steer_outward: bool  # the steer angle + outward on each side (else: about z)
     text: str  # what the file's header says
+    # columns this tool defines with the opposite physical sense (by stem, any side)
+    negated: frozenset = frozenset()
 
     def axis_sign(self, axis: str) -> int:
         return dict(zip("xyz", (s for _, s in self.axes), strict=True))[axis]
@@ -59,6 +61,9 @@ CONVENTIONS = {
         1,
         False,
         "Lotus SHARK: x rearward, y to the right, z up",
+        # Lotus' castor trail (hub) reads + with the axis behind the wheel centre: two
+        # Lotus reports' hub trail against their own hardpoints (docs/results.md)
+        frozenset({"caster_trail_at_hub"}),
     ),
     "optimumk": Convention(
         "optimumk",
@@ -97,6 +102,9 @@ NAMED = {
     "roll_gradient": ("rx", "y"),  # d roll / d ay
 }
 
+# columns whose sense one of the tools defines the other way (Convention.negated)
+DEFINED = ("caster_trail_at_hub",)
+
 
 def stem(name: str) -> tuple[str, str | None]:
     """The name without its side or axle suffixes, and the side it names (left, right,
@@ -123,6 +131,8 @@ def factors(name: str) -> tuple:
         return factors(column) + factors(driver)
     if base in NAMED:
         return NAMED[base]
+    if base in DEFINED:
+        return (base,)
     if re.search(r"(^|_)[xyz]$", base):
         return (base[-1],)
     return ()
@@ -137,6 +147,8 @@ def sign(name: str, convention: Convention) -> int:
             out *= convention.axis_sign(f)
         elif f in ("rx", "ry", "rz"):
             out *= convention.axis_sign(f[1])
+        elif f in DEFINED:
+            out *= -1 if f in convention.negated else 1
         elif f == "toe":
             out *= convention.toe
         elif f == "steer":
