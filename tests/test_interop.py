@@ -385,6 +385,16 @@ def test_export_refuses_other_mechanisms(tmp_path, capsys):
     assert not (tmp_path / "o.shk").exists()
 
 
+@pytest.mark.parametrize("subject", ["axle_front.yaml", "vehicle_fs.yaml"])
+def test_export_refuses_an_axle_or_a_car_naming_its_kind(tmp_path, capsys, subject):
+    argv = ["export", str(EXAMPLES / subject), "--format", "optimumk", "-o", "o.csv"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "export is not built yet" in err
+    assert ("an axle takes" if subject.startswith("axle") else "a vehicle takes") in err
+    assert not (tmp_path / "o.csv").exists()
+
+
 def test_lotus_report_layout_and_a_damper_on_the_upper_wishbone(tmp_path, capsys):
     """Lotus' printed report: x y z before each name; a type pin_susp reads but whose
     damper it has no place for (on the upper wishbone): its points ignored, said."""

@@ -80,7 +80,10 @@ def refuse_unbuilt(args) -> None:
     if kind.commands is not None and name not in kind.commands:
         takes = ", ".join(f"pin-susp {c}" for c in kind.commands)
         raise InputError(
-            str(geometry), "scope", f"a {kind.noun} takes {takes} so far: {name} is not built yet"
+            str(geometry),
+            "scope",
+            f"{'an' if kind.noun[0] in 'aeiou' else 'a'} {kind.noun} takes {takes} so far: "
+            f"{name} is not built yet",
         )
 
 

@@ -73,6 +73,20 @@ class AxleModel(AxleAssembly):
     """
 
     labels = SIDES
+    # every command but export, which writes one corner's points (docs/interop.md)
+    commands = (
+        "sweep",
+        "attitude",
+        "urdf",
+        "mjcf",
+        "validate",
+        "view",
+        "draw",
+        "loads",
+        "setup",
+        "sensitivity",
+        "study",
+    )
     motion_at_once_from = MIN_STEPS  # linkage.Composed.label_motion
     refuses = ("repeats",)
     checks_counts_first = False  # its counts checked when solved (after loads' own)
