@@ -80,18 +80,19 @@ def c_factor_of(geometry, key: str = "config.steering.c_factor", source=None) ->
 TRACK_CHECK = 1.0  # mm: config.track against the mirrored partner's contact patches
 
 
-def track_of(geometry) -> float | None:
+def track_of(geometry, check: bool = True) -> float | None:
     """A corner's ``config.track`` (m): the track it stands in, which asks for its steering
-    with its mirrored partner (docs/results.md, "Steering"), checked > 0 and against
-    the partner's contact patch at design (the corner mirrored in y = 0, its own
-    contact patch's 2·|y|), to TRACK_CHECK; None where none is given."""
+    with its mirrored partner (docs/results.md, "Steering"), checked > 0 and (``check``:
+    the file's own corner, not a study's variant of it, whose moved points move its
+    partner alike) against the partner's contact patch at design (the corner mirrored
+    in y = 0, its own contact patch's 2·|y|), to TRACK_CHECK; None where none is given."""
     config = geometry.data.get("config") if isinstance(geometry.data, dict) else None
     if not isinstance(config, dict) or "track" not in config:
         return None
     r = Reader(geometry.source)
     track = r.positive(config["track"], "config.track")
     mirrored = 2.0 * abs(geometry.design_points()["contact_patch_center"][1]) * 1e3
-    if abs(track - mirrored) > TRACK_CHECK:
+    if check and abs(track - mirrored) > TRACK_CHECK:
         r.fail(
             "config.track",
             f"{track:g} mm, but the corner mirrored in y = 0 stands in a track of "

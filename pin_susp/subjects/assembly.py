@@ -11,6 +11,7 @@ places that still do).
 
 from __future__ import annotations
 
+import operator as eq
 from dataclasses import replace
 
 import numpy as np
@@ -145,14 +146,15 @@ class Assembly(SteeringSurface, Composed, AnalysesSurface):
         """The sweep as its steps hold it (``held_targets``): its targets, and the rack's
         at design where it gives every other (``sweep_notes`` says so); the sweep
         itself where nothing is held."""
-        targets = self.held_targets(sweep.targets)
-        return sweep if len(targets) == len(sweep.targets) else replace(sweep, targets=targets)
+        targets = self.held_targets(sweep.targets)  # a steering wheel's: the rack's
+        same = len(targets) == len(sweep.targets) and all(map(eq.is_, targets, sweep.targets))
+        return sweep if same else replace(sweep, targets=targets)
 
     def metric_columns_of(self, points: dict) -> dict:
         """Every metric column (name → (values, unit)) from its points with their rates
         along the drivers (name → {label: jet.Dual}, as ``label_motion`` gives them, or
-        an engine's): ``metric_columns``."""
-        return self.metric_columns(points)
+        an engine's): ``metric_columns``, and the steering's from them (steering_surface.py)."""
+        return self.with_steering(self.metric_columns(points))
 
     def motion_points(self, by_label: dict) -> dict:
         """Points with a Dual per label (name → {label: Dual}, ``label_motion``'s) in the

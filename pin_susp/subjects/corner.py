@@ -97,8 +97,9 @@ class Corner(Assembly, Linkage):
         warn: bool = True,
         visuals: bool = True,
     ):
-        """``warn``: a PlausibilityWarning for each implausible design metric (a study's
-        variants skip it: their design's was shown); ``visuals``: the URDF's shapes."""
+        """``warn``: a PlausibilityWarning for each implausible design metric, and its
+        ``config.track`` checked against its mirrored partner (a study's variants skip
+        both: their design's were); ``visuals``: the URDF's shapes."""
         if not isinstance(geometry, Geometry):
             geometry = load_geometry(geometry)
         if apply_setup and geometry.needs_setup:  # shims and adjusters: the as-set
@@ -107,7 +108,7 @@ class Corner(Assembly, Linkage):
             geometry = as_set.apply_setup(geometry)
         super().__init__(geometry, visuals)
         self.steering  # noqa: B018 (its c-factor checked as its file is read)
-        self.mirrored_track = track_of(geometry)  # config.track: its mirrored partner
+        self.mirrored_track = track_of(geometry, warn)  # config.track: its mirrored partner
         if warn:
             self._warn_implausible()
 

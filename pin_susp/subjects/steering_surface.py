@@ -102,6 +102,13 @@ class SteeringSurface:
         angle = steering.wheel_angle(columns["rack_displacement"])
         return {"steering_wheel_angle": (angle, "deg")} | self.steering_ratio(columns)
 
+    def with_steering(self, columns: dict) -> dict:
+        """The columns (name → (values, unit)) with the steering's computed from them (the
+        validation engines': Assembly.metric_columns_of): the steering wheel's angle where
+        they have the rack's travel, and the steering ratio."""
+        values = {name: column[0] for name, column in columns.items()}
+        return columns | self.steering_ratio(values) | self.steering_columns(values)
+
     def steering_ratio(self, columns: dict) -> dict:
         """``steering_ratio`` (deg/deg): d steering-wheel angle / d mean steer angle (+
         left) of its rack-steered wheels, each from its own derivative along the rack
