@@ -212,7 +212,7 @@ def test_a_corners_ackermann_is_its_mirrored_axles(axle):
     one = alone.run_sweep(sweep(wheel(-250, 250), z=(0, 0), steps=11))
     names = ("track", "steer_angle_inner", "steer_angle_outer", "ackermann")
     for name in names:
-        np.testing.assert_allclose(one[name], both[name], atol=1e-7, rtol=1e-9, err_msg=name)
+        np.testing.assert_allclose(one[name], both[name], atol=1e-9, rtol=1e-9, err_msg=name)
     assert np.isfinite(one["ackermann"]).sum() == 10
     # the corner's ratio is its own wheel's: the axle's mean rate is the corner's at x
     # and at −x (its partner's), 1/ratio the mean of the corner's two
