@@ -148,8 +148,9 @@ class Corner(Assembly, Linkage):
         )
 
     def own_columns(self, sweep: Sweep, qs: list, plain: dict, columns: dict, tangents=None):
-        """The steering wheel's angle and ratio (Assembly's), then with a wheelbase its
-        steering with its mirrored partner (``partner_columns``, steering_surface.py)."""
+        """The steering wheel's angle and ratio (Assembly's), then with config.wheelbase and
+        config.track its steering with its mirrored partner (``partner_columns``,
+        steering_surface.py)."""
         out = super().own_columns(sweep, qs, plain, columns, tangents)
         return out | self.partner_columns(qs, plain, columns)
 

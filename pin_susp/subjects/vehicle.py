@@ -132,6 +132,8 @@ class Vehicle(VehicleExport, VehicleViews, VehicleTangents, VehicleAssembly):
         "arb_twist_rear heave_link_length_front heave_link_length_rear".split()
     )
     held_joints = JOINTS  # a corner's rates: its own height with the body still
+    c_factor_key = "vehicle_config.steering.c_factor"  # its c-factor, else its front
+    front_c_factor = "axle_config.steering.c_factor"  # axle file's
     tangents_by_targets = True  # a sweep solved at once: its tangents, the body's rates
     needs = (
         "the body's heave, pitch and roll, and the steering (steering_wheel or a rack "
@@ -409,9 +411,6 @@ class Vehicle(VehicleExport, VehicleViews, VehicleTangents, VehicleAssembly):
         the steering ratio of its front wheels (steering_surface.py)."""
         out = self.body_columns(sweep, qs, plain, columns, tangents)
         return out | self.steering_ratio(columns)
-
-    c_factor_key = "vehicle_config.steering.c_factor"
-    front_c_factor = "axle_config.steering.c_factor"  # the front axle's, else
 
     @property
     def steering(self) -> Steering | None:
