@@ -83,6 +83,8 @@ def member_forces(corner, sweep, cases: list, solutions=None, results=None, prog
     for k, name in enumerate(names):
         columns[name] = values[k]
         units[name] = "N·m" if name.startswith("torque") else "N"
+    for name, force in steering_columns(corner.steering, columns).items():
+        columns[name], units[name] = force, "N·m" if name.endswith("torque") else "N"
     for name, values in results.columns.items():
         if name != "step_index":
             columns[name] = np.repeat(values, n)
@@ -90,6 +92,20 @@ def member_forces(corner, sweep, cases: list, solutions=None, results=None, prog
     _warn_dead_centre_share(corner, cases, columns)
     meta = dict(results.meta, not_two_force=statics.not_two_force())
     return Results(columns, units, meta)
+
+
+def steering_columns(steering, columns: dict) -> dict:
+    """``rack_force`` (N): the trackrods' force on the rack along its axis, + in the sense
+    that turns the car left (``force_rack`` is along +y); ``steering_wheel_torque`` (N·m,
+    with a c-factor): the torque it puts on the steering wheel through an ideal gear,
+    rack_force · c / (2π), + turning left — the driver holds it with the opposite
+    (docs/loads.md). None without a rack (``steering``: the subject's, model/steering.py)."""
+    if steering is None or "force_rack" not in columns:
+        return {}
+    out = {"rack_force": steering.rack_force(columns["force_rack"])}
+    if steering.c_factor is not None:
+        out["steering_wheel_torque"] = steering.wheel_torque(out["rack_force"])
+    return out
 
 
 # A spring's share of the tyre's vertical load outside this band (spring force over

@@ -37,6 +37,10 @@ SUMMARY_EXTRA = (
     "spring_torque",
     "wheel_rate",
     "ride_rate",
+    "steering_wheel_angle",
+    "steering_ratio",
+    "ackermann",
+    "turning_radius",
 )
 
 

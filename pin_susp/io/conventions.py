@@ -85,7 +85,7 @@ NAMED = {
     "steer_angle": ("steer",),
     "rack_displacement": ("y",),  # TRI_y − design: + rack to the left
     "force_rack": ("y",),  # along +y
-    "rack_force": ("y",),
+    "rack_force": ("rz",),  # + where the loads push the rack the way that steers left
     "heave": ("z",),
     "wheel_travel": ("z",),  # WC_z − design
     "ride_height_change": ("z",),

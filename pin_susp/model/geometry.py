@@ -348,6 +348,7 @@ def parse_geometry(data: dict, r: Reader, sha: str | None) -> Geometry:
             "steering",
             "cg_position",
             "wheelbase",
+            "track",
             "axle_position",
             "front_brake_bias",
             "driven_axle",
@@ -372,13 +373,12 @@ def parse_geometry(data: dict, r: Reader, sha: str | None) -> Geometry:
     if spring == "torsion_bar" and actuation != "pushrod_rocker":
         r.fail("spring.type", "a torsion bar needs actuation type pushrod_rocker")
 
-    steer_map = r.mapping(config.get("steering", {}), "config.steering", optional=("type",))
+    steer_map = r.mapping(config.get("steering", {}), "config.steering", (), ("type", "c_factor"))
     steering = r.choice(
         steer_map.get("type", mech.STEERING[0]), "config.steering.type", mech.STEERING
     )
     wheel = read_wheel(config["wheel"], r)
     options = Options(kind, side, steering, actuation, mount, spring)
-
     names = mech.hardpoint_names(options)
     hp_map = data["hardpoints"]
     if not isinstance(hp_map, dict):

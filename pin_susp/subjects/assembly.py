@@ -11,6 +11,7 @@ places that still do).
 
 from __future__ import annotations
 
+import operator as eq
 from dataclasses import replace
 
 import numpy as np
@@ -26,6 +27,7 @@ from ..solve.march import march
 from ..solve.solver import NewtonSolver, Solution
 from .analyses_surface import AnalysesSurface
 from .elements import rack
+from .steering_surface import SteeringSurface
 
 CHUNK = 10_000  # steps solved and written at a time by a streamed sweep
 Z = np.array([0.0, 0.0, 1.0])
@@ -34,7 +36,7 @@ Z = np.array([0.0, 0.0, 1.0])
 VEHICLE_QUANTITIES = ("pitch", "road_z", "steering_wheel", "rack")  # a body on the road's alone
 
 
-class Assembly(Composed, AnalysesSurface):
+class Assembly(SteeringSurface, Composed, AnalysesSurface):
     """The surface :class:`~pin_susp.subjects.corner.Corner` and
     :class:`~pin_susp.subjects.axle.AxleModel` share.
 
@@ -144,14 +146,15 @@ class Assembly(Composed, AnalysesSurface):
         """The sweep as its steps hold it (``held_targets``): its targets, and the rack's
         at design where it gives every other (``sweep_notes`` says so); the sweep
         itself where nothing is held."""
-        targets = self.held_targets(sweep.targets)
-        return sweep if len(targets) == len(sweep.targets) else replace(sweep, targets=targets)
+        targets = self.held_targets(sweep.targets)  # a steering wheel's: the rack's
+        same = len(targets) == len(sweep.targets) and all(map(eq.is_, targets, sweep.targets))
+        return sweep if same else replace(sweep, targets=targets)
 
     def metric_columns_of(self, points: dict) -> dict:
         """Every metric column (name → (values, unit)) from its points with their rates
         along the drivers (name → {label: jet.Dual}, as ``label_motion`` gives them, or
-        an engine's): ``metric_columns``."""
-        return self.metric_columns(points)
+        an engine's): ``metric_columns``, and the steering's from them (steering_surface.py)."""
+        return self.with_steering(self.metric_columns(points))
 
     def motion_points(self, by_label: dict) -> dict:
         """Points with a Dual per label (name → {label: Dual}, ``label_motion``'s) in the
@@ -195,6 +198,7 @@ class Assembly(Composed, AnalysesSurface):
                 seen[what] = i
             if t.quantity is not None:
                 if t.quantity not in quantities:
+                    self.refuse_steering(t, i, source)  # steering_surface.py
                     owner = "a vehicle's" if t.quantity in VEHICLE_QUANTITIES else "an axle's"
                     takes = ", ".join(quantities) if quantities else "no quantity, only points"
                     raise InputError(
@@ -555,9 +559,9 @@ class Assembly(Composed, AnalysesSurface):
     ) -> dict:
         """Its columns beyond its corners' and elements' (name → (values, unit)), from the
         solved configurations ``qs``, the points as measured (``plain``, m), the columns
-        so far and the sweep's tangents per step (sweep_results', or None): none (a
-        vehicle's body)."""
-        return {}
+        so far and the sweep's tangents per step (sweep_results', or None): the steering
+        wheel's angle and ratio where a c-factor is given (steering_surface.py)."""
+        return self.steering_columns(columns)
 
     def run_sweep_chunks(self, sweep: Sweep | str | dict, rows: int = CHUNK, progress=None):
         """The sweep's Results ``rows`` steps at a time (each chunk's ``step_index``

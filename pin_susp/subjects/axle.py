@@ -72,6 +72,8 @@ class AxleModel(AxleAssembly):
     As an Assembly (assembly.py): labels ``left``, ``right``; ``corners`` the geometries.
     """
 
+    c_factor_key = "axle_config.steering.c_factor"  # docs/axle.md
+
     labels = SIDES
     # every command but export, which writes one corner's points (docs/interop.md)
     commands = (
@@ -137,6 +139,7 @@ class AxleModel(AxleAssembly):
         self.kin.update(self.q_design)
         if elements is not None:
             self._check_determined(elements.source)
+        self.steering  # noqa: B018 (its c-factor checked as its file is read)
         self.design_steer = {}
         for side, g in self.geometries.items():
             d = self.design_positions

@@ -13,6 +13,7 @@ import numpy as np
 from ..columns.metrics import METRICS, Pose, metric_columns
 from ..errors import InputError
 from ..model.geometry import Geometry, load_geometry, summary_repr, warn_outside
+from ..model.steering import track_of
 from ..model.sweep import Sweep, Target
 from ..solve.linkage import Linkage
 from ..solve.solver import Solution
@@ -96,8 +97,9 @@ class Corner(Assembly, Linkage):
         warn: bool = True,
         visuals: bool = True,
     ):
-        """``warn``: a PlausibilityWarning for each implausible design metric (a study's
-        variants skip it: their design's was shown); ``visuals``: the URDF's shapes."""
+        """``warn``: a PlausibilityWarning for each implausible design metric, and its
+        ``config.track`` checked against its mirrored partner (a study's variants skip
+        both: their design's were); ``visuals``: the URDF's shapes."""
         if not isinstance(geometry, Geometry):
             geometry = load_geometry(geometry)
         if apply_setup and geometry.needs_setup:  # shims and adjusters: the as-set
@@ -105,6 +107,8 @@ class Corner(Assembly, Linkage):
 
             geometry = as_set.apply_setup(geometry)
         super().__init__(geometry, visuals)
+        self.steering  # noqa: B018 (its c-factor checked as its file is read)
+        self.mirrored_track = track_of(geometry, warn)  # config.track: its mirrored partner
         if warn:
             self._warn_implausible()
 
@@ -142,6 +146,13 @@ class Corner(Assembly, Linkage):
             points={k: p.val[0] * 1e3 for k, p in points.items()},
             derivatives={k: float(v[0]) for k, (v, _) in columns.items() if "deriv_" in k},
         )
+
+    def own_columns(self, sweep: Sweep, qs: list, plain: dict, columns: dict, tangents=None):
+        """The steering wheel's angle and ratio (Assembly's), then with config.wheelbase and
+        config.track its steering with its mirrored partner (``partner_columns``,
+        steering_surface.py)."""
+        out = super().own_columns(sweep, qs, plain, columns, tangents)
+        return out | self.partner_columns(qs, plain, columns)
 
     # Assembly surface for loads, viz and drawing
     @property

@@ -33,6 +33,7 @@ from ..errors import InputError
 from ..maths.vectors import unit
 from ..model.geometry import contact_patch, summary_repr
 from ..model.mechanisms import xml_name
+from ..model.steering import Steering, c_factor_of, steer_sense
 from ..solve.linkage import RACK_HELD, Linkage
 from .axle_file import AxleGeometry
 from .corner import Results
@@ -131,6 +132,8 @@ class Vehicle(VehicleExport, VehicleViews, VehicleTangents, VehicleAssembly):
         "arb_twist_rear heave_link_length_front heave_link_length_rear".split()
     )
     held_joints = JOINTS  # a corner's rates: its own height with the body still
+    c_factor_key = "vehicle_config.steering.c_factor"  # its c-factor, else its front
+    front_c_factor = "axle_config.steering.c_factor"  # axle file's
     tangents_by_targets = True  # a sweep solved at once: its tangents, the body's rates
     needs = (
         "the body's heave, pitch and roll, and the steering (steering_wheel or a rack "
@@ -155,13 +158,13 @@ class Vehicle(VehicleExport, VehicleViews, VehicleTangents, VehicleAssembly):
             )
             for label in LABELS
         }
-        front = self.corners["fl"]
+        front, c = self.corners["fl"], vehicle.c_factor
         sense = 1.0
         if front.steering == "rack":  # the rack's travel left steers left where the
-            # trackrods are ahead of the wheel centre
-            p = front.design_points()
-            sense = 1.0 if p["trackrod_outboard"][0] > p["wheel_center"][0] else -1.0
-        self.body = BodyOnRoad(vehicle.cg, vehicle.c_factor, sense)
+            sense = steer_sense(front.design_points())  # trackrods are ahead of the wheel
+            if c is None:  # the front axle file's own, where the vehicle gives none
+                c = c_factor_of(front, *axle_key(vehicle, "front", self.front_c_factor)[::-1])
+        self.body = BodyOnRoad(vehicle.cg, Steering(c, sense))
         # each axle's bar and heave link, named by its corners' labels and its end
         self.axle_elements = {end: AxleElements(getattr(vehicle, end), end) for end in AXLES}
         self.elements = tuple(e for a in self.axle_elements.values() for e in (a.bar, a.link))
@@ -404,8 +407,16 @@ class Vehicle(VehicleExport, VehicleViews, VehicleTangents, VehicleAssembly):
 
     def own_columns(self, sweep, qs: list, plain: dict, columns: dict, tangents=None) -> dict:
         """The body's pose, what the road sees and the rates along the body
-        (``body_columns``; ``tangents``: the sweep's per target, where it has them)."""
-        return self.body_columns(sweep, qs, plain, columns, tangents)
+        (``body_columns``; ``tangents``: the sweep's per target, where it has them), and
+        the steering ratio of its front wheels (steering_surface.py)."""
+        out = self.body_columns(sweep, qs, plain, columns, tangents)
+        return out | self.steering_ratio(columns)
+
+    @property
+    def steering(self) -> Steering | None:
+        """The steering wheel on its rack: its body's (the vehicle's c-factor, else its
+        front axle file's); None without a rack."""
+        return self.body.steering if self.corners["fl"].steering == "rack" else None
 
     def body_columns(self, sweep, qs: list, plain: dict, columns: dict, tangents=None) -> dict:
         """The body's heave, pitch, roll and steering-wheel angle; each corner's camber

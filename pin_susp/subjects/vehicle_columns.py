@@ -13,8 +13,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..model.steering import turning_radius as radius_of
+
 ENDS = {"front": ("fl", "fr"), "rear": ("rl", "rr")}
-STRAIGHT = 1e-6  # m of rack travel: a straight-ahead step has no turning radius
 
 
 def vehicle_columns(car, plain: dict, columns: dict) -> dict:
@@ -113,9 +114,6 @@ def turning_radius(car, columns: dict) -> dict:
     if any(s is None for s in steer) or travel is None:
         return {}
     design = [car.design_steer(c) for c in ENDS["front"]]
-    delta = np.radians(0.5 * (steer[0] - design[0] + steer[1] - design[1]))
     base = 0.5 * (columns["wheelbase_left"] + columns["wheelbase_right"])  # on the road
-    with np.errstate(divide="ignore", invalid="ignore"):
-        radius = base * 1e-3 / np.tan(delta)
-    radius[np.abs(travel) < STRAIGHT * 1e3] = np.nan
+    radius = radius_of(steer, design, base * 1e-3, travel * 1e-3)  # model/steering.py
     return {"turning_radius": (radius, "m")}

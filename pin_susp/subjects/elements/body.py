@@ -11,7 +11,8 @@ world position with the three joints at zero.
 
 Its sweep quantities — ``heave`` (mm, the CG's rise), ``pitch``, ``roll`` (deg),
 ``road_z`` (mm, under one corner: warp) and ``steering_wheel`` (deg, + turning
-left, through the steering's c-factor to the rack) — are each one solver row:
+left, through the steering's c-factor to the rack: model/steering.py) — are each one
+solver row:
 the body's joint, the corner's contact patch on the road, or the rack's slide.
 """
 
@@ -23,6 +24,7 @@ import numpy as np
 
 from ...constraints import JointTarget, PointTarget
 from ...errors import InputError
+from ...model.steering import Steering
 from ...model.tree import Body, FloatingBase, Joint, Tree
 from . import rack
 
@@ -33,15 +35,17 @@ Z = np.array([0.0, 0.0, 1.0])
 
 
 class BodyOnRoad:
-    """The sprung body on three joints at its CG ``cg`` (3,), m; ``c_factor``: mm of
-    rack per steering-wheel turn (None: no steering-wheel target); ``steer_sense``:
-    +1 where the rack's travel to the left (+y) turns the car left."""
+    """The sprung body on three joints at its CG ``cg`` (3,), m; ``steering``: the
+    steering wheel on the rack (model/steering.py: its c-factor, mm of rack per turn,
+    None: no steering-wheel target, and the sense of the rack's travel that turns the
+    car left)."""
 
     quantities = ("heave", "pitch", "roll", "road_z", "steering_wheel", "rack")
 
-    def __init__(self, cg: np.ndarray, c_factor: float | None, steer_sense: float = 1.0):
+    def __init__(self, cg: np.ndarray, steering: Steering):
         self.cg = np.asarray(cg, dtype=float)
-        self.c_factor, self.steer_sense = c_factor, steer_sense
+        self.steering = steering
+        self.c_factor = steering.c_factor
 
     def add_to(self, bodies, points, closures, visuals, materials) -> None:
         """The road as the root and the body's three joints above the chassis."""
@@ -119,12 +123,12 @@ class BodyOnRoad:
             return np.radians(v)
         if self.c_factor is None:  # the wheel centred (row: any other is refused)
             return np.zeros_like(v)
-        return self.steer_sense * v / 360.0 * self.c_factor * 1e-3
+        return self.steering.rack_travel(v) * 1e-3
 
     def steering_wheel_angle(self, travel: np.ndarray) -> np.ndarray:
         """The steering wheel's angle (deg, + turning left) for the rack's travel (m):
         ``value``'s inverse."""
-        return self.steer_sense * travel * 1e3 / self.c_factor * 360.0
+        return self.steering.wheel_angle(travel * 1e3)
 
     def columns_of(self, model, points: dict, sides: dict) -> dict:
         """None of its own among the corners': the vehicle writes the body's (vehicle.py)."""

@@ -18,6 +18,7 @@ from ...constraints import HeaveTarget, RollTarget
 from ...errors import InputError
 from ...maths.jet import Dual
 from ...maths.vectors import roll_centre, unit
+from ...model import steering
 from . import rack
 
 SIDES = ("left", "right")
@@ -178,31 +179,23 @@ def pair_columns(model, p: dict, sides: dict, cps: dict) -> dict:
     for side, s in (("left", 1.0), ("right", -1.0)):
         steer[side] = -s * sides[side]["roadwheel_angle"][0]
         out[f"steer_angle_{side}"] = (steer[side], "deg")
-    ratio = ackermann(model, steer, track)
-    if travel is None:  # no rack: no steering input
-        ratio[:] = np.nan
-    else:  # bump or roll steer alone is not steering: blank with the rack at centre
-        ratio[np.abs(travel) < 1e-6] = np.nan
-    out["ackermann"] = (ratio, "%")
+    out |= steer_columns(model, steer, track, travel)
     for element in model.elements:
         out |= element.columns(model, p, d)
     return out
 
 
-def ackermann(model, steer: dict, track: np.ndarray) -> np.ndarray:
-    """100·(δ_i − δ_o)/(δ_i* − δ_o) from the steer angles' change from design; blank for
-    |δ_o| < 0.5° or without a wheelbase."""
+def steer_columns(model, steer: dict, track: np.ndarray, travel) -> dict:
+    """``ackermann`` (%, blank without a rack or a wheelbase, or with the rack at centre)
+    and, with a rack, ``steer_angle_inner``, ``steer_angle_outer`` (deg, from design,
+    unsigned; blank with the rack at centre): model/steering.py's formulas."""
+    both = (steer["left"], steer["right"])
+    design = (model.design_steer["left"], model.design_steer["right"])
     wheelbase = model.corners["left"].wheelbase
-    n = len(track)
-    if wheelbase is None:
-        return np.full(n, np.nan)
-    design = model.design_steer
-    delta = {s: np.abs(steer[s] - design[s]) for s in SIDES}
-    left_inner = (steer["left"] + steer["right"]) > 0.0
-    inner = np.where(left_inner, delta["left"], delta["right"])
-    outer = np.where(left_inner, delta["right"], delta["left"])
-    with np.errstate(invalid="ignore", divide="ignore"):
-        o = np.radians(outer)
-        ideal = np.degrees(np.arctan2(wheelbase, wheelbase / np.tan(o) - np.abs(track)))
-        out = 100.0 * (inner - outer) / (ideal - outer)
-    return np.where(outer >= 0.5, out, np.nan)
+    out = {"ackermann": (steering.ackermann(both, design, wheelbase, track, travel), "%")}
+    if travel is None:
+        return out
+    inner, outer = steering.inner_outer(both, design)
+    centred = np.abs(travel) < steering.STRAIGHT
+    inner[centred] = outer[centred] = np.nan
+    return out | {"steer_angle_inner": (inner, "deg"), "steer_angle_outer": (outer, "deg")}
