@@ -168,7 +168,8 @@ def test_column_families_by_rule_including_the_new_columns():
     assert hub == {"iso": 1, "sae": 1, "lotus": -1, "optimumk": 1}  # Lotus' the other way
     assert sign("trail_in_wheel_axes", ok) == 1 and sign("scrub_in_wheel_axes_left", sae) == 1
     assert sign("steering_wheel_angle", sae) == -1 and sign("steering_wheel_torque", sae) == -1
-    assert sign("steering_ratio", sae) == 1 and sign("rack_force", lotus) == 1 and sign("rack_force", sae) == -1
+    assert sign("steering_ratio", sae) == 1
+    assert sign("rack_force", lotus) == 1 and sign("rack_force", sae) == -1
     assert sign("steer_angle_fl", ok) == 1 and sign("steer_angle_fr", ok) == -1  # + outward
     assert sign("steer_angle_fl", sae) == -1 and sign("steer_angle_rr", lotus) == 1
     # a derivative: sign(column) · sign(driver)
