@@ -258,7 +258,11 @@ def test_a_bump_only_sweep_validates_and_differentiates_with_the_rack_held(corne
 
     results, (report,) = validate(corner, load_sweep(bump_only(5)), engines=("pointwise",))
     assert not report.note and not report.failed_steps and not report.disagree
-    assert report.differences["roadwheel_angle"] < 1e-9 and report.worst < 1e-6
+    assert report.differences["roadwheel_angle"] < 1e-9
+    # every column within 1e-6 mm or deg but the kinematic instant centre, a pole v/ω_x
+    # tens of km out here (ω_x near 0): compared relative to |IC|²/half track (above)
+    near = {k: d for k, d in report.differences.items() if "kinematic_instant" not in k}
+    assert max(near.values()) < 1e-6, near
     np.testing.assert_array_equal(results["rack_displacement"], 0.0)
     sa = hardpoint_sensitivities(corner, bump_only(3))
     sb = hardpoint_sensitivities(corner, rack_held(3))
