@@ -138,7 +138,7 @@ def test_the_design_camber_and_toe_are_the_static_ones(tmp_path, side, camber, t
     assert r["wheel_center_y"][design] == pytest.approx(g["config"]["wheel"]["center"][1])
 
 
-def test_the_loaded_radius_raises_the_road(tmp_path):
+def test_the_loaded_radius_raises_the_road(tmp_path, capsys):
     """The tyre by its diameter and width: the contact patch is loaded_radius from the
     wheel centre in the wheel plane, diameter/2 − loaded_radius nearer than unloaded;
     the design ride height (wheel centre above the road) is R_l·cos(inclination)."""
@@ -156,6 +156,13 @@ def test_the_loaded_radius_raises_the_road(tmp_path):
     assert loaded.design_ride_height * 1e3 == pytest.approx(225.0 * np.sqrt(1 - a_z**2))
     assert loaded.wheel.section_width == pytest.approx(0.190)
     assert loaded.wheel.unloaded_radius == pytest.approx(0.23241)
+    from pin_susp.cli import main
+
+    assert main(["setup", str(tmp_path / "b.yaml")]) == 0  # the sheet reports it
+    said = f"design ride height {225.0 * np.sqrt(1 - a_z**2):.3f} mm"
+    assert said in capsys.readouterr().out
+    assert main(["setup", str(tmp_path / "a.yaml")]) == 0
+    assert "design ride height" not in capsys.readouterr().out  # no loaded radius given
 
 
 def errors(tmp_path, geometry) -> str:

@@ -168,6 +168,7 @@ def run(args) -> int:
             setting = "" if s in chosen else f"; not set: --side {args.side}"
             print(f"  {s} corner ({subject.setup_place(s)}{setting}):")
         _sheet(rows[s], labels[s][: len(rows[s])], links[s])
+        _ride_height(drawn[s])
         if targets and (found[s].iterations or not s):  # a corner not set: no hit
             _hit(targets, found[s].iterations)
         if args.sensitivities and not targets:
@@ -229,6 +230,17 @@ def _write_setup(data: dict, name: str, path) -> None:
 
     text = yaml.safe_dump(data, sort_keys=False, default_flow_style=None)
     write_text(f"# {name}: setup solved by pin-susp setup\n" + text, path)
+
+
+def _ride_height(geometry) -> None:
+    """The design ride height where the tyre is given by its loaded radius (docs/geometry.md,
+    "The wheel by its centre"): the wheel centre's height above the road at design."""
+    if geometry.wheel.loaded_radius is not None:
+        print(
+            f"  design ride height {geometry.design_ride_height * 1e3:.3f} mm: the wheel "
+            f"centre above the road on the tyre's loaded radius "
+            f"({geometry.wheel.loaded_radius * 1e3:g} mm)"
+        )
 
 
 def _link(geometry) -> str:
