@@ -60,8 +60,8 @@ def placed_points(shaft: Driveshaft | None, p: dict) -> dict:
     driveshaft."""
     if shaft is None or shaft.outboard_offset is None:
         return {}
-    spin = p["axle_outboard"] - p["axle_inboard"]
-    spin = spin / np.linalg.norm(spin)
+    spin = p["axle_outboard"] - p["axle_inboard"]  # plain arrays or jet.Duals
+    spin = spin / np.linalg.norm(spin, axis=-1)[..., None]
     return {"cv_outboard": p["wheel_center"] - spin * shaft.outboard_offset}
 
 
