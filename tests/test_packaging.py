@@ -435,3 +435,32 @@ def test_the_cli_says_a_bad_key_in_one_line(tmp_path, capsys):
     )
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and "config.limits.bump_stop.gap" in err and "Traceback" not in err
+
+
+def test_a_corner_in_inches_and_lbf_is_the_same():
+    """The keys' lengths in inches and the bump stop's rate in lbf/in, converted by hand:
+    the same columns (docs/geometry.md, "Units")."""
+    lbf = 4.4482216152605
+    mm = driven()
+    g = copy.deepcopy(mm)
+    g["units"], g["force_units"] = "inches", "lbf"
+    g["hardpoints"] = {n: {a: v / 25.4 for a, v in p.items()} for n, p in g["hardpoints"].items()}
+    c = g["config"]
+    c["cg_position"] = {a: v / 25.4 for a, v in c["cg_position"].items()}
+    c["wheelbase"] /= 25.4
+    c["wheel"]["tyre"]["rate"] /= lbf / 25.4
+    g["spring"] = {"type": "coilover", "rate": 175 / (lbf / 25.4), "preload": 2600 / lbf}
+    for key in ("outboard_offset", "max_plunge"):
+        c["driveshaft"][key] /= 25.4
+    c["limits"] = {
+        "damper_stroke": [v / 25.4 for v in STROKE],
+        "bump_stop": {"gap": GAP / 25.4, "rate": RATE / (lbf / 25.4)},
+        "rebound": REBOUND / 25.4,
+    }
+    sweep = {"version": 1, "targets": steer_and_bump()}
+    one, other = (pin_susp.Corner(d).run_sweep(sweep) for d in (mm, g))
+    names = (*SHAFT, "damper_margin_compression", "damper_margin_extension", "bump_stop_force")
+    for name in names:
+        np.testing.assert_allclose(other[name], one[name], rtol=1e-9, atol=1e-9, err_msg=name)
+    assert list(other["limit_exceeded"]) == list(one["limit_exceeded"])
+    assert any(one["limit_exceeded"])
