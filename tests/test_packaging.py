@@ -464,3 +464,50 @@ def test_a_corner_in_inches_and_lbf_is_the_same():
         np.testing.assert_allclose(other[name], one[name], rtol=1e-9, atol=1e-9, err_msg=name)
     assert list(other["limit_exceeded"]) == list(one["limit_exceeded"])
     assert any(one["limit_exceeded"])
+
+
+def test_a_vehicles_driven_axle_has_them_per_corner(tmp_path):
+    """The FS car's rear axle driven through shafts: each rear corner's columns from the
+    CSV's own points, the right in roll φ the left in −φ, and limit_exceeded_rl/_rr."""
+    (tmp_path / "vehicle").mkdir()
+    for name in ("fs_front.yaml", "fs_rear.yaml"):
+        data = yaml.safe_load((EXAMPLES / "vehicle" / name).read_text())
+        if name == "fs_rear.yaml":
+            data["hardpoints"]["left"]["cv_inboard"] = {"x": -1530.0, "y": 200.0, "z": 280.0}
+            data["axle_config"]["driveshaft"] = {"outboard_offset": OFFSET}
+            data["axle_config"]["limits"] = {"rebound": 10.0, "bump_stop": {"gap": 5, "rate": 300}}
+        (tmp_path / "vehicle" / name).write_text(yaml.safe_dump(data))
+    car = yaml.safe_load((EXAMPLES / "vehicle_fs.yaml").read_text())
+    (tmp_path / "car.yaml").write_text(yaml.safe_dump(car))
+    sweep = example("vehicle_roll.yaml")
+    (tmp_path / "roll.yaml").write_text(yaml.safe_dump(sweep))
+    out = tmp_path / "car.csv"
+    code = main(
+        ["sweep", str(tmp_path / "car.yaml"), str(tmp_path / "roll.yaml"), "-o", str(out), "-q"]
+    )
+    df = pd.read_csv(out, comment="#", keep_default_na=False, na_values=[""])
+    assert df["solver_converged"].all()
+    rear = yaml.safe_load((tmp_path / "vehicle" / "fs_rear.yaml").read_text())["hardpoints"]
+    p = {
+        n: np.array([rear["left"][n][a] for a in "xyz"]) for n in ("axle_inboard", "axle_outboard")
+    }
+    spin = (p["axle_outboard"] - p["axle_inboard"]) / np.linalg.norm(
+        p["axle_outboard"] - p["axle_inboard"]
+    )
+    # the shaft at design from the file's points (offset 0: the wheel centre on axle_outboard)
+    design = np.linalg.norm(p["axle_outboard"] - OFFSET * spin - [-1530.0, 200.0, 280.0])
+    for label in ("rl", "rr"):
+        hand = by_hand(df, f"{label}_")
+        hand["driveshaft_plunge"] = hand["driveshaft_length"] - design
+        np.testing.assert_allclose(hand["outboard"], hand["placed"], rtol=0, atol=1e-9)
+        for column in SHAFT:
+            np.testing.assert_allclose(
+                df[f"{column}_{label}"], hand[column], rtol=0, atol=1e-9, err_msg=column
+            )
+    for column in (*SHAFT, "bump_stop_force", "damper_margin_extension"):
+        rl, rr = df[f"{column}_rl"].to_numpy(), df[f"{column}_rr"].to_numpy()
+        np.testing.assert_allclose(rr, rl[::-1], rtol=1e-9, atol=1e-8, err_msg=column)
+    assert "driveshaft_length_fl" not in df  # the front is not driven
+    past = df["limit_exceeded_rl"].fillna("").tolist()
+    assert code == 1 and any(past) and not all(past)
+    assert past == df["limit_exceeded_rr"].fillna("").tolist()[::-1]
