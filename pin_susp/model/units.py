@@ -18,7 +18,14 @@ from dataclasses import dataclass
 
 MM = 1e-3  # m per mm
 INCH = 0.0254  # m per inch
-LENGTH_UNITS = {"millimeters": 1.0, "meters": 1000.0, "inches": 25.4}  # mm per unit
+LENGTH_UNITS = {  # mm per unit; the short names as the commands' --units take them
+    "millimeters": 1.0,
+    "meters": 1000.0,
+    "inches": 25.4,
+    "mm": 1.0,
+    "m": 1000.0,
+    "in": 25.4,
+}
 LBF = 4.4482216152605  # N per lbf (exact: 0.45359237 kg × 9.80665 m/s²)
 # force_units → (N per unit force, N/mm per unit rate, N·m per unit moment)
 FORCE_UNITS = {"N": (1.0, 1.0, 1.0), "lbf": (LBF, LBF / 25.4, LBF * INCH)}
