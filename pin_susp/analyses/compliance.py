@@ -121,7 +121,7 @@ class KC:
             out.append((P[0], toe, camber, J[0], dtoe, dcam))
         return out
 
-    def linear(self, qs: list, W: np.ndarray) -> np.ndarray:
+    def linear(self, qs: list, W: np.ndarray, progress=None) -> np.ndarray:
         """Every column (poses × names × cases) by the first-order solve at each pose."""
         m, nc = self.model, W.shape[1]
         out = np.empty((len(qs), len(self.names), nc))
@@ -137,6 +137,8 @@ class KC:
                 rates = motion[:, nc:]  # 5 motions × 4 unit loads per wheel
                 rows += [np.full(nc, x) for x in self._rates(rates, k)]
             out[i] = np.vstack([*rows, *self._parts(deflections, dx, nc, linear=True)])
+            if progress is not None and (i + 1 == len(qs) or i % 10 == 0):
+                progress(i + 1, len(qs))
         return out
 
     def _rates(self, motion: np.ndarray, k: int) -> list[float]:
@@ -170,7 +172,7 @@ class KC:
                 ]
         return rows
 
-    def nonlinear(self, qs: list, W: np.ndarray) -> np.ndarray:
+    def nonlinear(self, qs: list, W: np.ndarray, progress=None) -> np.ndarray:
         """Every column by the loaded pose's own solve (the rates stay the linear ones)."""
         m, nc = self.model, W.shape[1]
         out = self.linear(qs, W)
@@ -191,6 +193,8 @@ class KC:
                     out[i, k * per : k * per + len(MOTION), c] = motion
                 parts = self._parts(deflections, (e, s), 1, linear=False)
                 out[i, nw * per :, c] = np.concatenate(parts) if parts else []
+            if progress is not None:
+                progress(i + 1, len(qs))
         return out
 
 
@@ -198,10 +202,14 @@ PARTS = (("radial", "mm"), ("axial", "mm"), ("torsional", "deg"), ("conical", "d
 
 
 def kc_results(subject, sweep, cases, method: str = "linear", solutions=None, results=None,
-               compliances: dict | None = None):  # fmt: skip
+               compliances: dict | None = None, kc: KC | None = None, progress=None):  # fmt: skip
     """The K&C table (module docstring): a Results with one row per step and case —
     ``step_index``, ``load_case``, the K&C columns, then the sweep's own columns.
-    ``cases``: LoadCases (analyses/load_case.py) or a load-case file."""
+    ``cases``: LoadCases (analyses/load_case.py) or a load-case file; ``compliances``
+    (label → Compliance) instead of the files' blocks; ``progress(done, total)``.
+
+    >>> kc = kc_results(corner, "examples/bump_steer.yaml", "examples/kc.yaml")
+    >>> kc.to_pandas()[["load_case", "compliance_toe", "lateral_force_steer"]]"""
     from ..model.sweep import load_sweep
     from ..subjects.corner import Results
     from .load_case import load_cases
@@ -213,7 +221,7 @@ def kc_results(subject, sweep, cases, method: str = "linear", solutions=None, re
         sweep = load_sweep(sweep)
     if not isinstance(cases, list):
         cases = load_cases(cases, labels=subject.labels)
-    kc = KC(subject, compliances)
+    kc = KC(subject, compliances) if kc is None else kc
     W = Statics.loads_matrix(kc, cases)  # the cases' loads, 9 per wheel (a column each)
     if solutions is None:
         solutions = subject.solve_steps(sweep)
@@ -224,7 +232,8 @@ def kc_results(subject, sweep, cases, method: str = "linear", solutions=None, re
     done = [i for i, s in enumerate(solutions) if s.converged]
     if done:
         qs = [solutions[i].q for i in done]
-        values[done] = kc.linear(qs, W) if method == "linear" else kc.nonlinear(qs, W)
+        solve = kc.linear if method == "linear" else kc.nonlinear
+        values[done] = solve(qs, W, progress)
     values = values.transpose(1, 0, 2).reshape(len(kc.names), steps * n)
     columns = {
         "step_index": np.repeat(results["step_index"], n),
