@@ -122,13 +122,14 @@ class ComplianceModel:
         closures = list(subject.closures)
         link_names = {c.name: c for c in closures if isinstance(c, DistanceClosure)}
         tree_bodies = {b.name: b for b in subject.tree.bodies}
+        links, tyres = [], []
         for label, comp in compliances.items():
             prefix, g = subject.prefix(label), subject.corners[label]
             source, suffix = g.source, subject.suffix(label)
             pivots = {}  # body → its bushings' pickups
             for pickup in comp.bushings:
                 key = f"compliance.bushings.{pickup}"
-                body = self._pivot_body(tree_bodies, prefix + pickup)
+                body = self._pivot_body(tree_bodies, pickup, prefix)
                 if body is None:
                     raise InputError(
                         source,
@@ -167,11 +168,15 @@ class ComplianceModel:
                     raise InputError(
                         source, f"compliance.links.{name}", f"no such link here (links: {known})"
                     )
-                self.links[closure.name] = (col, k, name, suffix)
-                col += 1
+                links.append((closure.name, k, name, suffix))
             if comp.tyre:
-                self.tyres.append((label, col, comp.tyre.get("lateral"), comp.tyre.get("vertical")))
-                col += 2
+                tyres.append((label, comp.tyre.get("lateral"), comp.tyre.get("vertical")))
+        for name, *rest in links:  # x: q, every body's ε, every link's e, every tyre's s
+            self.links[name] = (col, *rest)
+            col += 1
+        for label, *rest in tyres:
+            self.tyres.append((label, col, *rest))
+            col += 2
         self.n = col
         self.kin = AugmentedKinematics(model, self.bodies, self.n)
         self.rows = closures + self._held_rows()
@@ -185,15 +190,17 @@ class ComplianceModel:
     def _unprefixed(body, prefix: str) -> list[str]:
         return [n.removeprefix(prefix) for n in body.joint.defined_by]
 
-    def _pivot_body(self, bodies: dict, point: str) -> str | None:
+    def _pivot_body(self, bodies: dict, point: str, prefix: str) -> str | None:
+        """The chassis child of the corner (its bodies prefixed) whose pivot has the point."""
         for b in bodies.values():
             j = b.joint
             if (
                 j is not None
                 and b.parent == "chassis"
+                and b.name.startswith(prefix)
                 and j.kind == "revolute"
                 and len(j.defined_by) == 2
-                and point in j.defined_by
+                and point in self._unprefixed(b, prefix)
             ):
                 return b.name
         return None
