@@ -224,3 +224,45 @@ def test_cli_kc_writes_the_table(tmp_path):
         "bushing_upper_wishbone_inboard_rear_radial",
     ):
         assert np.allclose(df[name], api[name], rtol=1e-6, atol=1e-9)
+
+
+def test_a_full_6x6_is_the_rate_form(saloon):
+    """{k: 6×6} diag(radial, radial, axial, conical, conical, torsional) (N/mm; N·m/rad)
+    gives the rate form's K&C to the last digits."""
+    deg = np.pi / 180
+    rates = {"radial": 3000, "axial": 800, "torsional": 1.0, "conical": 10.0}
+    diag = [3000, 3000, 800, 10.0 / deg, 10.0 / deg, 1.0 / deg]
+    front = "lower_wishbone_inboard_front"
+    a = KC(saloon, _comp(saloon, {"bushings": {front: rates}}))
+    b = KC(saloon, _comp(saloon, {"bushings": {front: {"k": np.diag(diag).tolist()}}}))
+    qs = [s.q for s in saloon.solve_steps(SWEEP)]
+    W = Statics.loads_matrix(a, [MIXED])
+    assert np.allclose(a.linear(qs, W), b.linear(qs, W), rtol=1e-12, atol=1e-15)
+
+
+def test_cli_kc_nonlinear_to_parquet(tmp_path):
+    """--method nonlinear, Parquet output: the compliances near the linear ones (1 kN on
+    rubber: within 5 % and 1e-3, the braking cases' recession of ~2 mm the farthest),
+    not equal to them, the rates the same."""
+    import pandas as pd
+
+    sweep = tmp_path / "sweep.yaml"
+    sweep.write_text(yaml.safe_dump({"steps": 3, "targets": [{"point": "wheel_center",
+        "direction": {"axis": "z"}, "mode": "relative", "start": -20, "stop": 20}]}))  # fmt: skip
+    tables = {}
+    for method in ("linear", "nonlinear"):
+        out = tmp_path / f"{method}.parquet"
+        run = subprocess.run(
+            [sys.executable, "-m", "pin_susp", "kc", str(EXAMPLES / "kc_saloon_corner.yaml"),
+             str(sweep), "--cases", str(EXAMPLES / "kc.yaml"), "-o", str(out), "--method",
+             method, "-q"],
+            capture_output=True, text=True, cwd=tmp_path,
+        )  # fmt: skip
+        assert run.returncode == 0, run.stderr
+        assert run.stdout == ""
+        tables[method] = pd.read_parquet(out)
+    lin, nl = tables["linear"], tables["nonlinear"]
+    assert np.allclose(lin["lateral_force_steer"], nl["lateral_force_steer"], rtol=1e-12)
+    for name in ("compliance_toe", "compliance_wheel_center_x"):
+        assert not np.allclose(lin[name], nl[name], rtol=1e-9, atol=0)
+        assert np.allclose(lin[name], nl[name], rtol=0.05, atol=1e-3)
