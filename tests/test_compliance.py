@@ -266,3 +266,39 @@ def test_cli_kc_nonlinear_to_parquet(tmp_path):
     for name in ("compliance_toe", "compliance_wheel_center_x"):
         assert not np.allclose(lin[name], nl[name], rtol=1e-9, atol=0)
         assert np.allclose(lin[name], nl[name], rtol=0.05, atol=1e-3)
+
+
+def test_compliance_rates_follow_force_units(tmp_path):
+    """force_units: lbf — the rates in lbf/in and lbf·in/deg (a 6×6's blocks in lbf/in,
+    lbf/rad, lbf·in/rad), converted by hand here: the same SI stiffnesses."""
+    from pin_susp.analyses.compliance import subject_compliance
+
+    lbf, inch = 4.4482216152605, 25.4  # N, mm
+    rate, moment = lbf / inch, lbf * inch / 1000.0  # N/mm per lbf/in, N·m per lbf·in
+    data = yaml.safe_load((EXAMPLES / "kc_saloon_corner.yaml").read_text())
+    k6 = np.diag([3000.0, 3000.0, 800.0, 600.0, 600.0, 60.0])
+    k6[0, 4] = k6[4, 0] = 50.0  # a coupling term: N/rad
+    data["compliance"]["bushings"]["lower_wishbone_inboard_rear"] = {"k": k6.tolist()}
+    (tmp_path / "n.yaml").write_text(yaml.safe_dump(data))
+    block = data["compliance"]
+    front = block["bushings"]["lower_wishbone_inboard_front"]
+    for k in ("radial", "axial"):
+        front[k] /= rate
+    for k in ("torsional", "conical"):
+        front[k] /= moment
+    per = np.full((6, 6), lbf)
+    per[:3, :3], per[3:, 3:] = rate, moment
+    block["bushings"]["lower_wishbone_inboard_rear"] = {"k": (k6 / per).tolist()}
+    block["links"] = {n: v / rate for n, v in block["links"].items()}
+    block["tyre"] = {n: v / rate for n, v in block["tyre"].items()}
+    data["force_units"] = "lbf"
+    (tmp_path / "lbf.yaml").write_text(yaml.safe_dump(data))
+    (a,), (b,) = (
+        subject_compliance(load_subject(tmp_path / n)).values() for n in ("n.yaml", "lbf.yaml")
+    )
+    assert a.bushings.keys() == b.bushings.keys() and a.links.keys() == b.links.keys()
+    for name in a.bushings:
+        np.testing.assert_allclose(b.bushings[name], a.bushings[name], rtol=1e-12)
+    for name in a.links:
+        assert b.links[name] == pytest.approx(a.links[name], rel=1e-12)
+    assert b.tyre == pytest.approx(a.tyre, rel=1e-12)

@@ -11,7 +11,7 @@ into SI stiffnesses.
 - ``links: {<link>: N/mm}``: each compliant two-force link's axial rate;
 - ``tyre: {vertical, lateral}`` (N/mm) at the contact patch.
 
-Each value is read whatever the file's ``units:`` say (the rates have their own).
+The values arrive in N/mm and N·m/deg (model/units.py converts a file in lbf).
 Which pickups hold a pivot and which links exist is the subject's (the model's
 tree): ``analyses/compliance.py`` checks those against it with the same messages.
 """
