@@ -143,7 +143,8 @@ def load_axle(source, warn_as: str | None = None) -> AxleGeometry:
         data,
         "",
         required=("hardpoints", "axle_config"),
-        optional=("type", "scope", "name", "version", "units", "force_units", "vehicle_config"),
+        optional=("type", "scope", "name", "version", "units", "force_units", "vehicle_config")
+        + ("clearance",),  # the bodies a tyre may hit (docs/clearance.md)
     )
     data = canonical_axle(data, r)  # mm and N, spindle points, rocker axes (model/forms.py)
     if r.choice(data.get("scope", "corner"), "scope", ("corner", "axle")) != "axle":
