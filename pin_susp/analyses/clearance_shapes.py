@@ -182,7 +182,7 @@ def user_shapes(bodies, chassis: str = "chassis") -> list[Shape]:
             triangles = coal.StdVec_Triangle()
             for a, b, c in body.faces:
                 triangles.append(coal.Triangle(int(a), int(b), int(c)))
-            geometry.beginModel()
+            geometry.beginModel(len(body.faces), len(body.vertices))
             geometry.addSubModel(vertices, triangles)
             geometry.endModel()
             centroids = body.vertices[body.faces].mean(axis=1)

@@ -6,10 +6,12 @@ At each step the tyre is its outer cylinder (unloaded radius, section width) as 
 prism: a polygon of SIDES sides circumscribed about each face's circle, so that it
 contains the round tyre (by at most r·(1/cos(π/SIDES) − 1): 0.3 mm on a 313 mm
 tyre). The convex hull of GROUP consecutive steps' prisms covers the tyre between
-those steps too; the hulls are joined by a boolean union (manifold3d, through
-trimesh) where it is installed — tighter than one hull round everything, which is
-what is written without it (``method`` says which). Each corner's tyre is one closed
-part of the mesh.
+those steps too; the hulls are joined by a boolean union (manifold3d) where it is
+installed — tighter than one hull round everything, which is what is written
+without it (``method`` says which). Each corner's tyre is one closed part of the
+mesh. An STL holds float32 coordinates and no vertex indices: the mesh is snapped to
+float32 and any edge shorter than that collapses (its two faces dropped), so that
+the file read back is as closed as the mesh.
 """
 
 from __future__ import annotations
@@ -43,6 +45,17 @@ def union_available() -> bool:
     return True
 
 
+def snapped(vertices: np.ndarray, faces: np.ndarray):
+    """The mesh with its vertices at float32 (an STL's), those that meet there merged
+    and the faces that lose an edge dropped (trimesh.Trimesh)."""
+    import trimesh
+
+    unique, inverse = np.unique(vertices.astype(np.float32), axis=0, return_inverse=True)
+    f = inverse.reshape(-1)[faces]
+    keep = (f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 0] != f[:, 2])
+    return trimesh.Trimesh(unique.astype(float), f[keep], process=False)
+
+
 def envelope(model, qs: list, hull_only: bool = False):
     """(the swept volume as a trimesh.Trimesh in mm, the method: ``union`` or ``hull``,
     the poses used) over the configurations ``qs`` (None: a step not solved)."""
@@ -60,12 +73,18 @@ def envelope(model, qs: list, hull_only: bool = False):
         axis = poses.turn(tyre.body, tyre.axis)
         points = 1e3 * tyre_points(centre, axis, tyre.outer, tyre.half_width)
         if not union:
-            parts.append(trimesh.convex.convex_hull(points.reshape(-1, 3)))
+            hull = trimesh.convex.convex_hull(points.reshape(-1, 3))
+            parts.append(snapped(np.asarray(hull.vertices), np.asarray(hull.faces)))
             continue
+        import manifold3d
+
         starts = range(0, max(len(solved) - 1, 1), GROUP - 1)
-        hulls = [trimesh.convex.convex_hull(points[s : s + GROUP].reshape(-1, 3)) for s in starts]
-        parts.append(
-            trimesh.boolean.union(hulls, engine="manifold") if len(hulls) > 1 else hulls[0]
-        )
+        hulls = [
+            manifold3d.Manifold.hull_points(points[s : s + GROUP].reshape(-1, 3)) for s in starts
+        ]
+        joined = manifold3d.Manifold.batch_boolean(hulls, manifold3d.OpType.Add)
+        mesh = joined.to_mesh()
+        vertices = np.asarray(mesh.vert_properties, dtype=float)[:, :3]
+        parts.append(snapped(vertices, np.asarray(mesh.tri_verts, dtype=np.int64)))
     mesh = trimesh.util.concatenate(parts) if len(parts) > 1 else parts[0]
     return mesh, "union" if union else "hull", len(solved)

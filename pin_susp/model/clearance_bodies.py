@@ -100,7 +100,7 @@ def _mesh(name, value, r: Reader, key: str, folder: Path, m: float) -> Clearance
     except Exception as e:  # trimesh raises many kinds on a damaged file
         r.fail(key, f"{path}: not a readable STL ({type(e).__name__}: {e})")
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
-        r.fail(key, f"{path}: no triangles")
+        r.fail(key, f"{path}: not a readable STL (no triangles)")
     vertices = np.asarray(mesh.vertices, dtype=float)
     if not np.all(np.isfinite(vertices)):
         r.fail(key, f"{path}: a vertex that is not finite")

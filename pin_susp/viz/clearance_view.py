@@ -1,7 +1,9 @@
 """The clearance replay (docs/clearance.md, ``pin-susp clearance --view``): the sweep in
 meshcat as ``pin-susp view --html`` draws it (scene.py), with the ``clearance:`` bodies
 (translucent grey, moving with the chassis) and, at each frame, that step's closest
-pair drawn red: a red rod between its two closest points and a red ball at each."""
+pair drawn red: a red ball at each of its two closest points (meshcat's animation
+tracks move and turn a node but do not scale it: a rod between them could not follow
+their distance)."""
 
 from __future__ import annotations
 
@@ -14,8 +16,7 @@ from .scene import ROOT, LastAnimation, Scene, rod_transform
 
 CLOSEST = 0xE01010
 BODY_COLOUR, BODY_OPACITY = 0x8C8C8C, 0.45
-MARK = 0.006  # m: the closest points' balls
-LINE = 0.002  # m: the rod between them
+MARK = 0.008  # m: the closest points' balls
 
 
 def _bodies(scene: Scene, bodies, mg) -> dict:
@@ -56,7 +57,6 @@ def clearance_replay(model, results, measured, bodies, fps: float = 10.0) -> str
     try:
         placed = _bodies(scene, bodies, mg)
         red = mg.MeshLambertMaterial(color=CLOSEST)
-        scene.viewer[f"{ROOT}/clearance/closest"].set_object(mg.Cylinder(1.0, LINE), red)
         for end in ("wheel", "body"):
             scene.viewer[f"{ROOT}/clearance/closest_{end}"].set_object(mg.Sphere(MARK), red)
         solved = [q for q in qs if q is not None]
@@ -72,7 +72,6 @@ def clearance_replay(model, results, measured, bodies, fps: float = 10.0) -> str
                 if np.isfinite(column).any():
                     i = int(np.nanargmin(column))
                     a, b = measured.on_wheel[i, k] * 1e-3, measured.on_body[i, k] * 1e-3
-                    frame[f"{ROOT}/clearance/closest"].set_transform(rod_transform(a, b))
                     for end, p in (("wheel", a), ("body", b)):
                         T = np.eye(4)
                         T[:3, 3] = p
