@@ -428,3 +428,45 @@ def test_a_mesh_body_is_read_in_the_files_units_and_measured(tmp_path):
     clearance.pairs = [p for p in clearance.pairs if p.shape.name in ("mesh", "box")]
     d = clearance.measure([model.q_design])["distance"][:, 0]
     assert d[0] == pytest.approx(d[1], abs=1e-6) and d[0] > 0.05
+
+
+# ------------------------------------------------------------------ axles and vehicles
+
+
+@pytest.mark.parametrize(
+    "geometry, sweep, left, right",
+    [
+        ("axle_front.yaml", "heave_roll.yaml", "left_tyre", "right_tyre"),
+        ("vehicle_fs.yaml", "vehicle_roll.yaml", "fl_tyre", "fr_tyre"),
+    ],
+)
+def test_mirrored_tubes_on_the_chassis_mirror_the_tyres_distances(
+    tmp_path, geometry, sweep, left, right
+):
+    """A tube on the chassis above each front tyre, one the other's mirror: over a roll
+    from −θ to +θ (symmetric steps), the left tyre's distance at a step is the right
+    one's at the mirrored step — on an axle, and on a car whose body (and the tubes on
+    it) rolls."""
+    import shutil
+
+    for path in EXAMPLES.glob("vehicle/*.yaml"):
+        (tmp_path / "vehicle").mkdir(exist_ok=True)
+        shutil.copy(path, tmp_path / "vehicle" / path.name)
+    data = yaml.safe_load((EXAMPLES / geometry).read_text())
+    tube = {"from": [-470, 780, 650], "to": [430, 780, 650], "radius": 12.7}
+    mirror = {k: [v[0], -v[1], v[2]] if isinstance(v, list) else v for k, v in tube.items()}
+    data["clearance"] = {
+        "bodies": [{"name": "tube_l", "tube": tube}, {"name": "tube_r", "tube": mirror}]
+    }
+    path = tmp_path / geometry
+    path.write_text(yaml.safe_dump(data))
+    out = tmp_path / "c.csv"
+    assert main(["clearance", str(path), str(EXAMPLES / sweep), "-o", str(out), "-q"]) == 0
+    table = pd.read_csv(out, comment="#")
+    a = table[table["pair"] == f"{left}/tube_l"].sort_values("step")["distance"].to_numpy()
+    b = table[table["pair"] == f"{right}/tube_r"].sort_values("step")["distance"].to_numpy()
+    assert len(a) == len(b) > 10 and np.ptp(a) > 1.0  # it moves
+    assert np.allclose(a, b[::-1], atol=1e-4)
+    on_tube = table[table["pair"] == f"{left}/tube_l"].sort_values("step")["body_z"].to_numpy()
+    rolls = geometry.startswith("vehicle")  # the car's body rolls ±2°: its tube ±27 mm
+    assert (np.ptp(on_tube) > 40.0) == rolls
