@@ -42,6 +42,7 @@ def test_every_registered_command_is_a_module_with_its_parts():
 REQUIRED = {
     "sweep": ("g.yaml", "s.yaml", "-o", "o.csv"),
     "loads": ("g.yaml", "s.yaml", "--cases", "c.yaml", "-o", "o.csv"),
+    "kc": ("g.yaml", "s.yaml", "--cases", "c.yaml", "-o", "o.csv"),
     "validate": ("g.yaml", "s.yaml"),
     "mjcf": ("g.yaml", "-o", "o.xml"),
     "demo": (),

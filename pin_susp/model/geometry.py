@@ -305,7 +305,7 @@ OTHER_SCOPES = {
 }
 SCOPES = ("corner", *OTHER_SCOPES)
 CORNER_KEYS = ("type", "scope", "side", "name", "version", "units", "force_units")
-CORNER_KEYS += ("actuation", "spring", "config", "clearance")  # clearance: docs/clearance.md
+CORNER_KEYS += ("actuation", "spring", "config", "compliance", "clearance")  # docs/clearance.md
 
 
 def parse_geometry(data: dict, r: Reader, sha: str | None) -> Geometry:
@@ -313,7 +313,7 @@ def parse_geometry(data: dict, r: Reader, sha: str | None) -> Geometry:
     ``r`` (naming the file and key); ``sha`` the file's hash. No plausibility
     warnings: :func:`load_geometry` adds them, and an axle's corners or a study's
     variants, read from data they hold, warn (or not) for themselves."""
-    from . import mechanisms
+    from . import compliance, mechanisms
     from .forms import canonical_corner
 
     for scope, (_, keys, needs) in OTHER_SCOPES.items() if isinstance(data, dict) else ():
@@ -417,11 +417,11 @@ def parse_geometry(data: dict, r: Reader, sha: str | None) -> Geometry:
             f"axle_outboard must be outboard (toward {'+' if sign > 0 else '-'}y) of axle_inboard",
         )
     mech.prepare(hardpoints, options, r)
+    compliance.read_compliance(data["compliance"], r, names) if "compliance" in data else None
     adjusters = _setup_block(config.get("setup", {}), actuation, mech.steering_points(options), r)
 
     density, wheel_mass = _inertia(config.get("inertia", {}), r)
-    cg = config.get("cg_position")
-    bias = config.get("front_brake_bias")
+    cg, bias = config.get("cg_position"), config.get("front_brake_bias")
     height = config.get("opposite_axle_axis_height")
     return Geometry(
         name=name,

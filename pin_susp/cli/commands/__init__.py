@@ -49,6 +49,10 @@ COMMANDS = {
         "pin_susp.cli.commands.loads",
         "member and joint forces at every step under load cases",
     ),
+    "kc": (
+        "pin_susp.cli.commands.kc",
+        "elastokinematics (K&C): compliance steer, camber and bushing deflections per case",
+    ),
     "attitude": (
         "pin_susp.cli.commands.attitude",
         "a vehicle's attitude, wheel loads and load transfer (TLLTD) under steady g",
