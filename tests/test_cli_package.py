@@ -52,6 +52,8 @@ REQUIRED = {
     "attitude": ("v.yaml", "a.yaml", "-o", "o.csv"),
     "import": ("car.shk", "-o", "o.yaml"),
     "export": ("g.yaml", "--format", "shk", "-o", "o.shk"),
+    "clearance": ("g.yaml", "s.yaml", "-o", "o.csv"),
+    "envelope": ("g.yaml", "s.yaml", "-o", "o.stl"),
 }
 
 

@@ -305,7 +305,7 @@ OTHER_SCOPES = {
 }
 SCOPES = ("corner", *OTHER_SCOPES)
 CORNER_KEYS = ("type", "scope", "side", "name", "version", "units", "force_units")
-CORNER_KEYS += ("actuation", "spring", "config", "compliance")
+CORNER_KEYS += ("actuation", "spring", "config", "compliance", "clearance")  # docs/clearance.md
 
 
 def parse_geometry(data: dict, r: Reader, sha: str | None) -> Geometry:

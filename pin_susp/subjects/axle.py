@@ -88,6 +88,8 @@ class AxleModel(AxleAssembly):
         "setup",
         "sensitivity",
         "study",
+        "clearance",
+        "envelope",
     )
     motion_at_once_from = MIN_STEPS  # linkage.Composed.label_motion
     refuses = ("repeats",)

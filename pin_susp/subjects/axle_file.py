@@ -144,7 +144,7 @@ def load_axle(source, warn_as: str | None = None) -> AxleGeometry:
         "",
         required=("hardpoints", "axle_config"),
         optional=("type", "scope", "name", "version", "units", "force_units", "vehicle_config")
-        + ("compliance",),  # each corner's, the right's mirrored (docs/compliance.md)
+        + ("compliance", "clearance"),  # docs/compliance.md, docs/clearance.md
     )
     data = canonical_axle(data, r)  # mm and N, spindle points, rocker axes (model/forms.py)
     if r.choice(data.get("scope", "corner"), "scope", ("corner", "axle")) != "axle":

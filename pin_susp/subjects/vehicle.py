@@ -121,6 +121,8 @@ class Vehicle(VehicleExport, VehicleViews, VehicleTangents, VehicleAssembly):
         "loads",
         "setup",
         "sensitivity",
+        "clearance",
+        "envelope",
     )  # docs/vehicle.md: the rest not yet
     reports = True
     on_road = True

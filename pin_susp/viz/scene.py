@@ -330,3 +330,12 @@ def _set_visible(node, visible: bool) -> None:
         node.set_property("visible", "boolean", visible)
     else:
         node.set_property("visible", visible)
+
+
+def rod_transform(p0: np.ndarray, p1: np.ndarray) -> np.ndarray:
+    """Place meshcat's unit cylinder (along its y axis) from p0 to p1 (m): what the
+    scene's links are drawn with, and the clearance replay's closest pair."""
+    return _rod_transform(p0, p1)
+
+
+LastAnimation = _LastAnimation  # the animation command kept after the objects, by its name

@@ -69,6 +69,14 @@ COMMANDS = {
         "pin_susp.cli.commands.export",
         "a corner's hardpoints as a Lotus .shk or an OptimumK table",
     ),
+    "clearance": (
+        "pin_susp.cli.commands.clearance",
+        "along a sweep, each tyre's and rim's distance to the links and clearance bodies (coal)",
+    ),
+    "envelope": (
+        "pin_susp.cli.commands.envelope",
+        "the tyre's swept volume over a sweep as one watertight STL mesh (mm)",
+    ),
 }
 
 
