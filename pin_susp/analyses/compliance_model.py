@@ -61,8 +61,22 @@ class CompliantBody:
     column: int  # ε_b's first column in x
     origin: np.ndarray  # o_b (m)
     frames: list  # every frame its subtree carries
-    bushings: list  # (column name, pickup position, R, K)
+    bushings: list  # (column name, pickup position, R, K, suffix)
     balls: list  # rigid pickups: positions
+    ends: tuple = ()  # the pivot's two points: (point, bushing's K or None, name, suffix)
+
+    def place(self, kin) -> None:
+        """The pivot's pickups, origin and bushing frame where the pose puts them (a
+        car's chassis moves: its pickups with it)."""
+        p = [point.position(kin).copy() for point, *_ in self.ends]
+        R = bushing_frame(p[1] - p[0])
+        self.origin = 0.5 * (p[0] + p[1])
+        self.bushings = [
+            (f"bushing_{n}", x, R, k, sfx)
+            for x, (_, k, n, sfx) in zip(p, self.ends, strict=True)
+            if k is not None
+        ]
+        self.balls = [x for x, (_, k, *_) in zip(p, self.ends, strict=True) if k is None]
 
 
 class AugmentedKinematics(Kinematics):
@@ -148,15 +162,19 @@ class ComplianceModel:
                     for f in range(len(model.frames))
                     if jid in model.supports[model.frames[f].parentJoint]
                 ]
-                bushings, balls = [], []
+                bushings, balls, at = [], [], []
                 for n, p in zip(self._unprefixed(b, prefix), ends, strict=True):
-                    if n in pickups:
-                        bushings.append((f"bushing_{n}", p, R, comp.bushings[n], suffix))
+                    k = comp.bushings[n] if n in pickups else None
+                    at.append((subject.points[prefix + n], k, n, suffix))
+                    if k is not None:
+                        bushings.append((f"bushing_{n}", p, R, k, suffix))
                     else:
                         balls.append(p)
                 origin = 0.5 * (ends[0] + ends[1])
                 self.bodies.append(
-                    CompliantBody(body, b.joint.name, col, origin, frames, bushings, balls)
+                    CompliantBody(
+                        body, b.joint.name, col, origin, frames, bushings, balls, tuple(at)
+                    )
                 )
                 col += 6
             for name, k in comp.links.items():
@@ -325,6 +343,8 @@ class ComplianceModel:
         self._s0 = self._e0 + len(self.links)
         kin = self.kin
         kin.update(q0)
+        for b in self.bodies:
+            b.place(kin)
         self.active = []  # the held rows, each zero at q0 (a spring at its length there)
         for row in self.rows:
             if isinstance(row, _Held):

@@ -88,6 +88,7 @@ class AxleModel(AxleAssembly):
         "setup",
         "sensitivity",
         "study",
+        "kc",
     )
     motion_at_once_from = MIN_STEPS  # linkage.Composed.label_motion
     refuses = ("repeats",)

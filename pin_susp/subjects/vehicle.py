@@ -121,6 +121,7 @@ class Vehicle(VehicleExport, VehicleViews, VehicleTangents, VehicleAssembly):
         "loads",
         "setup",
         "sensitivity",
+        "kc",
     )  # docs/vehicle.md: the rest not yet
     reports = True
     on_road = True
