@@ -83,9 +83,15 @@ class KC:
         for label in self.labels:
             sfx = subject.suffix(label)
             names += [(n + sfx, u) for n, u in (*MOTION, *RATES)]
+        label_of = {subject.suffix(label): label for label in self.labels}
+        self.bushing_columns = []  # (stem, radial column, axial column, its point)
         for b in m.bodies:
             for name, *_, sfx in b.bushings:
                 names += [(f"{name}_{p}{sfx}", u) for p, u in PARTS]
+                point = subject.prefix(label_of[sfx]) + name.removeprefix("bushing_")
+                self.bushing_columns.append(
+                    (name + sfx, f"{name}_radial{sfx}", f"{name}_axial{sfx}", point)
+                )
         for _, _, short, sfx in m.links.values():
             names.append((f"link_{short}_stretch{sfx}", "mm"))
         for label, *_ in m.tyres:

@@ -25,6 +25,7 @@ to first order is [K A ᵀ; A 0][δx; λ] = [G w; 0] — K = Σ Bᵢᵀ Kᵢ B�
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -38,6 +39,7 @@ CONDITION = 1e12  # the reduced stiffness' condition number above which a freedo
 NEWTON_TOL = 1e-9  # the loaded pose's force balance, relative to the largest load
 STEP_TOL = 1e-14  # m, rad: the last step's largest part
 MAX_ITER = 60
+EYE3 = np.eye(3)
 
 
 def skew(v: np.ndarray) -> np.ndarray:
@@ -47,11 +49,11 @@ def skew(v: np.ndarray) -> np.ndarray:
 def bushing_frame(axis: np.ndarray) -> np.ndarray:
     """R (columns x, y radial, z axial): z along the pivot line a → b; x the world
     vertical's part normal to it (the world x's, for a near-vertical pivot); y = z × x."""
-    z = axis / np.linalg.norm(axis)
+    z = axis / math.sqrt(axis @ axis)
     up = np.array([0.0, 0.0, 1.0]) if abs(z[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
     x = up - (up @ z) * z
-    x /= np.linalg.norm(x)
-    return np.column_stack([x, np.cross(z, x), z])
+    x /= math.sqrt(x @ x)
+    return np.column_stack([x, skew(z) @ x, z])
 
 
 @dataclass
@@ -61,8 +63,22 @@ class CompliantBody:
     column: int  # ε_b's first column in x
     origin: np.ndarray  # o_b (m)
     frames: list  # every frame its subtree carries
-    bushings: list  # (column name, pickup position, R, K)
+    bushings: list  # (column name, pickup position, R, K, suffix)
     balls: list  # rigid pickups: positions
+    ends: tuple = ()  # the pivot's two points: (point, bushing's K or None, name, suffix)
+
+    def place(self, kin) -> None:
+        """The pivot's pickups, origin and bushing frame where the pose puts them (a
+        car's chassis moves: its pickups with it)."""
+        p = [point.position(kin).copy() for point, *_ in self.ends]
+        R = bushing_frame(p[1] - p[0])
+        self.origin = 0.5 * (p[0] + p[1])
+        self.bushings = [
+            (f"bushing_{n}", x, R, k, sfx)
+            for x, (_, k, n, sfx) in zip(p, self.ends, strict=True)
+            if k is not None
+        ]
+        self.balls = [x for x, (_, k, *_) in zip(p, self.ends, strict=True) if k is None]
 
 
 class AugmentedKinematics(Kinematics):
@@ -77,10 +93,16 @@ class AugmentedKinematics(Kinematics):
         self.rigid = {}
 
     def update(self, q: np.ndarray, T: list | None = None) -> None:
+        """The frames at q, each compliant subtree moved by its T (none given: every T
+        the identity, the rigid tree's frames as they are)."""
         self.q = q
+        self.moved = T is not None
         self.T = [pin.SE3.Identity() for _ in self.bodies] if T is None else T
+        self.cache = {}
         pin.computeJointJacobians(self.model, self.data, q)
         pin.updateFramePlacements(self.model, self.data)
+        if not self.moved:
+            return
         oMf = self.data.oMf
         for b, M in zip(self.bodies, self.T, strict=True):
             for f in b.frames:
@@ -90,6 +112,14 @@ class AugmentedKinematics(Kinematics):
     update_positions = update
 
     def frame_jacobian(self, frame_id: int) -> np.ndarray:
+        """The frame's 6 × n Jacobian in x (read-only: one array per frame and update)."""
+        out = self.cache.get(frame_id)
+        if out is None:
+            out = self.cache[frame_id] = self._jacobian(frame_id)
+            out.flags.writeable = False
+        return out
+
+    def _jacobian(self, frame_id: int) -> np.ndarray:
         model, data, nv = self.model, self.data, self.model.nv
         out = np.zeros((6, self.n))
         k = self.owner.get(frame_id)
@@ -98,14 +128,19 @@ class AugmentedKinematics(Kinematics):
             return out
         joint = model.frames[frame_id].parentJoint
         J = pin.getJointJacobian(model, data, joint, pin.WORLD).reshape(6, -1)
-        R = self.T[k].rotation
-        out[:3, :nv] = R @ (J[:3] - skew(self.rigid[frame_id]) @ J[3:])
-        out[3:, :nv] = R @ J[3:]
+        here = data.oMf[frame_id].translation
+        if self.moved:
+            R = self.T[k].rotation
+            out[:3, :nv] = R @ (J[:3] - skew(self.rigid[frame_id]) @ J[3:])
+            out[3:, :nv] = R @ J[3:]
+        else:  # T = I: the tree's own (LOCAL_WORLD_ALIGNED) Jacobian
+            out[:3, :nv] = J[:3] - skew(here) @ J[3:]
+            out[3:, :nv] = J[3:]
         b = self.bodies[k]
         c = b.column
-        out[:3, c : c + 3] = np.eye(3)
-        out[:3, c + 3 : c + 6] = -skew(data.oMf[frame_id].translation - b.origin)
-        out[3:, c + 3 : c + 6] = np.eye(3)
+        out[:3, c : c + 3] = EYE3
+        out[:3, c + 3 : c + 6] = -skew(here - b.origin)
+        out[3:, c + 3 : c + 6] = EYE3
         return out
 
 
@@ -148,15 +183,19 @@ class ComplianceModel:
                     for f in range(len(model.frames))
                     if jid in model.supports[model.frames[f].parentJoint]
                 ]
-                bushings, balls = [], []
+                bushings, balls, at = [], [], []
                 for n, p in zip(self._unprefixed(b, prefix), ends, strict=True):
-                    if n in pickups:
-                        bushings.append((f"bushing_{n}", p, R, comp.bushings[n], suffix))
+                    k = comp.bushings[n] if n in pickups else None
+                    at.append((subject.points[prefix + n], k, n, suffix))
+                    if k is not None:
+                        bushings.append((f"bushing_{n}", p, R, k, suffix))
                     else:
                         balls.append(p)
                 origin = 0.5 * (ends[0] + ends[1])
                 self.bodies.append(
-                    CompliantBody(body, b.joint.name, col, origin, frames, bushings, balls)
+                    CompliantBody(
+                        body, b.joint.name, col, origin, frames, bushings, balls, tuple(at)
+                    )
                 )
                 col += 6
             for name, k in comp.links.items():
@@ -236,12 +275,14 @@ class ComplianceModel:
 
     # ------------------------------------------------------------ one state
 
-    def evaluate(self, q, T, e, s, w=None):
+    def evaluate(self, q, T, e, s, w=None, at_pose=False):
         """At the state (q, T, e, s): the held rows' residual c and Jacobian A, the
         elastic gradient g and Gauss-Newton stiffness K, the load map G (n × 9 per
-        wheel), the frames' data for the outputs; ``w`` the loads (9 per wheel)."""
+        wheel), the frames' data for the outputs; ``w`` the loads (9 per wheel);
+        ``at_pose``: the state is ``at_pose``'s own (its kinematics already updated)."""
         kin, n = self.kin, self.n
-        kin.update(q, T)
+        if not at_pose:
+            kin.update(q, T)
         c, A = [], []
         for row in self.active:
             r = np.atleast_1d(row.residual(kin))
@@ -325,6 +366,8 @@ class ComplianceModel:
         self._s0 = self._e0 + len(self.links)
         kin = self.kin
         kin.update(q0)
+        for b in self.bodies:
+            b.place(kin)
         self.active = []  # the held rows, each zero at q0 (a spring at its length there)
         for row in self.rows:
             if isinstance(row, _Held):
@@ -340,7 +383,7 @@ class ComplianceModel:
         """δx (n × cases) of the first-order equilibrium at q0 under ``loads`` (9 per
         wheel × cases), and the state's data (``evaluate``'s) at q0."""
         self.at_pose(q0)
-        state = self.evaluate(q0, *self.zero)
+        state = self.evaluate(q0, *self.zero, at_pose=True)
         _, A, _, K, G, _ = state
         return solve_kkt(K, A, G @ loads, self.subject.source), state
 

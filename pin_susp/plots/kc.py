@@ -15,8 +15,9 @@ PANELS = (
 
 
 def kc_figure(results, labels: tuple[str, ...], suffix):
-    """The four panels from a K&C Results (kc_results), x the wheel centre's travel
-    (mm from the first step's height; per wheel on an axle)."""
+    """The four panels from a K&C Results (kc_results), x each wheel's travel (its
+    ``wheel_travel`` column: mm, + up, relative to the chassis; a line per wheel on an
+    axle or a car)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -27,11 +28,11 @@ def kc_figure(results, labels: tuple[str, ...], suffix):
     for ax, (name, title, unit) in zip(axes.flat, PANELS, strict=True):
         for label in labels:
             s = suffix(label)
-            z = np.asarray(results[f"wheel_center_z{s}"][first], dtype=float)
+            z = np.asarray(results[f"wheel_travel{s}"][first], dtype=float)
             y = np.asarray(results[f"{name}{s}"][first], dtype=float)
-            ax.plot(z - z[0], y, label=label or "corner")
+            ax.plot(z, y, label=label or "corner")
         ax.set_title(title)
-        ax.set_xlabel("wheel centre z from the first step [mm]")
+        ax.set_xlabel("wheel travel [mm]")
         ax.set_ylabel(f"{name} [{unit}]")
         ax.grid(True, alpha=0.3)
     axes.flat[0].legend()

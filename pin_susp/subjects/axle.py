@@ -90,6 +90,7 @@ class AxleModel(AxleAssembly):
         "study",
         "clearance",
         "envelope",
+        "kc",
     )
     motion_at_once_from = MIN_STEPS  # linkage.Composed.label_motion
     refuses = ("repeats",)

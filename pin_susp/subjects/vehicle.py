@@ -123,6 +123,7 @@ class Vehicle(VehicleExport, VehicleViews, VehicleTangents, VehicleAssembly):
         "sensitivity",
         "clearance",
         "envelope",
+        "kc",
     )  # docs/vehicle.md: the rest not yet
     reports = True
     on_road = True

@@ -7,15 +7,18 @@ from __future__ import annotations
 
 from ..options import check_image, check_outputs, run_arguments
 from ..report import progress_bar, report_failures
+from .loads import chosen_case
 
 DESCRIPTION = (
     "Solve SWEEP on GEOMETRY (a corner or an axle with a compliance: block: bushings, "
-    "links, tyre) and, at every step and load case of CASES, the compliant wheel's "
+    "links, tyre; a vehicle, its axle files' blocks) and, at every step and load case "
+    "of CASES, the compliant wheel's "
     "motion (docs/compliance.md): compliance_toe/camber (deg), compliance_wheel_center_"
     "x/y/z (mm), the K&C rates (lateral force steer and camber, aligning torque steer, "
     "braking steer, recession) and every bushing's, link's and tyre's deflection. "
-    "One CSV row per step and case, then the sweep's own columns. Exit code 1 if a "
-    "step did not converge."
+    "One CSV row per step and case, then the sweep's own columns; --view writes a "
+    "replay with the bushings coloured by their deflection under one case. Exit code 1 "
+    "if a step did not converge."
 )
 
 
@@ -34,6 +37,15 @@ def arguments(parser) -> None:
         help="linear: the first-order compliance at each pose (default); nonlinear: "
         "the loaded pose solved with the bushings as springs",
     )
+    parser.add_argument(
+        "--view",
+        metavar="OUT.html",
+        help="also write a self-contained replay of the sweep, a sphere at each bushing "
+        "coloured by its deflection under one case (pale yellow 0, dark red the largest)",
+    )
+    parser.add_argument(
+        "--case", metavar="NAME", help="the load case the replay shows (default: the first)"
+    )
 
 
 def run(args) -> int:
@@ -41,18 +53,22 @@ def run(args) -> int:
 
     from ...analyses.compliance import KC, kc_results
     from ...analyses.load_case import load_cases
-    from ...io.atomic import all_or_none
+    from ...errors import PinSuspError
+    from ...io.atomic import all_or_none, write_text
     from ...io.tables import is_parquet, write_csv
     from ...model.sweep import load_sweep
     from ...subjects.subject import load_subject
     from ..options import output_form
 
-    check_outputs(args, args.output, args.plot)
+    check_outputs(args, args.output, args.plot, args.view)
     if args.plot is not None:
         check_image(args.plot)
+    if args.case is not None and args.view is None:
+        raise PinSuspError(f"--case {args.case}: is the replay's: give --view OUT.html")
     subject = load_subject(args.geometry)
     sweep = load_sweep(args.sweep)
     cases = load_cases(args.cases, labels=subject.labels)
+    case = chosen_case(args.cases, cases, args.case)
     subject.check_sweep(sweep)
     kc = KC(subject)  # the compliance's errors before any work
     solutions, results = subject.solve_sweep(sweep, progress=progress_bar(sweep.steps, args.quiet))
@@ -61,6 +77,9 @@ def run(args) -> int:
         progress=progress_bar(sweep.steps, args.quiet, label=f"K&C {args.method}"),
     )  # fmt: skip
     form = output_form(args)
+    page = None
+    if args.view is not None:
+        page, frames = _replay(subject, kc, table, results, case, args.cases)
     with all_or_none():
         if is_parquet(args.output):
             from ...io.tables import write_parquet
@@ -73,6 +92,8 @@ def run(args) -> int:
             from ...plots.kc import kc_figure
 
             save_figure(kc_figure(table, subject.labels, subject.suffix), args.plot)
+        if page is not None:
+            write_text(page, args.view)
     if not args.quiet:
         print(
             f"wrote {args.output}: {len(results)} steps x {len(cases)} load cases "
@@ -81,7 +102,33 @@ def run(args) -> int:
         _summary(table, subject, np)
         if args.plot is not None:
             print(f"wrote {args.plot}")
+        if page is not None:
+            print(f"wrote {args.view} ({frames} frames, bushings coloured under {case!r})")
     return report_failures(results)
+
+
+def _replay(subject, kc, table, results, case: str, cases_path) -> tuple[str, int]:
+    """The replay's page (viz/kc_colours.py) and its frames."""
+    import contextlib
+    import io
+    from pathlib import Path
+
+    from ...viz.kc_colours import kc_replay
+    from ...viz.scene import Scene
+
+    qs = [
+        q if ok else None
+        for q, ok in zip(results.meta["q"], results["solver_converged"], strict=True)
+    ]
+    with contextlib.redirect_stdout(io.StringIO()):  # meshcat announces its server
+        scene = Scene(subject)
+    try:
+        page, frames, _ = kc_replay(
+            scene, subject, table, kc.bushing_columns, qs, case, Path(cases_path).name
+        )
+    finally:
+        scene.close()
+    return page, frames
 
 
 RATES = (
