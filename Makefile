@@ -50,6 +50,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_study.py --full --json benchmarks/last_study_run.json
 	$(BIN)/python benchmarks/bench_validate.py
 	$(BIN)/python benchmarks/bench_attitude.py --json benchmarks/last_attitude_run.json
+	$(BIN)/python benchmarks/bench_kc.py
 
 # Regenerate urdf/ from examples/ (a test fails when they differ).
 urdf: $(STAMP)

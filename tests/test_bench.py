@@ -101,3 +101,21 @@ def test_attitude_benchmark_quick_slice(tmp_path):
         for kind in ("run", "equilibria"):
             assert s["ms_per_point"][kind] > 0 and s["ratio_to_sweep_step"][kind] > 0
     assert report["baseline_ms_per_step"] > 0 and report["constants_ms"] > 0
+
+
+def test_kc_benchmark_quick_slice(tmp_path):
+    """bench_kc.py's quick slice (two rounds, no nonlinear): every figure reported, each
+    with its ratio to the sweep (no timing asserted)."""
+    out = tmp_path / "kc.json"
+    proc = subprocess.run(
+        [sys.executable, str(ROOT / "benchmarks" / "bench_kc.py"), "--quick", "--json", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert "x the sweep" in proc.stdout and "target <= 50 ms" in proc.stdout
+    report = json.loads(out.read_text())
+    assert report["steps"] == 41 and report["cases"] == 4
+    assert set(report["ms"]) == {"baseline_sweep", "kc_linear", "kc_linear_with_sweep"}
+    assert all(v > 0 for v in report["ms"].values())

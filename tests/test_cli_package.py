@@ -42,6 +42,7 @@ def test_every_registered_command_is_a_module_with_its_parts():
 REQUIRED = {
     "sweep": ("g.yaml", "s.yaml", "-o", "o.csv"),
     "loads": ("g.yaml", "s.yaml", "--cases", "c.yaml", "-o", "o.csv"),
+    "kc": ("g.yaml", "s.yaml", "--cases", "c.yaml", "-o", "o.csv"),
     "validate": ("g.yaml", "s.yaml"),
     "mjcf": ("g.yaml", "-o", "o.xml"),
     "demo": (),
@@ -51,6 +52,8 @@ REQUIRED = {
     "attitude": ("v.yaml", "a.yaml", "-o", "o.csv"),
     "import": ("car.shk", "-o", "o.yaml"),
     "export": ("g.yaml", "--format", "shk", "-o", "o.shk"),
+    "clearance": ("g.yaml", "s.yaml", "-o", "o.csv"),
+    "envelope": ("g.yaml", "s.yaml", "-o", "o.stl"),
 }
 
 

@@ -337,3 +337,17 @@ def test_a_study_in_lotus_axes_is_the_iso_one_turned(tmp_path):
     for c, s in (("wheel_center_x", -1), ("wheel_center_y", -1), ("wheel_center_z", 1)):
         np.testing.assert_array_equal(lotus_steps[c], s * iso_steps[c])
     np.testing.assert_array_equal(lotus_steps["roadwheel_angle"], iso_steps["roadwheel_angle"])
+
+
+@pytest.mark.parametrize("option", [["--units", "in"], ["--convention", "lotus"]])
+def test_plot_refuses_a_file_written_in_another_convention_or_units(tmp_path, capsys, option):
+    """The report's labels are ISO's in mm: a converted file is refused, not mislabelled."""
+    geometry, sweep = str(EXAMPLES / "double_wishbone.yaml"), str(EXAMPLES / "bump.yaml")
+    assert main(["sweep", geometry, sweep, "-o", "out.csv", "-q", *option]) == 0
+    capsys.readouterr()
+    assert main(["plot", "out.csv", "-o", "report.png"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "written in convention" in err and option[1] in err
+    assert not (tmp_path / "report.png").exists()
+    assert main(["sweep", geometry, sweep, "-o", "iso.csv", "-q"]) == 0
+    assert main(["plot", "iso.csv", "-o", "report.png"]) == 0

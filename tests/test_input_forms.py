@@ -310,7 +310,7 @@ def test_an_axle_by_wheel_centre_and_rocker_pivot_sweeps_as_its_points(tmp_path)
 
 # ---------------------------------------------------------------- units
 
-LENGTH = {"millimeters": 1.0, "meters": 1000.0, "inches": 25.4}  # mm per unit
+LENGTH = {"millimeters": 1.0, "meters": 1000.0, "inches": 25.4, "in": 25.4}  # mm per unit
 
 
 def in_units(g: dict, units: str, force: str) -> dict:
@@ -332,7 +332,9 @@ def in_units(g: dict, units: str, force: str) -> dict:
     return g
 
 
-@pytest.mark.parametrize("units, force", [("inches", "lbf"), ("meters", "N"), ("inches", "N")])
+@pytest.mark.parametrize(
+    "units, force", [("inches", "lbf"), ("meters", "N"), ("inches", "N"), ("in", "lbf")]
+)
 def test_a_corner_sweep_and_loads_in_other_units_are_the_same(tmp_path, units, force):
     g = example("pushrod_rocker.yaml")
     g["config"]["wheel"]["offset"] = 12.0
@@ -403,7 +405,7 @@ def test_an_axle_and_a_vehicle_in_meters_and_lbf_are_the_same(tmp_path):
 def test_an_unknown_unit_is_named(tmp_path):
     g = example("double_wishbone.yaml")
     g["units"] = "furlongs"
-    assert "units: expected one of millimeters, meters, inches" in errors(tmp_path, g)
+    assert "units: expected one of millimeters, meters, inches, mm, m, in" in errors(tmp_path, g)
     g["units"], g["force_units"] = "meters", "kgf"
     assert "force_units: expected one of N, lbf" in errors(tmp_path, g)
 

@@ -426,3 +426,246 @@ def test_lotus_report_layout_and_a_damper_on_the_upper_wishbone(tmp_path, capsys
 def test_optimumk_axes_that_are_no_car_frame(tmp_path, capsys, axes, said):
     argv = ["import", str(INTEROP / "fs_front_optimumk.csv"), "-o", "out.yaml", f"--axes={axes}"]
     refused(capsys, tmp_path, argv + list(OPTIONS), said)
+
+
+# ------------------------------------------------------- a new user's files (review)
+
+CSV = (INTEROP / "fs_front_optimumk.csv").read_text()
+
+
+def example_points():
+    return quiet_load(EXAMPLES / "double_wishbone.yaml").hardpoints_mm
+
+
+@pytest.mark.parametrize("sep", [",", ";"])
+def test_a_table_with_title_lines_above_its_header(tmp_path, capsys, sep):
+    """Title rows (one cell; or empty cells) are skipped; the header's separator is the
+    table's; the unit from x [m]; the row numbers are the file's lines."""
+    head, *rows = CSV.splitlines()
+    body = [
+        sep.join([r.split(",")[0], *(repr(float(v) / 1e3) for v in r.split(",")[1:])]) for r in rows
+    ]
+    text = ["My car", sep * 3, sep.join(["Name", "x [m]", "y [m]", "z [m]"]), *body]
+    (tmp_path / "t.csv").write_text("\n".join(text) + "\n")
+    assert (
+        main(
+            [
+                "import",
+                "t.csv",
+                "-o",
+                "out.yaml",
+                "--template",
+                str(EXAMPLES / "double_wishbone.yaml"),
+            ]
+        )
+        == 0
+    )
+    assert_points(quiet_load(tmp_path / "out.yaml"), example_points(), tol=1e-9)
+    out = capsys.readouterr().out
+    assert "used      Lower Wishbone Front Pivot (row 4) as lower_wishbone_inboard_front" in out
+    assert "m (from the header)" in out
+
+
+def test_pin_susp_own_names_with_the_axle_points_are_read_as_they_are(tmp_path, capsys):
+    g = example_points()
+    rows = ["name,X,Y,Z"] + [",".join([n, *map(repr, map(float, v))]) for n, v in g.items()]
+    (tmp_path / "own.csv").write_text("\n".join(rows) + "\n")
+    assert main(["import", "own.csv", "-o", "out.yaml", "--tyre", "270/55R13"]) == 0
+    assert_points(quiet_load(tmp_path / "out.yaml"), g)
+    row = list(g).index("axle_inboard") + 2  # the header is row 1
+    assert f"used      axle_inboard (row {row}) as axle_inboard" in capsys.readouterr().out
+
+
+def adams_with(tmp_path, angle_unit: str | None, camber: str) -> str:
+    text = (INTEROP / "fs_front_adams.sub").read_text()
+    lines = text.splitlines()
+    at = next(i for i, t in enumerate(lines) if "LENGTH" in t)
+    if angle_unit:
+        lines.insert(at + 1, f" ANGLE   =  '{angle_unit}'")
+    lines = [(t.rsplit(None, 1)[0] + "  " + camber) if "'camber_angle'" in t else t for t in lines]
+    (tmp_path / "car.sub").write_text("\n".join(lines) + "\n")
+    return "car.sub"
+
+
+def test_adams_camber_in_radians_is_converted(tmp_path, capsys):
+    camber = -np.degrees(np.arctan2(5, 150))  # the example's spin axis (0, 150, 5) mm
+    adams_with(tmp_path, "radians", repr(float(np.radians(camber))))
+    assert main(["import", "car.sub", "-o", "rad.yaml", "--tyre", "270/55R13"]) == 0
+    h = quiet_load(tmp_path / "rad.yaml").hardpoints_mm
+    axis = h["axle_outboard"] - h["axle_inboard"]
+    assert np.allclose(axis / np.linalg.norm(axis), np.array([0, 150, 5]) / np.hypot(150, 5))
+    assert f"from file static camber = {camber:g} deg" in capsys.readouterr().out
+    adams_with(tmp_path, "grads", "0.1")
+    refused(
+        capsys,
+        tmp_path,
+        ["import", "car.sub", "-o", "out.yaml", "--tyre", "270/55R13"],
+        "car.sub: line 12: [UNITS] ANGLE 'grads': expected one of degrees",
+    )
+
+
+@pytest.mark.parametrize(
+    "file, argv, said",
+    [
+        (
+            "fs_front.shk",
+            ["--camber", "1"],
+            "--camber: the file gives the spin axis ('Wheel spindle point', line 60)",
+        ),
+        (
+            "fs_front_optimumk.csv",
+            ["--toe", "0"],
+            "--toe: the file gives the spin axis ('Spindle Point', row 10)",
+        ),
+        ("fs_front.shk", ["--units", "m"], "--units: "),
+        ("fs_front.shk", ["--axes", "rearward,right,up"], "--axes: "),
+        ("fs_front_adams.sub", ["--map", "x=strut_top"], "--map: "),
+        ("fs_front_adams.sub", ["--camber", "60"], "--camber 60: 60° is beyond ±45°"),
+        ("fs_front_optimumk.csv", ["--units", "m"], "--units m: the X, Y, Z headers say mm"),
+        (
+            "fs_front.shk",
+            ["--type", "macpherson"],
+            "the file's type line says a double_wishbone corner ('Double Wishbone, damper to "
+            "lower wishbone'); --type macpherson",
+        ),
+        (
+            "fs_front.shk",
+            ["--template", str(EXAMPLES / "axle_front.yaml")],
+            "the template must be a corner file",
+        ),
+    ],
+)
+def test_an_option_the_file_does_not_take_is_refused(tmp_path, capsys, file, argv, said):
+    base = ["import", str(INTEROP / file), "-o", "out.yaml"]
+    tyre = [] if "--template" in argv else ["--tyre", "270/55R13"]
+    err = refused(capsys, tmp_path, base + tyre + argv, said)
+    assert "is for an OptimumK table" in err or not said.endswith(": ")
+
+
+def test_an_absurd_camber_in_the_file_is_refused(tmp_path, capsys):
+    adams_with(tmp_path, None, "89")
+    refused(
+        capsys,
+        tmp_path,
+        ["import", "car.sub", "-o", "out.yaml", "--tyre", "270/55R13"],
+        "car.sub: line 42 ('camber_angle'): 89° is beyond ±45° (degrees, at design)",
+    )
+
+
+def test_a_point_given_twice(tmp_path, capsys):
+    lines = CSV.splitlines()
+    (tmp_path / "same.csv").write_text("\n".join([*lines, lines[3]]) + "\n")
+    argv = ["import", "same.csv", "-o", "same.yaml", "--tyre", "270/55R13"]
+    assert main(argv) == 0
+    assert (
+        "ignored   Lower Ball Joint (row 12): lower_wishbone_outboard is given by "
+        "'Lower Ball Joint' (row 4) at the same position"
+    ) in capsys.readouterr().out
+    (tmp_path / "two.csv").write_text("\n".join([*lines, "Lower Ball Joint,1.0,901,200"]) + "\n")
+    refused(
+        capsys,
+        tmp_path,
+        ["import", "two.csv", "-o", "out.yaml", "--tyre", "270/55R13"],
+        "two.csv: 'Lower Ball Joint' (row 12) and 'Lower Ball Joint' (row 4) are both "
+        "lower_wishbone_outboard, at different positions",
+    )
+
+
+@pytest.mark.parametrize(
+    "fmt, name, said",
+    [
+        ("optimumk", "x.xls", "x.xls: --format optimumk writes .csv or .xlsx files, not .xls"),
+        ("optimumk", "x.txt", "x.txt: --format optimumk writes .csv or .xlsx files, not .txt"),
+        ("shk", "x.csv", "x.csv: --format shk writes .shk files, not .csv"),
+    ],
+)
+def test_export_refuses_a_suffix_its_format_does_not_write(tmp_path, capsys, fmt, name, said):
+    argv = ["export", str(EXAMPLES / "double_wishbone.yaml"), "--format", fmt, "-o", name]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and said in err
+    assert not (tmp_path / name).exists()
+
+
+def shk_lines():
+    return (INTEROP / "fs_front.shk").read_text().splitlines()
+
+
+@pytest.mark.parametrize(
+    "change, said",
+    [
+        (
+            "wheel centre across",
+            "fs.shk: the file's points are on both sides of the car: its wheel "
+            "centre 'Wheel centre point' (line 67) on the right (ISO y < 0), 'Lower wishbone outer "
+            "ball joint' (line 18) on the left",
+        ),
+        (
+            "no type line",
+            "fs.shk: line 3: no suspension type line: 'Lower wishbone front pivot' "
+            "starts a point's block",
+        ),
+        ("binary", "fs.shk: not a text file (binary data): a Lotus .shk is text"),
+        ("empty", "fs.shk: the file is empty"),
+    ],
+)
+def test_lotus_files_that_are_not_what_they_seem(tmp_path, capsys, change, said):
+    lines = shk_lines()
+    if change == "wheel centre across":
+        lines[72] = " ".join(
+            str(-float(v)) if i == 1 else v for i, v in enumerate(lines[72].split())
+        )
+    elif change == "no type line":
+        del lines[2]
+    data = "\n".join(lines).encode() + b"\n"
+    data = {"binary": bytes(range(256)) * 4, "empty": b"\n\n"}.get(change, data)
+    (tmp_path / "fs.shk").write_bytes(data)
+    err = refused(
+        capsys, tmp_path, ["import", "fs.shk", "-o", "out.yaml", "--tyre", "270/55R13"], said
+    )
+    assert "\\x" not in err
+
+
+@pytest.mark.parametrize(
+    "name, data, said",
+    [
+        ("e.csv", b"", "e.csv: the file is empty"),
+        ("e.xlsx", b"", "e.xlsx: the file is empty"),
+        ("j.xlsx", bytes(range(256)) * 8, "j.xlsx: not an Excel workbook (.xlsx, .xlsm)"),
+        ("b.csv", bytes(range(256)) * 8, "b.csv: not a text table (binary data)"),
+    ],
+)
+def test_tables_that_are_no_tables(tmp_path, capsys, name, data, said):
+    (tmp_path / name).write_bytes(data)
+    err = refused(capsys, tmp_path, ["import", name, "-o", "out.yaml", "--tyre", "270/55R13"], said)
+    assert "engine" not in err and "\\" not in err
+
+
+def test_an_excel_formula_without_a_saved_value(tmp_path, capsys):
+    import openpyxl
+
+    book = openpyxl.Workbook()
+    sheet = book.active
+    for i, row in enumerate(CSV.splitlines()):
+        cells = row.split(",")
+        sheet.append(cells[:1] + ([float(v) for v in cells[1:]] if i else cells[1:]))
+    sheet["C4"] = "=C3*2"  # openpyxl saves no value for it, as a script would
+    book.save(tmp_path / "f.xlsx")
+    refused(
+        capsys,
+        tmp_path,
+        ["import", "f.xlsx", "-o", "out.yaml", "--tyre", "270/55R13"],
+        "f.xlsx: row 4 ('Lower Ball Joint'): Y (mm): the cell is a formula (=C3*2) without a "
+        "saved value: save the workbook in Excel",
+    )
+
+
+def test_camber_and_toe_give_the_spin_axis_of_those_angles(tmp_path):
+    """With toe, the axis still has the camber asked for, by pin_susp's definition
+    (docs/results.md): camber = −atan2(â_z, s·â_y), toe = atan2(â_x, s·â_y)."""
+    argv = ["import", str(INTEROP / "fs_front_adams.sub"), "-o", "out.yaml", "--tyre", "270/55R13"]
+    assert main([*argv, "--camber", "-2.5", "--toe", "1.5"]) == 0
+    h = quiet_load(tmp_path / "out.yaml").hardpoints_mm
+    a = h["axle_outboard"] - h["axle_inboard"]  # a left corner: s = +1
+    assert np.degrees(-np.arctan2(a[2], a[1])) == pytest.approx(-2.5, abs=1e-9)  # 1e-10 mm on 50 mm
+    assert np.degrees(np.arctan2(a[0], a[1])) == pytest.approx(1.5, abs=1e-9)

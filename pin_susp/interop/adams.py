@@ -5,7 +5,8 @@ said); every row of a ``[HARDPOINT]`` / ``[HARDPOINTS]`` table (or of a block un
 ``$---...HARDPOINT...`` divider): ``'hpl_name' x y z`` / ``'hpr_name' x y z``, or a
 subsystem file's ``'name' 'left/right' x y z`` (the left's values; the right is its
 mirror) and ``'name' 'single' x y z``; and a ``[PARAMETER]`` table's
-``camber_angle`` and ``toe_angle`` (deg) for the spin axis. Adams/Car axes: x
+``camber_angle`` and ``toe_angle`` for the spin axis (in the ``[UNITS]`` block's
+``ANGLE``: degrees, or radians converted; within ±45°). Adams/Car axes: x
 rearward, y to the right, z up; in ISO: x = −X, y = −Y, z = Z (its left corner has
 Y < 0). One side is read, ``--side`` (default the left where the file has it).
 """
@@ -18,7 +19,7 @@ import shlex
 import numpy as np
 
 from ..errors import PinSuspError
-from .corner import WHEEL_CENTER, Found, Source
+from .corner import WHEEL_CENTER, Found, Source, angle_problem
 
 FORMAT = "Adams/Car property file"
 TO_ISO = np.array([-1.0, -1.0, 1.0])
@@ -65,12 +66,20 @@ NAMES = {
     "bellcrank_pivot_orient": ("rocker_axis_b", 0),
     "rocker_axis": ("rocker_axis_b", 0),
 }
+ANGLE = {  # deg per unit
+    "degrees": 1.0,
+    "degree": 1.0,
+    "deg": 1.0,
+    "radians": 180.0 / np.pi,
+    "radian": 180.0 / np.pi,
+    "rad": 180.0 / np.pi,
+}
 SIDE = {"left": "hpl_", "right": "hpr_"}
 
 
 def read(path: str, text: str, options) -> Source:
     lines = text.splitlines()
-    scale, unit_note = _units(path, lines)
+    scale, unit_note, degrees = _units(path, lines)
     rows, params = [], {}
     block = None
     for no, line in enumerate(lines, start=1):
@@ -106,7 +115,11 @@ def read(path: str, text: str, options) -> Source:
         found = params.get(f"{what}_angle") or params.get(f"pv{side[0]}_{what}_angle")
         if found is not None:
             no, tokens = found
-            setattr(src, what, _number(path, no, tokens[0], tokens[-1]))
+            value = _number(path, no, tokens[0], tokens[-1]) * degrees
+            problem = angle_problem(value)
+            if problem:
+                raise PinSuspError(f"{path}: line {no} ({tokens[0]!r}): {problem}")
+            setattr(src, what, value)
     return src
 
 
@@ -117,23 +130,26 @@ def _tokens(path: str, no: int, text: str) -> list[str]:
         raise PinSuspError(f"{path}: line {no}: {exc}") from None
 
 
-def _units(path: str, lines: list[str]) -> tuple[float, str]:
-    inside = False
+def _units(path: str, lines: list[str]) -> tuple[float, str, float]:
+    """The ``[UNITS]`` block's LENGTH (mm per unit, said) and ANGLE (deg per unit)."""
+    inside, found = False, {}
     for no, line in enumerate(lines, start=1):
         t = line.strip()
         if t.startswith("["):
             inside = t.strip("[] ").upper() == "UNITS"
             continue
-        m = re.fullmatch(r"LENGTH\s*=\s*'?([A-Za-z]+)'?", t, re.I) if inside else None
+        m = re.fullmatch(r"(LENGTH|ANGLE)\s*=\s*'?([A-Za-z]+)'?", t, re.I) if inside else None
         if m:
-            unit = m.group(1).lower()
-            if unit not in LENGTH:
+            what, unit = m.group(1).upper(), m.group(2).lower()
+            table = LENGTH if what == "LENGTH" else ANGLE
+            if unit not in table:
                 raise PinSuspError(
-                    f"{path}: line {no}: [UNITS] LENGTH {unit!r}: "
-                    f"expected one of {', '.join(LENGTH)}"
+                    f"{path}: line {no}: [UNITS] {what} {unit!r}: "
+                    f"expected one of {', '.join(table)}"
                 )
-            return LENGTH[unit], unit
-    return 1.0, "mm (the file has no [UNITS] LENGTH)"
+            found.setdefault(what, (table[unit], unit))
+    scale, unit = found.get("LENGTH", (1.0, "mm (the file has no [UNITS] LENGTH)"))
+    return scale, unit, found.get("ANGLE", (1.0, ""))[0]
 
 
 def _number(path: str, no: int, name: str, value: str) -> float:

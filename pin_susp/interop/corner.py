@@ -13,7 +13,6 @@ geometry's data with the report of what was used and what was ignored.
 
 from __future__ import annotations
 
-import math
 import re
 import warnings
 from dataclasses import dataclass, field
@@ -126,8 +125,12 @@ def build(src: Source, want: Wanted) -> tuple[dict, list[str]]:
         role = roles[id(p)]
         if role is None or (role not in names and role not in (WHEEL_CENTER, SPINDLE)):
             continue
-        if role not in chosen:
-            chosen[role] = p
+        first = chosen.setdefault(role, p)
+        if first is not p and first.rank == p.rank and not _same(first, p):
+            src.fail(
+                f"{p.name!r} ({p.where}) and {first.name!r} ({first.where}) are both "
+                f"{role}, at different positions: keep one (or --map the other elsewhere)"
+            )
     from_axle = "axle_inboard" in chosen and "axle_outboard" in chosen
     if from_axle:  # the file gives the axle points themselves (a pin_susp-named table)
         chosen.pop(WHEEL_CENTER, None)
@@ -141,10 +144,18 @@ def build(src: Source, want: Wanted) -> tuple[dict, list[str]]:
             f"missing point{'s' if len(missing) > 1 else ''} for a {kind} corner "
             f"({_describe(options)}): {said}"
         )
+    _one_side(src, chosen, mech.wheel_side_points(options), file_side)
     flip = np.array([1.0, -1.0 if side != file_side else 1.0, 1.0])
     if side != file_side:
         notes.append(f"mirrored  the file's {file_side} corner to the {side} side (y → −y)")
     hard = {n: chosen[n].xyz * flip for n in names if n in chosen}
+    given = [o for o in ("camber", "toe") if getattr(want, o) is not None]
+    spin = chosen.get(SPINDLE) or chosen.get("axle_inboard")
+    if given and (from_axle or spin is not None):
+        src.fail(
+            f"--{given[0]}: the file gives the spin axis ({spin.name!r}, {spin.where}): "
+            "--camber and --toe are for a file without a spindle point"
+        )
     offset = _offset(want, template, from_axle, notes)
     if not from_axle:
         hard.update(_axle(src, chosen, flip, offset, want, side, notes))
@@ -176,10 +187,49 @@ def build(src: Source, want: Wanted) -> tuple[dict, list[str]]:
     return data, report + notes
 
 
+def _same(a: Found, b: Found) -> bool:
+    return bool(np.max(np.abs(a.xyz - b.xyz)) <= 1e-9)
+
+
+def _one_side(src: Source, chosen: dict, wheel_side: tuple, file_side: str) -> None:
+    """The points that ride with the wheel are on the file's side (its wheel
+    centre's): a sign slip in the file is said in its own names."""
+    sign = 1.0 if file_side == "left" else -1.0
+    for role in (*wheel_side, SPINDLE):
+        p = chosen.get(role)
+        if p is not None and sign * p.xyz[1] < 0.0:
+            by = chosen.get(WHEEL_CENTER)
+            ref = f"its wheel centre {by.name!r} ({by.where})" if by else "most of its points"
+            other = "right" if file_side == "left" else "left"
+            src.fail(
+                f"the file's points are on both sides of the car: {ref} on the {file_side} "
+                f"(ISO y {'>' if sign > 0 else '<'} 0), {p.name!r} ({p.where}) on the {other}: "
+                "check the signs of y in the file"
+            )
+
+
+def angle_problem(value: float) -> str | None:
+    """What is wrong with a static camber or toe (deg), as the wheel-by-centre reader
+    says it (pin_susp.model.forms), or None."""
+    from ..model.forms import MAX_ANGLE
+
+    if abs(value) > MAX_ANGLE:
+        return f"{value:g}° is beyond ±{MAX_ANGLE:g}° (degrees, at design)"
+    return None
+
+
 def _template(path: str | None):
     if path is None:
         return None
     from ..model.geometry import load_geometry
+    from ..subjects.subject import is_axle_file, is_vehicle_file
+
+    for whose, test in (("an axle", is_axle_file), ("a car", is_vehicle_file)):
+        if test(path):
+            raise PinSuspError(
+                f"--template {path}: is {whose}'s file; the template must be a corner file "
+                "(a double_wishbone or macpherson corner, e.g. examples/double_wishbone.yaml)"
+            )
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -196,7 +246,8 @@ def _kind(src: Source, want: Wanted, template, notes: list[str]) -> str:
     kind = want.kind or (template.type if template else None)
     if src.kind is not None:
         if kind is not None and kind != src.kind:
-            src.fail(f"the file is a {src.kind} corner ({src.described}), the template's a {kind}")
+            by = f"--type {kind}" if want.kind else f"the template is a {kind} corner"
+            src.fail(f"the file's type line says a {src.kind} corner ({src.described}); {by}")
         return src.kind
     if kind is None:
         has = {p.role for p in src.points}
@@ -262,7 +313,8 @@ def _why(p: Found, role: str | None, chosen: dict, names: tuple) -> str:
     if role is None:
         return p.why
     if role in chosen:
-        return f"{role} is given by {chosen[role].name!r} ({chosen[role].where})"
+        same = " at the same position" if _same(p, chosen[role]) else ""
+        return f"{role} is given by {chosen[role].name!r} ({chosen[role].where}){same}"
     if role.startswith("axle_") or role in (WHEEL_CENTER, SPINDLE):
         return "the axle points are given as axle_inboard/axle_outboard"
     return (
@@ -314,8 +366,9 @@ def _axle(src: Source, chosen: dict, flip, offset: float, want: Wanted, side: st
             notes.append(
                 f"from file static {what} = {value:g} deg (the spin axis: no spindle point)"
             )
-    c, t = math.radians(camber or 0.0), math.radians(toe or 0.0)
-    axis = np.array([math.sin(t) * math.cos(c), sign * math.cos(t) * math.cos(c), -math.sin(c)])
+    from ..model.forms import spin_axis  # the wheel-by-centre form's axis, the same camber
+
+    axis = spin_axis(camber or 0.0, toe or 0.0, sign)
     outboard = wc + offset * axis
     return {"axle_inboard": outboard - SPINDLE_SPACING * axis, "axle_outboard": outboard}
 

@@ -17,6 +17,7 @@ import re
 
 import numpy as np
 
+from ..errors import PinSuspError
 from .corner import SPINDLE, WHEEL_CENTER, Found, Source
 
 FORMAT = "Lotus SHARK"
@@ -91,7 +92,14 @@ def read(path: str, text: str, options) -> Source:
             path, None, "no suspension type line (e.g. 'Double Wishbone, damper to lower wishbone')"
         )
     type_line, type_no = re.sub(r"^TYPE\s+\d+\s+", "", lines[i].strip(), flags=re.I), i + 1
-    kind, said = _type(path, type_line, type_no)
+    if type_line.lower() in LOWER or type_line.lower() in LOWER_MOUNTED:
+        raise _no_type(path, type_no, type_line)
+    try:
+        kind, said = _type(path, type_line, type_no)
+    except PinSuspError:
+        if _xyz(lines, i + 1 + DEFINITION_LINES):  # the line is a point's name after all
+            raise _no_type(path, type_no, type_line) from None
+        raise
     points = []
     i = _skip_blank(lines, i + 1)
     while i < len(lines) and not _heading(lines[i]):
@@ -144,6 +152,24 @@ def _read_report(path: str, lines: list[str]) -> Source:
     )
 
 
+def _no_type(path: str, line: int, text: str):
+    return _error(
+        path,
+        line,
+        f"no suspension type line: {text!r} starts a point's block (give the type, e.g. "
+        "'Double Wishbone, damper to lower wishbone', on the line before the points)",
+    )
+
+
+def _xyz(lines: list[str], i: int) -> bool:
+    """Whether line ``i`` is a point's x y z line."""
+    values = lines[i].split() if i < len(lines) else []
+    try:
+        return len(values) == 3 and all(np.isfinite([float(v) for v in values]))
+    except ValueError:
+        return False
+
+
 def _skip_blank(lines: list[str], i: int) -> int:
     while i < len(lines) and not lines[i].strip():
         i += 1
@@ -156,8 +182,6 @@ def _heading(line: str) -> bool:
 
 
 def _error(path: str, line: int | None, problem: str):
-    from ..errors import PinSuspError
-
     return PinSuspError(f"{path}: {'' if line is None else f'line {line}: '}{problem}")
 
 

@@ -9,6 +9,7 @@ Y, Z point, default ``forward,left,up`` (ISO 8855).
 
 from __future__ import annotations
 
+import csv
 import re
 from pathlib import Path
 
@@ -20,6 +21,7 @@ from .corner import SPINDLE, WHEEL_CENTER, Found, Source
 FORMAT = "OptimumK table"
 UNITS = {"mm": 1.0, "m": 1000.0, "in": 25.4, "inch": 25.4, "cm": 10.0}
 EXCEL = (".xlsx", ".xlsm")
+AXLE = ("axle_inboard", "axle_outboard")  # pin_susp's own spindle points, read as they are
 
 # The names written (first) and read, compared without case, spaces, '_' or '-'.
 NAMES = {
@@ -61,7 +63,7 @@ def vocabulary(extra: dict | None = None) -> dict[str, str]:
     """Compared name → pin_susp point: this table's names, pin_susp's own, ``extra``."""
     from .lotus import NAMES as LOTUS
 
-    out = {key(role): role for role in NAMES}
+    out = {key(role): role for role in (*NAMES, *AXLE)}
     out.update({key(n): role for n, role in LOTUS.items()})
     out.update({key(n): role for role, names in NAMES.items() for n in names})
     out.update({key(n): role for n, (role, _) in MOUNTED.items()})
@@ -146,31 +148,68 @@ def read(path: str, raw: bytes, options) -> Source:
     return src
 
 
+class Formula(str):
+    """An Excel cell holding a formula whose value the workbook did not save."""
+
+
 def _rows(path: str, raw: bytes) -> tuple[list[list], int]:
-    """The table's rows (the header first) and the header's row number."""
+    """The table's rows from the header on (the header first) and the header's row
+    number; the rows above it (a title) are skipped."""
+    if not raw.strip():
+        raise PinSuspError(f"{path}: the file is empty")
+    if Path(path).suffix.lower() in EXCEL:
+        rows = _excel_rows(path, raw)
+        for i, row in enumerate(rows):  # the header: the first row with an X, a Y and a Z
+            if all(_column([str(c) for c in row], a) is not None for a in "XYZ"):
+                return rows[i:], i + 1
+    else:
+        lines = _text(path, raw).splitlines()
+        for i, line in enumerate(lines):
+            for sep in ",;\t":  # the header's separator is the table's
+                cells = next(csv.reader([line], delimiter=sep), [])
+                if all(_column(cells, a) is not None for a in "XYZ"):
+                    return [list(r) for r in csv.reader(lines[i:], delimiter=sep)], i + 1
+    raise PinSuspError(f"{path}: no header row with X, Y and Z columns")
+
+
+def _text(path: str, raw: bytes) -> str:
+    if b"\0" in raw:
+        raise PinSuspError(f"{path}: not a text table (binary data): a CSV table is text")
+    try:
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        return raw.decode("latin-1")
+
+
+def _excel_rows(path: str, raw: bytes) -> list[list]:
+    """The first sheet's cells (None: ''); a formula the workbook saved no value of
+    is a :class:`Formula`."""
     import io
 
-    import pandas as pd
+    import openpyxl
 
     try:
-        if Path(path).suffix.lower() in EXCEL:
-            frame = pd.read_excel(io.BytesIO(raw), header=None, dtype=object)
-        else:
-            first = next((t for t in raw.decode("utf-8-sig").splitlines() if t.strip()), "")
-            sep = next((c for c in ",;\t" if c in first), ",")
-            frame = pd.read_csv(
-                io.BytesIO(raw), header=None, dtype=str, sep=sep, keep_default_na=False
-            )
-    except Exception as exc:  # a file pandas cannot read as a table: said, not a traceback
-        raise PinSuspError(f"{path}: not a table pandas can read ({exc})") from None
-    rows = [
-        [("" if v is None or (isinstance(v, float) and np.isnan(v)) else v) for v in r]
-        for r in frame.values.tolist()
-    ]
-    for i, row in enumerate(rows):  # the header: the first row with an X, a Y and a Z
-        if all(_column([str(c) for c in row], a) is not None for a in "XYZ"):
-            return rows[i:], i + 1
-    raise PinSuspError(f"{path}: no header row with X, Y and Z columns")
+        values, formulas = (
+            openpyxl.load_workbook(io.BytesIO(raw), data_only=d).worksheets[0]
+            for d in (True, False)
+        )
+        pairs = zip(
+            values.iter_rows(values_only=True), formulas.iter_rows(values_only=True), strict=False
+        )
+        return [
+            [
+                Formula(f)
+                if v is None and isinstance(f, str) and f.startswith("=")
+                else ("" if v is None else v)
+                for v, f in zip(vr, fr, strict=False)
+            ]
+            for vr, fr in pairs
+        ]
+    except Exception:  # not a workbook openpyxl opens (junk, an old .xls): said, no traceback
+        raise PinSuspError(
+            f"{path}: not an Excel workbook (.xlsx, .xlsm) openpyxl can open: save it as "
+            ".xlsx or export the table as CSV"
+        ) from None
 
 
 def _column(header: list[str], axis: str) -> int | None:
@@ -187,6 +226,12 @@ def _column(header: list[str], axis: str) -> int | None:
 def _scale(path: str, headers: list[str], options) -> tuple[float, str]:
     found = {m.group(1).lower() for h in headers if (m := re.search(r"[\(\[]\s*(\w+)\s*[\)\]]", h))}
     if options.units is not None:
+        if any(UNITS.get(u) != UNITS[options.units] for u in found):
+            raise PinSuspError(
+                f"{path}: --units {options.units}: the X, Y, Z headers say "
+                f"{', '.join(sorted(found))} ({', '.join(headers)}): give --units only for a "
+                "table whose headers name no unit"
+            )
         return UNITS[options.units], f"{options.units} (--units)"
     if len(found) > 1 or (found and not found <= set(UNITS)):
         raise PinSuspError(
@@ -199,6 +244,11 @@ def _scale(path: str, headers: list[str], options) -> tuple[float, str]:
 
 
 def _number(path: str, row: int, name: str, column: str, value) -> float:
+    if isinstance(value, Formula):
+        raise PinSuspError(
+            f"{path}: row {row} ({name!r}): {column}: the cell is a formula ({value}) without a "
+            "saved value: save the workbook in Excel (or LibreOffice) or give the values"
+        )
     try:
         x = float(value)
         if not np.isfinite(x):

@@ -310,7 +310,7 @@ OTHER_SCOPES = {
 }
 SCOPES = ("corner", *OTHER_SCOPES)
 CORNER_KEYS = ("type", "scope", "side", "name", "version", "units", "force_units")
-CORNER_KEYS += ("actuation", "spring", "config")
+CORNER_KEYS += ("actuation", "spring", "config", "compliance", "clearance")  # docs/clearance.md
 CONFIG_KEYS = ("steering", "cg_position", "wheelbase", "track", "axle_position")
 CONFIG_KEYS += ("front_brake_bias", "driven_axle", "camber_shim", "setup", "strut")
 CONFIG_KEYS += ("opposite_axle_axis_height", "inertia", "driveshaft", "limits")
@@ -321,7 +321,7 @@ def parse_geometry(data: dict, r: Reader, sha: str | None) -> Geometry:
     ``r`` (naming the file and key); ``sha`` the file's hash. No plausibility
     warnings: :func:`load_geometry` adds them, and an axle's corners or a study's
     variants, read from data they hold, warn (or not) for themselves."""
-    from . import mechanisms
+    from . import compliance, mechanisms
     from .forms import canonical_corner
 
     for scope, (_, keys, needs) in OTHER_SCOPES.items() if isinstance(data, dict) else ():
@@ -407,12 +407,12 @@ def parse_geometry(data: dict, r: Reader, sha: str | None) -> Geometry:
             f"axle_outboard must be outboard (toward {'+' if sign > 0 else '-'}y) of axle_inboard",
         )
     mech.prepare(hardpoints, options, r)
+    compliance.read_compliance(data["compliance"], r, names) if "compliance" in data else None
     driveshaft = packaging.read_driveshaft(config, hardpoints, side, r)
     adjusters = _setup_block(config.get("setup", {}), actuation, mech.steering_points(options), r)
 
     density, wheel_mass = _inertia(config.get("inertia", {}), r)
-    cg = config.get("cg_position")
-    bias = config.get("front_brake_bias")
+    cg, bias = config.get("cg_position"), config.get("front_brake_bias")
     height = config.get("opposite_axle_axis_height")
     return Geometry(
         name=name,

@@ -18,7 +18,14 @@ from dataclasses import dataclass
 
 MM = 1e-3  # m per mm
 INCH = 0.0254  # m per inch
-LENGTH_UNITS = {"millimeters": 1.0, "meters": 1000.0, "inches": 25.4}  # mm per unit
+LENGTH_UNITS = {  # mm per unit; the short names as the commands' --units take them
+    "millimeters": 1.0,
+    "meters": 1000.0,
+    "inches": 25.4,
+    "mm": 1.0,
+    "m": 1000.0,
+    "in": 25.4,
+}
 LBF = 4.4482216152605  # N per lbf (exact: 0.45359237 kg × 9.80665 m/s²)
 # force_units → (N per unit force, N/mm per unit rate, N·m per unit moment)
 FORCE_UNITS = {"N": (1.0, 1.0, 1.0), "lbf": (LBF, LBF / 25.4, LBF * INCH)}
@@ -108,6 +115,39 @@ def _spring(data: dict, spring: str, actuation: str, config: str, u: Units) -> N
     scale_at(data, f"{config}.limits.bump_stop.rate", u.rate)
 
 
+def _compliance(data: dict, u: Units) -> None:
+    """The ``compliance:`` block's rates (docs/compliance.md): a bushing's radial and
+    axial (force per length) and torsional and conical (moment per degree) rates, or
+    its 6×6 by block (force/length, force per radian, moment per radian); the links'
+    and the tyre's rates (force per length)."""
+    block = data.get("compliance")
+    if not isinstance(block, dict):
+        return
+    for spec in (
+        (block.get("bushings") or {}).values() if isinstance(block.get("bushings"), dict) else ()
+    ):
+        if not isinstance(spec, dict):
+            continue
+        for k in ("radial", "axial"):
+            scale_at(spec, k, u.rate)
+        for k in ("torsional", "conical"):
+            scale_at(spec, k, u.moment)
+        k = spec.get("k")
+        if isinstance(k, list) and len(k) == 6 and all(isinstance(row, list) for row in k):
+            spec["k"] = [
+                [
+                    scaled(
+                        v, u.rate if i < 3 and j < 3 else u.moment if i >= 3 and j >= 3 else u.force
+                    )
+                    for j, v in enumerate(row)
+                ]
+                for i, row in enumerate(k)
+            ]
+    for part in ("links", "tyre"):
+        if isinstance(block.get(part), dict):
+            block[part] = scaled(block[part], u.rate)
+
+
 def _wheel(data: dict, wheel: str, u: Units) -> None:
     for k in WHEEL_LENGTHS:
         scale_at(data, f"{wheel}.{k}", u.length)
@@ -128,6 +168,7 @@ def corner_in_mm(data: dict, r) -> dict:
     for k in SETUP_LENGTHS:
         scale_at(data, f"config.{k}" if k.startswith("camber") else f"config.setup.{k}", u.length)
     _spring(data, "spring", "actuation", "config", u)
+    _compliance(data, u)
     return data | {"units": "millimeters", "force_units": "N"}
 
 
@@ -146,6 +187,7 @@ def axle_in_mm(data: dict, r) -> dict:
             scale_at(data, f"axle_config.{side}_setup.{k}", u.length)
     _spring(data, "axle_config.spring", "axle_config.actuation", "axle_config", u)
     scale_at(data, "axle_config.anti_roll.stiffness", u.moment)  # N·m/deg ("rigid" stays)
+    _compliance(data, u)
     return data | {"units": "millimeters", "force_units": "N"}
 
 

@@ -102,6 +102,14 @@ class ResultsFile:
                 )
         self.units = {}
         for line in comments:
+            if line.startswith("# convention:"):  # io.conventions.Output.header
+                raise InputError(
+                    source,
+                    "# convention",
+                    f"written in convention {_form(line)} (--convention/--units): the "
+                    "report's panels and labels are ISO 8855's in mm; plot the file the "
+                    "command writes without those options",
+                )
             if line.startswith("# units:"):
                 self.units = _units(source, line.removeprefix("# units:"))
         self.columns = {}
@@ -186,6 +194,13 @@ def _cell(text: str) -> float:
     if text in ("True", "False"):
         return float(text == "True")
     return float(text)
+
+
+def _form(line: str) -> str:
+    """``iso, lengths in, forces lbf`` from a ``# convention:`` line."""
+    name = line.removeprefix("# convention:").split()[0]
+    units = line.partition("; units: ")[2].partition(" (")[0]
+    return f"{name}, {units}" if units else name
 
 
 def _units(source: str, text: str) -> dict[str, str]:

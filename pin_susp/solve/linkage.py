@@ -544,6 +544,8 @@ class Linkage(Composed):
                     names.append(point)
         if not names:
             return ""
+        if "rocker_axis_a" in names:  # a file may give the axis as pivot + direction
+            names[names.index("rocker_axis_a")] = "rocker_axis_a (or rocker_pivot/rocker_axis)"
         return f"the wheel centre held, the joints at {', '.join(names)} still move"
 
     def motion(self, qs: list, tangents: list | None = None) -> dict[str, Dual]:

@@ -248,7 +248,7 @@ class Assembly(SteeringSurface, Composed, AnalysesSurface):
                     source,
                     "targets",
                     "a rack-steered corner needs exactly one target on the rack "
-                    f"(trackrod_inboard along y), got {len(on_rack)}",
+                    f"(trackrod_inboard along y, rack or steering_wheel), got {len(on_rack)}",
                 )
 
     def solver_for(self, targets: list, source: str = "<targets>") -> NewtonSolver:

@@ -88,6 +88,9 @@ class AxleModel(AxleAssembly):
         "setup",
         "sensitivity",
         "study",
+        "clearance",
+        "envelope",
+        "kc",
     )
     motion_at_once_from = MIN_STEPS  # linkage.Composed.label_motion
     refuses = ("repeats",)

@@ -146,7 +146,8 @@ def load_axle(source, warn_as: str | None = None) -> AxleGeometry:
         data,
         "",
         required=("hardpoints", "axle_config"),
-        optional=("type", "scope", "name", "version", "units", "force_units", "vehicle_config"),
+        optional=("type", "scope", "name", "version", "units", "force_units", "vehicle_config")
+        + ("compliance", "clearance"),  # docs/compliance.md, docs/clearance.md
     )
     data = canonical_axle(data, r)  # mm and N, spindle points, rocker axes (model/forms.py)
     if r.choice(data.get("scope", "corner"), "scope", ("corner", "axle")) != "axle":
@@ -250,6 +251,7 @@ def load_axle(source, warn_as: str | None = None) -> AxleGeometry:
             "config": corner_config,
         }
         corner |= {k: config[k] for k in ("actuation", "spring") if k in config}
+        corner |= {k: data[k] for k in ("compliance",) if k in data}
         if side == "right":
             corner["side"] = "right"
             if mirrored:

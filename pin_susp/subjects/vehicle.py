@@ -121,6 +121,9 @@ class Vehicle(VehicleExport, VehicleViews, VehicleTangents, VehicleAssembly):
         "loads",
         "setup",
         "sensitivity",
+        "clearance",
+        "envelope",
+        "kc",
     )  # docs/vehicle.md: the rest not yet
     reports = True
     on_road = True

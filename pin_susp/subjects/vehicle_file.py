@@ -87,7 +87,7 @@ def load_vehicle(source) -> VehicleGeometry:
         data,
         "",
         required=("scope", "vehicle_config", "front", "rear"),
-        optional=("name", "version", "units", "force_units"),
+        optional=("name", "version", "units", "force_units", "clearance"),  # docs/clearance.md
     )
     r.choice(data["scope"], "scope", ("vehicle",))
     data = vehicle_in_mm(data, r)  # mm and N (model/units.py)

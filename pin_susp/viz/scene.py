@@ -199,13 +199,16 @@ class Scene:
         grid[2, 3] = ground - target[2] - 0.5 * GROUND_THICKNESS
         self.viewer["/Grid"].set_transform(grid)
 
-    def show(self, q: np.ndarray | None = None, viewer=None, markers=None, colours=None) -> None:
+    def show(
+        self, q: np.ndarray | None = None, viewer=None, markers=None, colours=None, places=None
+    ) -> None:
         """Display the model at q (default: its design state), drawn on ``viewer``.
 
         ``markers``: {name: position (m)} of the markers (an axle's
         ``roll_centre``); a marker not given, or NaN, is hidden. By default
         at the design state, where the design results put them. ``colours``:
-        {node: rgb (0 to 1)} of members coloured by their force."""
+        {node: rgb (0 to 1)} of members coloured by their force; ``places``: {node:
+        position (m)} of nodes moved to a point (the K&C replay's bushings)."""
         if q is None:
             q = self.model.q_rest
             markers = self.design_markers if markers is None else markers
@@ -234,6 +237,10 @@ class Scene:
             _set_visible(target[f"{ROOT}/{name}"], visible)
         for node, rgb in (colours or {}).items():
             set_colour(target[node], rgb)
+        for node, p in (places or {}).items():
+            place = np.eye(4)
+            place[:3, 3] = p
+            target[node].set_transform(place)
 
     def animate(
         self,
@@ -242,11 +249,13 @@ class Scene:
         play: bool = True,
         markers=None,
         colours=None,
+        places=None,
     ) -> int:
         """Record the poses as a meshcat animation; returns the number of frames.
 
         ``markers``: {name: positions (m, one row per pose, NaN where hidden)};
-        ``colours``: {node: rgb (one row per pose)}, from ``force_colours``."""
+        ``colours``: {node: rgb (one row per pose)}, from ``force_colours``;
+        ``places``: {node: positions (m, one row per pose)}."""
         from meshcat.animation import Animation
 
         animation = Animation(default_framerate=fps)
@@ -256,8 +265,9 @@ class Scene:
                 continue
             at = {name: rows[i] for name, rows in (markers or {}).items()}
             paint = {node: rows[i] for node, rows in (colours or {}).items()}
+            moved = {node: rows[i] for node, rows in (places or {}).items()}
             with animation.at_frame(self.viewer, frames) as frame:
-                self.show(q, viewer=frame, markers=at, colours=paint)
+                self.show(q, viewer=frame, markers=at, colours=paint, places=moved)
             frames += 1
         self.viewer.window.send(_LastAnimation(animation, play=play, repetitions=0))
         self.frames = frames
@@ -330,3 +340,12 @@ def _set_visible(node, visible: bool) -> None:
         node.set_property("visible", "boolean", visible)
     else:
         node.set_property("visible", visible)
+
+
+def rod_transform(p0: np.ndarray, p1: np.ndarray) -> np.ndarray:
+    """Place meshcat's unit cylinder (along its y axis) from p0 to p1 (m): what the
+    scene's links are drawn with, and the clearance replay's closest pair."""
+    return _rod_transform(p0, p1)
+
+
+LastAnimation = _LastAnimation  # the animation command kept after the objects, by its name

@@ -49,6 +49,10 @@ COMMANDS = {
         "pin_susp.cli.commands.loads",
         "member and joint forces at every step under load cases",
     ),
+    "kc": (
+        "pin_susp.cli.commands.kc",
+        "elastokinematics (K&C): compliance steer, camber and bushing deflections per case",
+    ),
     "attitude": (
         "pin_susp.cli.commands.attitude",
         "a vehicle's attitude, wheel loads and load transfer (TLLTD) under steady g",
@@ -64,6 +68,14 @@ COMMANDS = {
     "export": (
         "pin_susp.cli.commands.export",
         "a corner's hardpoints as a Lotus .shk or an OptimumK table",
+    ),
+    "clearance": (
+        "pin_susp.cli.commands.clearance",
+        "along a sweep, each tyre's and rim's distance to the links and clearance bodies (coal)",
+    ),
+    "envelope": (
+        "pin_susp.cli.commands.envelope",
+        "the tyre's swept volume over a sweep as one watertight STL mesh (mm)",
     ),
 }
 

@@ -3,7 +3,12 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from ..options import check_outputs, geometry_argument
+
+# the suffixes each layout is written to (.xlsx: an Excel workbook, else CSV text)
+SUFFIXES = {"shk": (".shk",), "optimumk": (".csv", ".xlsx")}
 
 DESCRIPTION = (
     "Write the hardpoints of GEOMETRY (a double wishbone or MacPherson corner) as a Lotus "
@@ -35,6 +40,13 @@ def run(args) -> int:
     from ...io.atomic import atomic_write
     from ...model.geometry import load_geometry
 
+    suffix = Path(args.output).suffix.lower()
+    if suffix not in SUFFIXES[args.format]:
+        raise PinSuspError(
+            f"{args.output}: --format {args.format} writes {' or '.join(SUFFIXES[args.format])}"
+            f" files, not {suffix or 'a name without a suffix'}: name the output "
+            f"FILE{SUFFIXES[args.format][0]}"
+        )
     check_outputs(args, args.output)
     try:
         axes = parse_axes(args.axes)

@@ -5,6 +5,7 @@ because `import` is a Python keyword."""
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 from ...errors import PinSuspError
@@ -77,7 +78,9 @@ def arguments(parser) -> None:
         "8855; e.g. rearward,right,up)",
     )
     parser.add_argument(
-        "--units", choices=("mm", "m", "in"), help="OptimumK: the table's length unit"
+        "--units",
+        choices=("mm", "m", "in"),
+        help="OptimumK: the table's length unit, where its headers name none",
     )
     parser.add_argument(
         "--map",
@@ -104,6 +107,7 @@ def run(args) -> int:
                     f"{args.output}: is an input of this command: writing it would lose it"
                 )
     fmt = args.format or _format(args.source)
+    _refuse_options(args, fmt)
     try:
         args.axes_given = args.axes is not None
         args.axes_text = args.axes or "forward,left,up"
@@ -120,11 +124,7 @@ def run(args) -> int:
     if fmt == "optimumk":
         src = module.read(args.source, raw, args)
     else:
-        try:
-            text = raw.decode("utf-8-sig")
-        except UnicodeDecodeError:
-            text = raw.decode("latin-1")
-        src = module.read(args.source, text, args)
+        src = module.read(args.source, _text(args.source, raw, fmt), args)
     want = Wanted(
         template=args.template,
         side=args.side,
@@ -142,6 +142,51 @@ def run(args) -> int:
         print("\n".join(report))
     print(f"wrote {args.output}")
     return 0
+
+
+# why --units, --axes and --map are an OptimumK table's only: the other formats say
+# their units, axes and point names themselves
+NAMED = {
+    "shk": "a Lotus .shk (mm, Lotus axes, Lotus names)",
+    "adams": "an Adams/Car file (its [UNITS] block, Adams axes, Adams names)",
+}
+
+
+def _refuse_options(args, fmt: str) -> None:
+    """An option FILE's format does not take is refused, naming it; a static camber
+    or toe beyond ±45° too (as a wheel by its centre, docs/geometry.md)."""
+    from ...interop.corner import angle_problem
+
+    for what in ("camber", "toe"):
+        value = getattr(args, what)
+        problem = None if value is None else angle_problem(value)
+        if problem:
+            raise PinSuspError(f"--{what} {value:g}: {problem}")
+    if fmt == "optimumk":
+        return
+    given = [
+        flag
+        for flag, value in (("--units", args.units), ("--axes", args.axes), ("--map", args.map))
+        if value
+    ]
+    if given:
+        raise PinSuspError(
+            f"{given[0]}: {args.source} is {NAMED[fmt]}: {given[0]} is for an OptimumK table"
+        )
+
+
+def _text(path: str, raw: bytes, fmt: str) -> str:
+    """FILE's text (UTF-8, else Latin-1); a file of binary data is refused."""
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        text = raw.decode("latin-1")
+    if not text.strip():
+        raise PinSuspError(f"{path}: the file is empty")
+    if re.search(r"[\x00-\x08\x0b\x0e-\x19\x1b-\x1f\x7f]", text):
+        what = "a Lotus .shk" if fmt == "shk" else "an Adams/Car property file"
+        raise PinSuspError(f"{path}: not a text file (binary data): {what} is text")
+    return text
 
 
 def _format(path: str) -> str:
