@@ -8,6 +8,7 @@ from __future__ import annotations
 
 # The command line's exit codes for how a run ended (0: success; 128 + N: signal N).
 EXIT_NOT_CONVERGED = 1  # it finished, but some steps did not converge (their rows flagged)
+EXIT_LIMIT = 1  # it finished, but some steps are past a hard travel limit (limit_exceeded)
 EXIT_INPUT = 2  # a problem with the input: one line on stderr, nothing written
 
 

@@ -137,7 +137,7 @@ def test_flat_steering_axis_leaves_scrub_and_trail_empty():
 def test_registry_gives_every_column_a_unit_and_label():
     assert len({m.name for m in METRICS}) == len(METRICS)
     for m in METRICS:
-        assert m.unit in ("deg", "mm", "mm/rad", "%") and m.label and m.function.__doc__
+        assert m.unit in ("deg", "mm", "mm/rad", "%", "N") and m.label and m.function.__doc__
 
 
 @pytest.mark.parametrize("side", ["left", "right"])

@@ -222,7 +222,8 @@ def test_every_engine_agrees_with_pin_susp_on_every_column(car, sweep):
     rates along the hubs, the rack and the body; every point within 1e-9 mm."""
     name, vehicle = car
     results, reports = validate(vehicle, short(sweep), engines=("pointwise", "mujoco", "drake"))
-    written_ = {c for c in results.columns if c not in SOLVER and not np.isnan(results[c]).all()}
+    numbers = [c for c in results.columns if results[c].dtype.kind != "O"]  # not limit_exceeded
+    written_ = {c for c in numbers if c not in SOLVER and not np.isnan(results[c]).all()}
     points = {f"{p}_{a}" for p in vehicle.output_points for a in "xyz"}
     springs = {c for c in written_ if c.startswith(("spring_force_", "wheel_rate_", "ride_rate_"))}
     for report in reports:

@@ -89,9 +89,22 @@ def member_forces(corner, sweep, cases: list, solutions=None, results=None, prog
         if name != "step_index":
             columns[name] = np.repeat(values, n)
             units[name] = results.units.get(name, "")
+    bump_stops(corner, columns)
     _warn_dead_centre_share(corner, cases, columns)
     meta = dict(results.meta, not_two_force=statics.not_two_force())
     return Results(columns, units, meta)
+
+
+def bump_stops(subject, columns: dict) -> None:
+    """The bump stop in the loads (docs/loads.md, "Bump stops"): it pushes along the
+    damper beside the spring, so of the force the equilibrium puts along that line,
+    ``bump_stop_force`` (the sweep's column: rate · max(0, compression − gap) at the
+    pose) is the stop's and ``force_spring`` the rest, the spring's. The joints' and
+    the other members' loads are the line's force's either way."""
+    for suffix in map(subject.suffix, subject.labels):
+        stop, spring = f"bump_stop_force{suffix}", f"force_spring{suffix}"
+        if stop in columns and spring in columns:
+            columns[spring] = columns[spring] - np.asarray(columns[stop], dtype=float)
 
 
 def steering_columns(steering, columns: dict) -> dict:

@@ -23,8 +23,9 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ..errors import PinSuspError
-from ..model.geometry import Geometry, Wheel
+from ..model.geometry import Geometry, Wheel, wheel_points
 from ..model.mechanisms import Pointwise
+from ..model.packaging import placed_points
 from ..subjects.assembly import Assembly
 from ..subjects.elements import AntiRollBar, HeaveLink, elements_of
 
@@ -365,6 +366,11 @@ def labelled(corners: dict[str, Geometry], elements=(), hardpoints: dict | None 
         if own.rack is not None:
             racks.append(name(own.rack))
         points = (hardpoints or {}).get(label) or g.hardpoints
+        if g.driveshaft is not None:  # its outer joint rides on the part with the axle
+            wheel = next(k for k, v in own.parts.items() if "axle_outboard" in v)
+            spec.parts[name(wheel)].append(name("cv_outboard"))
+            ends = wheel_points(points["axle_inboard"], points["axle_outboard"], g.wheel)
+            points = placed_points(g.driveshaft, points | ends) | points
         hp.update({name(n): v for n, v in points.items()})
     planes = []
     for element in elements:

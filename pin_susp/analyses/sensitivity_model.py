@@ -44,6 +44,7 @@ from ..constraints import (
 )
 from ..maths.jet import Dual
 from ..model.geometry import contact_patch, unit, wheel_points
+from ..model.packaging import placed_points
 from ..model.sweep import Target
 from ..model.tree import Body, Joint, Tree
 from ..model.urdf import tree_to_urdf
@@ -115,11 +116,9 @@ class HardpointSensitivity:
         for h in seed:
             for a in range(3):
                 seed[h][col[h, a], a] = 1.0
-        derived = wheel_points(
-            Dual(g.hardpoints["axle_inboard"], seed["axle_inboard"]),
-            Dual(g.hardpoints["axle_outboard"], seed["axle_outboard"]),
-            g.wheel,
-        )
+        axle = {h: Dual(g.hardpoints[h], seed[h]) for h in seed}
+        derived = wheel_points(axle["axle_inboard"], axle["axle_outboard"], g.wheel)
+        derived |= placed_points(g.driveshaft, derived | axle)  # a driveshaft's outer joint
         # hardpoints placed by others (the MacPherson clamp on its strut line)
         seeds = {}
         for h in g.hardpoints:

@@ -14,7 +14,7 @@ import math
 import sys
 import warnings
 
-from ..errors import EXIT_NOT_CONVERGED, PlausibilityWarning
+from ..errors import EXIT_LIMIT, EXIT_NOT_CONVERGED, PlausibilityWarning
 
 # Instant-centre columns: past this (mm) the arms are all but parallel and the
 # centre is better described as "at infinity" than by a number.
@@ -97,6 +97,10 @@ class Digest:
         # extending in bump (past over-centre)]
         self.unseat: dict[str, list] = {}
         self.notes: list[str] = []  # how the sweep's targets were read (the rack held)
+        # (limit, corner suffix) → [Steps past it, worst |value| there (the driveshaft's)],
+        # from limit_exceeded (docs/results.md, "Travel limits"); steps past a hard one
+        self.limits: dict[tuple, list] = {}
+        self.past_hard = Steps()
 
     @classmethod
     def of(cls, results) -> Digest:
@@ -177,6 +181,43 @@ class Digest:
                 if ratio is not None:  # extending in bump: past over-centre
                     unseat[4] |= bool(np.any(bump & (ratio <= 0.0)))
 
+        self._limits(results, steps)
+
+    def _limits(self, results, steps) -> None:
+        """The steps past each limit a ``limit_exceeded`` column names (each corner's)."""
+        import numpy as np
+
+        from ..columns.packaging import HARD_LIMITS, LIMIT_COLUMN, SOFT_LIMITS, exceeded
+
+        hard = np.zeros(len(steps), dtype=bool)
+        for name, column in results.columns.items():
+            if not name.startswith(LIMIT_COLUMN):
+                continue
+            suffix, cells = name[len(LIMIT_COLUMN) :], exceeded(column)
+            for limit in HARD_LIMITS + SOFT_LIMITS:
+                hit = np.array([limit in c for c in cells], dtype=bool)
+                if not hit.any():
+                    continue
+                entry = self.limits.setdefault((limit, suffix), [Steps(), 0.0])
+                entry[0].add(steps[hit])
+                if limit in SOFT_LIMITS:
+                    v = np.abs(np.asarray(results[limit + suffix], dtype=float)[hit])
+                    entry[1] = max(entry[1], float(np.nanmax(v)))
+                else:
+                    hard |= hit
+        self.past_hard.add(steps[hard])
+
+    def hard_limits(self) -> list[str]:
+        """Each hard limit a step is past, with its corner's suffix and the steps:
+        ``damper_stroke_min_left at 2 steps (39, 40)``."""
+        from ..columns.packaging import HARD_LIMITS
+
+        return [
+            f"{limit}{suffix} at {steps.count} step{'s' * (steps.count != 1)} ({steps})"
+            for (limit, suffix), (steps, _) in self.limits.items()
+            if limit in HARD_LIMITS
+        ]
+
     def _column(self, name: str, v, steps) -> None:
         import numpy as np
 
@@ -246,7 +287,17 @@ def summary(results, path) -> None:
             f"  (blank: an empty cell in the CSV; {d.failed} of {d.steps} steps did not "
             "converge, and their metrics are blank)"
         )
+    limits_line(d)
     print("  (every column, derivatives included, is in the CSV)")
+
+
+def limits_line(d: Digest) -> None:
+    """The summary's line on the steps past a hard travel limit (limit_exceeded), if any."""
+    if d.past_hard.count:
+        print(
+            f"  {d.past_hard.count} of {d.steps} steps past a hard travel limit: "
+            f"{'; '.join(d.hard_limits())} (named in limit_exceeded; exit code 1)"
+        )
 
 
 def sweep_summary(
@@ -295,6 +346,7 @@ def columns_summary(
             f"  (blank: an empty cell in the CSV; {failed} of {len(results)} steps did not "
             "converge, and their columns are blank)"
         )
+    limits_line(digest)
     corners = "both corners" if suffixes.count("/") == 1 else "every corner"
     print(f"  (every column of {corners}, suffixed {suffixes}, is in the CSV)")
 
@@ -343,6 +395,40 @@ def warn_transmission(results) -> None:
                 PlausibilityWarning,
                 stacklevel=2,
             )
+
+
+def warn_driveshaft(results) -> None:
+    """Name the first step (and how many) where a driveshaft's plunge or joint angle is
+    past config.driveshaft.max_plunge / max_cv_angle (each corner's; limit_exceeded)."""
+    from ..columns.packaging import SOFT_LIMITS
+
+    d = Digest.of(results)
+    for (limit, suffix), (steps, worst) in d.limits.items():
+        if limit not in SOFT_LIMITS:
+            continue
+        plunge = limit == "driveshaft_plunge"
+        key, unit_text = ("max_plunge", "mm") if plunge else ("max_cv_angle", "deg")
+        warnings.warn(
+            f"{limit}{suffix} past config.driveshaft.{key} at {steps.count} step"
+            f"{'s' * (steps.count != 1)}, first at step {steps.first[0]} (worst "
+            f"{worst:.4g} {unit_text}): the driveshaft is out of its range there",
+            PlausibilityWarning,
+            stacklevel=2,
+        )
+
+
+def report_limits(results) -> int:
+    """Name the steps past a hard travel limit on stderr (docs/results.md, "Travel
+    limits"); the exit code: 1 (EXIT_LIMIT) if any, else 0."""
+    d = Digest.of(results)
+    if not d.past_hard.count:
+        return 0
+    print(
+        f"pin-susp: warning: {d.past_hard.count} of {d.steps} steps are past a hard travel "
+        f"limit: {'; '.join(d.hard_limits())}. Their rows are flagged in limit_exceeded.",
+        file=sys.stderr,
+    )
+    return EXIT_LIMIT
 
 
 def _ratio_trend(ratio: float | None, best: float, best_ratio: float | None) -> str:

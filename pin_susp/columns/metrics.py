@@ -1,22 +1,20 @@
 """Corner metrics: plain functions of solved point positions, and their registry.
 
-Each function takes a :class:`PointSet` (every named point as an (n, 3)
-array in metres, one row per step) and returns an (n,) array in SI (m,
-rad); NaN where the metric is undefined. The same code runs on
-:class:`~pin_susp.maths.jet.Dual` points and then also returns exact derivatives
-(along the motion, or with respect to a hardpoint): so it indexes with
-``[..., k]`` and reduces over ``axis=-1``.
+Each function takes a :class:`PointSet` (every named point as an (n, 3) array in
+metres, one row per step) and returns an (n,) array in SI (m, rad); NaN where the
+metric is undefined. The same code runs on :class:`~pin_susp.maths.jet.Dual` points
+and then also returns exact derivatives (along the motion, or with respect to a
+hardpoint): so it indexes with ``[..., k]`` and reduces over ``axis=-1``.
 
-The registry ``METRICS`` gives each column's name, unit, label, the
-conversion to output units and the drivers it has derivative columns for;
-it alone decides which columns a sweep writes and in what order (an entry is a
-registry.Metric; the columns other tools report, and their entries, are other_tools.py's).
+The registry ``METRICS`` gives each column's name, unit, label, the conversion to
+output units and the drivers it has derivative columns for; it alone decides which
+columns a sweep writes and in what order (an entry is a registry.Metric; the columns
+other tools report are other_tools.py's, the packaging ones packaging.py's).
 
-Why one module of ~700 lines: the registry and the functions it names are read
-together (each entry next to the function whose column it declares, in the CSV's
-order), and the instant-centre and anti-geometry functions share the same few
-point helpers; split by metric, a column's declaration would sit apart from its
-formula.
+Why one module of ~700 lines: the registry and the functions it names are read together
+(each entry next to the function whose column it declares, in the CSV's order), and the
+instant-centre and anti-geometry functions share the same few point helpers; split by
+metric, a column's declaration would sit apart from its formula.
 Definitions and signs follow docs/results.md: s = +1 left, −1 right; â =
 unit(axle_outboard − axle_inboard); k̂ = unit(UBJ − LBJ); WC = wheel centre,
 CP = contact patch.
@@ -31,7 +29,7 @@ import numpy as np
 from ..maths.jet import Dual, cross, value
 from ..maths.jet import rate as jet_rate
 from ..model.geometry import Geometry, unit
-from . import other_tools
+from . import other_tools, packaging
 from .registry import BOTH, HUB_Z, RACK, STEERING_AXIS_FLAT, Metric  # noqa: F401 (as they were)
 
 PARALLEL_PLANES = 1e-12  # |n₁ × n₂|² below this (unit normals): no instant axis
@@ -543,6 +541,7 @@ METRICS = (
         always_written=True,
         needs="config.axle_position, driven_axle (the same axle), cg_position and wheelbase",
     ),
+    *packaging.PACKAGING,  # the driveshaft; the damper's travel limits, its bump stop
 )
 METRIC_BY_NAME = {m.name: m for m in METRICS}
 # The standard kinematics set: the setup sheet's static values, the report's first panels.
@@ -628,6 +627,7 @@ def metric_columns(
             out[m.name] = (value(values[m.name]), m.unit)
         elif m.always_written and (only is None or m.name in only):
             out[m.name] = (np.full(n, np.nan), m.unit)
+    out |= packaging.limit_columns(geometry, out, only)  # the limits a step is past
     if not isinstance(points["wheel_center"], Dual):
         return out
     drivers = (HUB_Z, RACK) if geometry.steering == "rack" else (HUB_Z,)

@@ -31,7 +31,7 @@ class Metric:
     """
 
     name: str
-    unit: str  # "deg", "mm", "mm/rad" or "%"
+    unit: str  # "deg", "mm", "mm/rad", "%" or "N"
     label: str
     function: Callable  # PointSet (metrics.py) → (n,) array in SI, NaN where undefined
     applies: Callable[[Geometry], bool] = field(default=_always)
@@ -45,4 +45,4 @@ class Metric:
     @property
     def scale(self) -> float:
         """SI → output unit."""
-        return {"deg": 180.0 / np.pi, "mm": 1e3, "mm/rad": 1e3, "%": 1.0}[self.unit]
+        return {"deg": 180.0 / np.pi, "mm": 1e3, "mm/rad": 1e3, "%": 1.0, "N": 1.0}[self.unit]

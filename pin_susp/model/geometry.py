@@ -21,6 +21,8 @@ import numpy as np
 from ..errors import PlausibilityWarning
 from ..io.yamlio import MAX_LENGTH_MM, Reader, load_yaml
 from ..maths.vectors import COINCIDENT, direction, unit
+from . import packaging
+from .packaging import Driveshaft, Limits
 from .units import INCH as INCH
 from .units import MM as MM
 from .wheel import Wheel as Wheel
@@ -116,6 +118,8 @@ class Geometry:
     # config.inertia, for the URDF's and MJCF's masses (None: the defaults, docs/urdf.md)
     density: float | None = None  # kg/m³ of the drawn links and joints
     wheel_mass: float | None = None  # kg: rim, tyre, hub and brake
+    driveshaft: Driveshaft | None = None  # cv_inboard and config.driveshaft (packaging.py)
+    limits: Limits | None = None  # config.limits: the damper's travel (packaging.py)
     source: str = "<dict>"
     sha256: str | None = None
     data: dict = field(default_factory=dict, repr=False)
@@ -165,10 +169,11 @@ class Geometry:
         return self.mechanism.steering_points(self)
 
     def design_points(self) -> dict[str, np.ndarray]:
-        """Every hardpoint and derived point at the design condition (m)."""
+        """Every hardpoint and derived point at the design condition (m); a driveshaft's
+        outboard joint where its offset places it (packaging.py)."""
         points = dict(self.hardpoints)
         points.update(wheel_points(points["axle_inboard"], points["axle_outboard"], self.wheel))
-        return points
+        return points | packaging.placed_points(self.driveshaft, points)
 
     @property
     def hardpoints_mm(self) -> dict[str, np.ndarray]:
@@ -306,6 +311,9 @@ OTHER_SCOPES = {
 SCOPES = ("corner", *OTHER_SCOPES)
 CORNER_KEYS = ("type", "scope", "side", "name", "version", "units", "force_units")
 CORNER_KEYS += ("actuation", "spring", "config", "compliance", "clearance")  # docs/clearance.md
+CONFIG_KEYS = ("steering", "cg_position", "wheelbase", "track", "axle_position")
+CONFIG_KEYS += ("front_brake_bias", "driven_axle", "camber_shim", "setup", "strut")
+CONFIG_KEYS += ("opposite_axle_axis_height", "inertia", "driveshaft", "limits")
 
 
 def parse_geometry(data: dict, r: Reader, sha: str | None) -> Geometry:
@@ -340,25 +348,7 @@ def parse_geometry(data: dict, r: Reader, sha: str | None) -> Geometry:
     if "version" in data:
         r.text(data["version"], "version")
 
-    config = r.mapping(
-        data.get("config"),
-        "config",
-        required=("wheel",),
-        optional=(
-            "steering",
-            "cg_position",
-            "wheelbase",
-            "track",
-            "axle_position",
-            "front_brake_bias",
-            "driven_axle",
-            "camber_shim",
-            "setup",
-            "strut",
-            "opposite_axle_axis_height",
-            "inertia",
-        ),
-    )
+    config = r.mapping(data.get("config"), "config", required=("wheel",), optional=CONFIG_KEYS)
     for key, why in mech.FORBIDDEN.items():
         top, _, sub = key.partition(".")
         if (sub in config) if top == "config" else (key in data):
@@ -379,7 +369,7 @@ def parse_geometry(data: dict, r: Reader, sha: str | None) -> Geometry:
     )
     wheel = read_wheel(config["wheel"], r)
     options = Options(kind, side, steering, actuation, mount, spring)
-    names = mech.hardpoint_names(options)
+    names = mech.hardpoint_names(options) + packaging.cv_points(data["hardpoints"])
     hp_map = data["hardpoints"]
     if not isinstance(hp_map, dict):
         r.fail("hardpoints", "expected a mapping of point name to {x, y, z}")
@@ -418,6 +408,7 @@ def parse_geometry(data: dict, r: Reader, sha: str | None) -> Geometry:
         )
     mech.prepare(hardpoints, options, r)
     compliance.read_compliance(data["compliance"], r, names) if "compliance" in data else None
+    driveshaft = packaging.read_driveshaft(config, hardpoints, side, r)
     adjusters = _setup_block(config.get("setup", {}), actuation, mech.steering_points(options), r)
 
     density, wheel_mass = _inertia(config.get("inertia", {}), r)
@@ -463,6 +454,8 @@ def parse_geometry(data: dict, r: Reader, sha: str | None) -> Geometry:
         ),
         density=density,
         wheel_mass=wheel_mass,
+        driveshaft=driveshaft,
+        limits=packaging.read_limits(config, hardpoints, r),
         source=r.source,
         sha256=sha,
         data=data,

@@ -108,6 +108,11 @@ def _spring(data: dict, spring: str, actuation: str, config: str, u: Units) -> N
     scale_at(data, f"{config}.strut.preload", u.force)
     scale_at(data, f"{actuation}.bearing_spacing", u.length)
     scale_at(data, f"{config}.steering.c_factor", u.length)
+    for k in ("driveshaft.outboard_offset", "driveshaft.max_plunge", "limits.damper_stroke"):
+        scale_at(data, f"{config}.{k}", u.length)  # docs/geometry.md, "Driveshaft", "Travel
+    scale_at(data, f"{config}.limits.bump_stop.gap", u.length)  # limits"
+    scale_at(data, f"{config}.limits.rebound", u.length)
+    scale_at(data, f"{config}.limits.bump_stop.rate", u.rate)
 
 
 def _compliance(data: dict, u: Units) -> None:

@@ -31,6 +31,7 @@ EXTRA = (
 )
 DERIVED = ("camber", "roadwheel_angle")  # their derivative columns get panels
 TEXT = ("load_case",)  # columns of names, not numbers
+TEXT_STEMS = ("limit_exceeded",)  # such columns of each corner (limit_exceeded_left)
 # beyond this a value cannot be drawn: an axis spanning it overflows a float in
 # matplotlib's tick arithmetic (±8e307 already does); pin_susp's own columns stay far
 # below (an instant centre is blank, not huge, when the arms are parallel)
@@ -113,7 +114,7 @@ class ResultsFile:
                 self.units = _units(source, line.removeprefix("# units:"))
         self.columns = {}
         for j, name in enumerate(header):
-            if name in TEXT:
+            if name in TEXT or name.startswith(TEXT_STEMS):
                 self.columns[name] = np.array([row[j] for _, row in body], dtype=object)
                 continue
             try:

@@ -264,6 +264,8 @@ class _Design:
             near = [c for c in self.columns if name.split("_")[0] in c][:8]
             hint = f" (e.g. {', '.join(near)})" if near else ""
             r.fail(key, f"unknown column {name!r}: not among the sweep's results{hint}")
+        if self.results.columns[name].dtype.kind == "O":  # limit_exceeded: names, not numbers
+            r.fail(key, f"{name} is a column of names, not numbers (its margins are numbers)")
 
 
 def _variables(data: dict, design: _Design, r: Reader) -> list[Variable]:

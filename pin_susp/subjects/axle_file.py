@@ -16,6 +16,7 @@ from ..model.compose import SHARED, compose_tree
 from ..model.deadcentre import warn_dead_centres
 from ..model.forms import canonical_axle
 from ..model.geometry import MM, Geometry, summary_repr
+from ..model.packaging import mirrored_driveshaft
 from .assembly import Assembly
 from .elements import elements_of
 from .elements.anti_roll_bar import mount_body
@@ -60,6 +61,8 @@ AXLE_KEYS = (
     "heave_link",
     "left_setup",
     "right_setup",
+    "driveshaft",
+    "limits",
 )
 
 
@@ -225,9 +228,12 @@ def load_axle(source, warn_as: str | None = None) -> AxleGeometry:
         )
         corner_config = {
             k: config[k]
-            for k in ("steering", "wheel", "axle_position", "inertia", "strut")
+            for k in ("steering", "wheel", "axle_position", "inertia", "strut", "limits")
             if k in config
         }
+        if "driveshaft" in config:  # its inboard axis given for the left (packaging.py)
+            shaft = config["driveshaft"]
+            corner_config["driveshaft"] = mirrored_driveshaft(shaft) if side == "right" else shaft
         corner_config |= {k: vehicle[k] for k in VEHICLE_KEYS if k in vehicle}
         if "camber_shim" in setup:
             corner_config["camber_shim"] = setup["camber_shim"]

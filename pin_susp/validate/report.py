@@ -70,6 +70,8 @@ def compare(
             continue
         stalled = scope.stalled(points)  # a driver the engine cannot move
         for name, (values, unit) in scope.columns(points).items():
+            if np.asarray(values).dtype.kind == "O":  # text (limit_exceeded): of numbers
+                continue  # that are compared
             if np.isnan(values[0]) and stalled and scope.from_rates(name):
                 report.not_compared.add(name)
                 continue

@@ -12,8 +12,10 @@ from ..report import (
     Digest,
     progress_bar,
     report_failures,
+    report_limits,
     summary,
     sweep_summary,
+    warn_driveshaft,
     warn_transmission,
 )
 
@@ -21,7 +23,8 @@ DESCRIPTION = (
     "Solve every step of SWEEP on GEOMETRY (a corner, or an axle: scope: axle) "
     "and write the metrics (camber, toe, caster, KPI, scrub, trail, ...; an axle's per "
     "side, and its roll, roll centre, bar twist, ...) and every point to CSV. "
-    "Exit code 1 if any step did not converge (its row is flagged)."
+    "Exit code 1 if any step did not converge (its row is flagged) or is past a hard "
+    "travel limit of config.limits (named in limit_exceeded)."
 )
 
 
@@ -61,13 +64,14 @@ def run(args) -> int:
     results = subject.run_sweep(sweep, progress=progress_bar(sweep.steps, args.quiet))
     digest = Digest.of(results)
     warn_transmission(digest)
+    warn_driveshaft(digest)
     plot = write_results(args, results)
     if not args.quiet:
         suffixes = "/".join(subject.suffix(label) for label in subject.labels)
         sweep_summary(results, digest, args.output, subject.summary_columns, suffixes)
         if plot:
             print(f"wrote {args.plot}")
-    return report_failures(digest)
+    return max(report_failures(digest), report_limits(digest))
 
 
 def _sweep_streamed(args, corner, sweep) -> int:
@@ -97,9 +101,10 @@ def _sweep_streamed(args, corner, sweep) -> int:
             del part
         pending.result()
     warn_transmission(digest)
+    warn_driveshaft(digest)
     if not args.quiet:
         summary(digest, args.output)
-    return report_failures(digest)
+    return max(report_failures(digest), report_limits(digest))
 
 
 def write_results(args, results) -> bool:

@@ -168,6 +168,8 @@ def _not_compared(results, reports, subject) -> list[str]:
     for name in results.columns:
         if name in compared or name in points or name == "step_index":
             continue
+        if np.asarray(results[name]).dtype.kind == "O":  # text (limit_exceeded), of the
+            continue  # numbers compared
         if name.startswith("solver_") or np.isnan(results[name]).all():
             continue
         stem = next((name.removesuffix(s) for s in suffixes if name.endswith(s)), None)

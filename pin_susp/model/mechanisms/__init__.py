@@ -175,9 +175,18 @@ def visuals(g, p, body_of: dict[str, str], rods: list[tuple], material=None) -> 
     return out
 
 
-def wheel_mounts(body: str) -> dict[str, str]:
-    """The derived wheel points, on the body that carries the wheel."""
-    return dict.fromkeys(("axle_midpoint", "wheel_center", "wheel_inboard", "wheel_outboard"), body)
+def wheel_mounts(body: str, g=None) -> dict[str, str]:
+    """The derived wheel points, on the body that carries the wheel, and the geometry
+    ``g``'s driveshaft's outboard joint (docs/geometry.md, "Driveshaft")."""
+    names = ("axle_midpoint", "wheel_center", "wheel_inboard", "wheel_outboard")
+    shaft = () if g is None or g.driveshaft is None else ("cv_outboard",)
+    return dict.fromkeys(names + shaft, body)
+
+
+def chassis_mounts(g) -> dict[str, str]:
+    """The optional points every mechanism may have on its chassis: a driveshaft's inboard
+    joint (on the chassis or the diff, docs/geometry.md, "Driveshaft")."""
+    return dict.fromkeys((n for n in ("cv_inboard",) if n in g.hardpoints), "chassis")
 
 
 def axis_foot(a: np.ndarray, b: np.ndarray, p: np.ndarray) -> np.ndarray:

@@ -27,6 +27,7 @@ from . import (
     STEERING_POINTS,
     Pointwise,
     axis_foot,
+    chassis_mounts,
     pivot,
     rack_joint,
     rack_rod,
@@ -203,15 +204,19 @@ def tree(g) -> Tree:
             Body("rocker", "chassis", pivot("rocker_pivot", "rocker_axis_a", "rocker_axis_b", p))
         )
 
-    body_of = {
-        "lower_wishbone_inboard_front": "chassis",
-        "lower_wishbone_inboard_rear": "chassis",
-        LBJ: "lower_wishbone",
-        "upper_wishbone_inboard_front": "chassis",
-        "upper_wishbone_inboard_rear": "chassis",
-        UBJ: "upper_wishbone",
-        inner: "rack" if g.steering == "rack" else "chassis",
-    } | upright_mounts(g)
+    body_of = (
+        {
+            "lower_wishbone_inboard_front": "chassis",
+            "lower_wishbone_inboard_rear": "chassis",
+            LBJ: "lower_wishbone",
+            "upper_wishbone_inboard_front": "chassis",
+            "upper_wishbone_inboard_rear": "chassis",
+            UBJ: "upper_wishbone",
+            inner: "rack" if g.steering == "rack" else "chassis",
+        }
+        | upright_mounts(g)
+        | chassis_mounts(g)
+    )
     if g.has_pushrod:
         body_of |= {
             "pushrod_outboard": g.actuation_mount,
@@ -291,7 +296,7 @@ def upright_mounts(g) -> dict[str, str]:
             names.append("pushrod_outboard")
         elif g.spring == "coilover":
             names.append("strut_bottom")
-    return dict.fromkeys(names, "upright") | wheel_mounts("upright")
+    return dict.fromkeys(names, "upright") | wheel_mounts("upright", g)
 
 
 def kingpin(ps):

@@ -27,6 +27,7 @@ from . import (
     MATERIALS,
     STEERING_POINTS,
     Pointwise,
+    chassis_mounts,
     pivot,
     rack_joint,
     rack_rod,
@@ -141,17 +142,21 @@ def tree(g) -> Tree:
     ]
     if g.steering == "rack":
         bodies.append(Body("rack", "chassis", rack_joint(p, inner)))
-    body_of = {
-        LOWER_ARM[0]: "chassis",
-        LOWER_ARM[1]: "chassis",
-        LBJ: "lower_wishbone",
-        TOP: "chassis",
-        CLAMP: "upright",
-        inner: "rack" if g.steering == "rack" else "chassis",
-        outer: "upright",
-        "axle_inboard": "upright",
-        "axle_outboard": "upright",
-    } | wheel_mounts("upright")
+    body_of = (
+        {
+            LOWER_ARM[0]: "chassis",
+            LOWER_ARM[1]: "chassis",
+            LBJ: "lower_wishbone",
+            TOP: "chassis",
+            CLAMP: "upright",
+            inner: "rack" if g.steering == "rack" else "chassis",
+            outer: "upright",
+            "axle_inboard": "upright",
+            "axle_outboard": "upright",
+        }
+        | wheel_mounts("upright", g)
+        | chassis_mounts(g)
+    )
     points = {name: (body, p[name]) for name, body in body_of.items()}
     closures = [
         # the strut's two assemblies: the top mount on the clamp's side of the LBJ, or

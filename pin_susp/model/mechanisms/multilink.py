@@ -32,6 +32,7 @@ from . import (
     MATERIALS,
     STEERING_POINTS,
     Pointwise,
+    chassis_mounts,
     common_perpendicular_midpoint,
     rack_joint,
     rack_rod,
@@ -163,7 +164,8 @@ def tree(g) -> Tree:
     body_of |= {ends(link)[1]: "upright" for link in LINKS if link != TREE_LINK}
     body_of[t_out] = TREE_LINK
     body_of |= {inner: "rack" if g.steering == "rack" else "chassis", outer: "upright"}
-    body_of |= dict.fromkeys(AXLE_POINTS, "upright") | wheel_mounts("upright")
+    body_of |= dict.fromkeys(AXLE_POINTS, "upright") | wheel_mounts("upright", g)
+    body_of |= chassis_mounts(g)
     if g.spring == "coilover":
         body_of |= {"strut_top": "chassis", "strut_bottom": "upright"}
     points = {name: (body, p[name]) for name, body in body_of.items()}

@@ -21,6 +21,7 @@ from . import (
     MATERIALS,
     Pointwise,
     axis_foot,
+    chassis_mounts,
     pivot,
     robot,
     visuals,
@@ -77,7 +78,7 @@ def tree(g) -> Tree:
     p = g.design_points()
     bodies = [Body("chassis"), Body("trailing_arm", "chassis", pivot("arm_pivot", *PIVOT, p))]
     body_of = dict.fromkeys(PIVOT, "chassis") | dict.fromkeys(AXLE_POINTS, "trailing_arm")
-    body_of |= wheel_mounts("trailing_arm")
+    body_of |= wheel_mounts("trailing_arm", g) | chassis_mounts(g)
     if g.spring == "coilover":
         body_of |= {"strut_top": "chassis", "strut_bottom": "trailing_arm"}
     points = {name: (body, p[name]) for name, body in body_of.items()}
