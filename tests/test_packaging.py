@@ -511,3 +511,21 @@ def test_a_vehicles_driven_axle_has_them_per_corner(tmp_path):
     past = df["limit_exceeded_rl"].fillna("").tolist()
     assert code == 1 and any(past) and not all(past)
     assert past == df["limit_exceeded_rr"].fillna("").tolist()[::-1]
+
+
+def test_a_pose_of_the_api_carries_the_shaft_and_the_limits():
+    """Corner.solve_pose on the packaging example: the shaft's length from the pose's own
+    points, limit_exceeded as text (blank within the limits, the rebound named past it)."""
+    corner = pin_susp.Corner(EXAMPLES / "packaging.yaml")
+    pose = corner.solve_pose(
+        [pin_susp.Target("wheel_center", "z", 20.0), pin_susp.Target("trackrod_inboard", "y", 5.0)]
+    )
+    p = pose.points
+    length = np.linalg.norm(p["cv_inboard"] - p["cv_outboard"])
+    assert pose.metrics["driveshaft_length"] == pytest.approx(length, abs=1e-9)
+    assert pose.metrics["limit_exceeded"] == ""
+    droop = corner.solve_pose(
+        [pin_susp.Target("wheel_center", "z", -120.0), pin_susp.Target("trackrod_inboard", "y", 0)]
+    )  # the damper 35.9 mm longer than at design: past the rebound stop's 35
+    assert droop.metrics["damper_margin_extension"] < 0
+    assert "rebound" in droop.metrics["limit_exceeded"]

@@ -142,7 +142,11 @@ class Corner(Assembly, Linkage):
             converged=solution.converged,
             iterations=solution.iterations,
             max_residual=solution.max_residual * 1e3,
-            metrics={k: float(v[0]) for k, (v, _) in columns.items() if "deriv_" not in k},
+            metrics={  # limit_exceeded is text: the limits a pose is past
+                k: v[0] if isinstance(v[0], str) else float(v[0])
+                for k, (v, _) in columns.items()
+                if "deriv_" not in k
+            },
             points={k: p.val[0] * 1e3 for k, p in points.items()},
             derivatives={k: float(v[0]) for k, (v, _) in columns.items() if "deriv_" in k},
         )
