@@ -470,3 +470,21 @@ def test_mirrored_tubes_on_the_chassis_mirror_the_tyres_distances(
     on_tube = table[table["pair"] == f"{left}/tube_l"].sort_values("step")["body_z"].to_numpy()
     rolls = geometry.startswith("vehicle")  # the car's body rolls ±2°: its tube ±27 mm
     assert (np.ptp(on_tube) > 40.0) == rolls
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [["sweep", "-o", "out.csv"], ["envelope", "-o", "out.stl"], ["view", "--html", "out.html"]],
+    ids=lambda a: a[0],
+)
+def test_a_bad_body_is_refused_by_every_command(tmp_path, capsys, argv):
+    """The clearance: bodies are checked wherever the file is loaded, not only by
+    pin-susp clearance: one line naming the key, exit 2, nothing written."""
+    g = yaml.safe_load((EXAMPLES / "packaging.yaml").read_text())
+    g["clearance"]["bodies"][0]["tube"]["radius"] = -12.7
+    (tmp_path / "g.yaml").write_text(yaml.safe_dump(g))
+    command, *out = argv
+    assert main([command, "g.yaml", str(EXAMPLES / "bump.yaml"), *out]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "clearance.bodies[0].tube.radius: must be > 0" in err
+    assert not (tmp_path / out[-1]).exists()

@@ -529,3 +529,45 @@ def test_a_pose_of_the_api_carries_the_shaft_and_the_limits():
     )  # the damper 35.9 mm longer than at design: past the rebound stop's 35
     assert droop.metrics["damper_margin_extension"] < 0
     assert "rebound" in droop.metrics["limit_exceeded"]
+
+
+@pytest.mark.parametrize("command", ["clearance", "envelope", "loads", "kc"])
+def test_every_command_that_solves_the_sweep_flags_a_hard_limit(tmp_path, capsys, command):
+    """A step past the damper's stroke: exit 1 and the warning line, whichever command
+    solved the sweep (docs/results.md, "Travel limits") — never written as good."""
+    name, stroke = (
+        ("kc_saloon_corner.yaml", [385, 392]) if command == "kc" else ("packaging.yaml", [240, 260])
+    )
+    g = example(name)
+    g["config"]["limits"] = {"damper_stroke": stroke}
+    (tmp_path / "g.yaml").write_text(yaml.safe_dump(g))
+    extra = {
+        "clearance": ["-o", "out.csv"],
+        "envelope": ["-o", "out.stl"],
+        "loads": ["--cases", str(EXAMPLES / "loads.yaml"), "-o", "out.csv"],
+        "kc": ["--cases", str(EXAMPLES / "kc.yaml"), "-o", "out.csv"],
+    }[command]
+    argv = [command, "g.yaml", str(EXAMPLES / "bump_steer.yaml"), *extra, "-q"]
+    assert main(argv) == 1
+    err = capsys.readouterr().err
+    assert "past a hard travel limit: damper_stroke_m" in err
+    g["config"]["limits"] = {"damper_stroke": [100, 900]}  # wide: within it everywhere
+    (tmp_path / "g.yaml").write_text(yaml.safe_dump(g))
+    assert main(argv) == 0
+
+
+def test_the_inboard_joint_inboard_of_the_upright(tmp_path):
+    """cv_inboard outboard of the spindle: an error naming it; across the centre line:
+    a warning (an offset diff may, rarely that far)."""
+    g = example("packaging.yaml")
+    g["hardpoints"]["cv_inboard"]["y"] = 1300.0
+    (tmp_path / "g.yaml").write_text(yaml.safe_dump(g))
+    with pytest.raises(InputError, match="hardpoints.cv_inboard: y = 1300 mm is outboard"):
+        pin_susp.Corner(tmp_path / "g.yaml")
+    g["hardpoints"]["cv_inboard"]["y"] = -230.0
+    (tmp_path / "g.yaml").write_text(yaml.safe_dump(g))
+    from pin_susp.errors import PlausibilityWarning
+    from pin_susp.model.geometry import load_geometry
+
+    with pytest.warns(PlausibilityWarning, match="230 mm across the car's centre"):
+        load_geometry(tmp_path / "g.yaml")

@@ -85,6 +85,20 @@ def load_clearance(path) -> list:
     return read_clearance(data.get("clearance"), r, Path(source).parent, scale)
 
 
+def check_clearance(path) -> None:
+    """A file's ``clearance:`` bodies read, for their errors alone, wherever a command
+    loads the file (``subjects.subject.load_subject``): a bad body is refused by every
+    command, not only by ``pin-susp clearance``. A file without the key costs a look."""
+    from ..io.yamlio import load_yaml
+
+    try:
+        data, _, _ = load_yaml(path)
+    except Exception:  # the file's own reader names what is wrong with it
+        return
+    if isinstance(data, dict) and "clearance" in data:
+        load_clearance(path)
+
+
 def _point(value, r: Reader, key: str, m: float) -> np.ndarray:
     return r.point(value, key) * m
 

@@ -11,10 +11,12 @@ margins, the bump stop's force, the limits a step is past) are
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import PlausibilityWarning
 from ..io.yamlio import MAX_LENGTH_MM, Reader
 from ..maths.vectors import COINCIDENT, direction
 
@@ -82,6 +84,7 @@ def read_driveshaft(config: dict, p: dict, side: str, r: Reader) -> Driveshaft |
             f"a driveshaft on a {at} corner, but config.driven_axle is {driven}: only a "
             "driven corner has one",
         )
+    _check_inboard_joint(p, side, r)
     key = "config.driveshaft"
     s = r.mapping({} if block is None else block, key, optional=DRIVESHAFT_KEYS)
     offset = None
@@ -177,3 +180,26 @@ def mirrored_driveshaft(block):
     elif isinstance(axis, list) and len(axis) == 3 and isinstance(axis[1], int | float):
         axis = [axis[0], -axis[1], axis[2]]
     return block | {"inboard_axis": axis}
+
+
+def _check_inboard_joint(p: dict, side: str, r: Reader) -> None:
+    """cv_inboard inboard of the upright (its spindle's inner point): an error; across
+    the car's centre line: a warning (an offset diff can put both outputs on one side,
+    but rarely far)."""
+    sign = 1.0 if side == "left" else -1.0
+    y, spindle = sign * p["cv_inboard"][1], sign * p["axle_inboard"][1]
+    if y >= spindle:
+        r.fail(
+            "hardpoints.cv_inboard",
+            f"y = {p['cv_inboard'][1] / MM:g} mm is outboard of the upright (axle_inboard "
+            f"at y = {p['axle_inboard'][1] / MM:g} mm): the inboard joint sits on the chassis "
+            "or the diff, inboard of the wheel",
+        )
+    if y < -0.1:  # m: 100 mm across the centre line
+        warnings.warn(
+            f"{r.source}: hardpoints.cv_inboard: y = {p['cv_inboard'][1] / MM:g} mm is "
+            f"{-y / MM:g} mm across the car's centre line from this {side} corner: "
+            "a diff offset that far, or the wrong sign of y?",
+            PlausibilityWarning,
+            stacklevel=3,
+        )

@@ -76,6 +76,9 @@ def load_subject(path, warn: bool = True) -> Assembly:
     or an AxleModel (both corners as set, the axle's shared elements). ``warn``: a
     corner's PlausibilityWarning for each implausible design metric (Corner's); a
     Vehicle (``scope: vehicle``)."""
+    from ..model.clearance_bodies import check_clearance
+
+    check_clearance(path)  # its bodies' errors for every command (docs/clearance.md)
     if is_vehicle_file(path):
         from .vehicle import Vehicle
 

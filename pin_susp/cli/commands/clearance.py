@@ -7,7 +7,7 @@ from __future__ import annotations
 import sys
 
 from ..options import check_outputs, count, geometry_argument, positive
-from ..report import progress_bar, report_failures
+from ..report import progress_bar, report_failures, report_limits
 
 DESCRIPTION = (
     "Solve SWEEP on GEOMETRY (a corner, an axle or a vehicle) and measure, at every step, "
@@ -72,7 +72,7 @@ def run(args) -> int:
             f"{args.output})",
             file=sys.stderr,
         )
-    return report_failures(results, "have no clearance (blank cells)")
+    return max(report_failures(results, "have no clearance (blank cells)"), report_limits(results))
 
 
 def write_table(measured, path, geometry, sweep) -> None:

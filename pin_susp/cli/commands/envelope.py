@@ -4,7 +4,7 @@ mm (docs/clearance.md), written atomically."""
 from __future__ import annotations
 
 from ..options import check_outputs, geometry_argument
-from ..report import progress_bar, report_failures
+from ..report import progress_bar, report_failures, report_limits
 
 DESCRIPTION = (
     "Solve SWEEP on GEOMETRY (a corner, an axle or a vehicle; e.g. a bump × steer grid) and "
@@ -63,4 +63,4 @@ def run(args) -> int:
             )
         )
         print(f"wrote {args.output}")
-    return report_failures(results, "are left out of the envelope")
+    return max(report_failures(results, "are left out of the envelope"), report_limits(results))

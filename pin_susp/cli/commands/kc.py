@@ -6,7 +6,7 @@ and case; the rates' range and each case's compliance printed."""
 from __future__ import annotations
 
 from ..options import check_image, check_outputs, run_arguments
-from ..report import progress_bar, report_failures
+from ..report import progress_bar, report_failures, report_limits
 from .loads import chosen_case
 
 DESCRIPTION = (
@@ -104,7 +104,7 @@ def run(args) -> int:
             print(f"wrote {args.plot}")
         if page is not None:
             print(f"wrote {args.view} ({frames} frames, bushings coloured under {case!r})")
-    return report_failures(results)
+    return max(report_failures(results), report_limits(results))
 
 
 def _replay(subject, kc, table, results, case: str, cases_path) -> tuple[str, int]:

@@ -6,7 +6,7 @@ compression of each member printed. Its inputs and solve are shared with `view
 from __future__ import annotations
 
 from ..options import check_image, check_outputs, run_arguments
-from ..report import progress_bar, report_failures
+from ..report import progress_bar, report_failures, report_limits
 from .sweep import write_results
 
 DESCRIPTION = (
@@ -62,7 +62,7 @@ def run(args) -> int:
         _force_summary(forces)
         if plot:
             print(f"wrote {args.plot}")
-    return report_failures(results)
+    return max(report_failures(results), report_limits(results))
 
 
 def load_inputs(geometry, sweep, cases):
