@@ -544,9 +544,10 @@ class Linkage(Composed):
                     names.append(point)
         if not names:
             return ""
+        said = f"the wheel centre held, the joints at {', '.join(names)} still move"
         if "rocker_axis_a" in names:  # a file may give the axis as pivot + direction
-            names[names.index("rocker_axis_a")] = "rocker_axis_a (or rocker_pivot/rocker_axis)"
-        return f"the wheel centre held, the joints at {', '.join(names)} still move"
+            said += "; a rocker by rocker_pivot and rocker_axis has its axis points there"
+        return said
 
     def motion(self, qs: list, tangents: list | None = None) -> dict[str, Dual]:
         """Every named point at each configuration, with its exact rates per driver.
