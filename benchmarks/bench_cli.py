@@ -1,0 +1,253 @@
+"""How long `pin-susp sweep` takes through the command line, by length, and where it goes.
+
+    python benchmarks/bench_cli.py [--rounds N] [--steps 11,201,...] [--json OUT.json]
+
+The example corner's combined bump + steer sweep (examples/double_wishbone.yaml; wheel
+centre z −40…120 mm with the rack −40…40 mm, the sweep of issue 17) is run through the
+CLI to CSV (``python -m pin_susp sweep GEOMETRY SWEEP -o out.csv -q``) at 11, 201, 501,
+1 001, 2 001, 5 001 and 20 001 steps, in alternation, ``--rounds`` times (default 3); the
+best wall time of each length is kept (the machine is shared: the best is the quiet
+one). Each run is split by time.perf_counter marks around its parts (this file run as
+a child with ``--child``; the marks cost nothing measurable):
+
+- start: the interpreter's start (the wall time less the child's own);
+- import: ``pin_susp.cli`` and the numerics (numpy, pinocchio, the model's modules);
+- build: the corner (load_subject: YAML, URDF, Pinocchio model, design state);
+- batched set-up: the model's tree and rows as arrays (bulk.Tree, bulk.Rows), once;
+- solve: every step (march.py; a sweep of bulk.MIN_STEPS or more solved at once);
+- columns: every metric, derivative and point column (Assembly.sweep_results);
+- writer import: pyarrow and pyarrow.compute, for a table of tables.FAST_CELLS cells
+  or more (the compiled text style), once;
+- write: the CSV's text and file (less the writer import);
+- other: the rest (argument parsing, the sweep file, the summary).
+
+It prints each length's wall time and split, the marginal cost per step between
+lengths (the target of issue 30: <= 40 us per step between 201 and 2 001 steps and
+beyond), the fixed costs by name (the 11-step run's split), and the ratio of a
+baseline run in this process — the point-based formulation with scipy least_squares
+and its analytic Jacobian, warm-started step to step (bench_sweep.baseline) on 101
+steps of the same sweep — to the CLI's marginal cost per step. A sweep of more than
+sweep.STREAM_STEPS steps streams: its solve, columns and write overlap (the writer is
+a second thread), so its split sums to more than its wall time.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+STEPS = (11, 201, 501, 1001, 2001, 5001, 20001)
+PAIRS = ((11, 201), (201, 2001), (2001, 5001), (2001, 20001))
+PHASES = (
+    "start",
+    "import",
+    "build",
+    "batched set-up",
+    "solve",
+    "columns",
+    "writer import",
+    "write",
+    "other",
+)
+OPEN_KINEMATICS_MS = (8.0, 14.0)  # per step, measured outside this repository (issue 30)
+
+
+def sweep_file(folder: Path, steps: int) -> Path:
+    path = folder / f"sweep_{steps}.yaml"
+    path.write_text(
+        f"version: 1\nsteps: {steps}\ntargets:\n"
+        "  - {point: wheel_center, direction: {axis: z}, start: -40, stop: 120}\n"
+        "  - {point: trackrod_inboard, direction: {axis: y}, start: -40, stop: 40}\n"
+    )
+    return path
+
+
+# -- the child: one CLI run, split -------------------------------------------------------
+
+
+def child(sweep: str, out: str) -> None:
+    """Run `pin-susp sweep` once in this process and print its split as JSON."""
+    started = time.perf_counter()
+    import pin_susp.cli.commands.sweep as command  # noqa: F401 (its imports, as the CLI's)
+    import pin_susp.io.tables as tables
+    import pin_susp.model.sweep as sweeps
+    import pin_susp.solve.bulk as bulk
+    import pin_susp.subjects.assembly as assembly
+    import pin_susp.subjects.subject as subject
+    from pin_susp.cli import main
+
+    imported = time.perf_counter()
+    spent: dict[str, float] = {}
+
+    def timed(owner, name: str, phase: str, before=None) -> None:
+        original = getattr(owner, name)
+
+        def wrapper(*args, **kwargs):
+            t = time.perf_counter()
+            if before is not None:
+                before(*args)
+            try:
+                return original(*args, **kwargs)
+            finally:
+                spent[phase] = spent.get(phase, 0.0) + time.perf_counter() - t
+
+        setattr(owner, name, wrapper)
+
+    def writer_import(stream, *_) -> None:
+        if stream.fast and "pyarrow.compute" not in sys.modules:
+            t = time.perf_counter()
+            import pyarrow  # noqa: F401
+            import pyarrow.compute  # noqa: F401
+
+            spent["writer import"] = time.perf_counter() - t
+
+    timed(subject, "load_subject", "build")
+    timed(sweeps, "load_sweep", "sweep file")
+    timed(bulk.Tree, "__init__", "batched set-up")
+    timed(bulk.Rows, "__init__", "batched set-up")
+    timed(assembly.Assembly, "solve_steps", "solve")
+    timed(assembly.Assembly, "sweep_results", "columns")
+    timed(tables.CsvStream, "write", "write", writer_import)
+    code = main(["sweep", "examples/double_wishbone.yaml", sweep, "-o", out, "-q"])
+    total = time.perf_counter() - started
+    if code:
+        raise SystemExit(code)
+    spent["solve"] = spent.get("solve", 0.0) - spent.get("batched set-up", 0.0)
+    spent["write"] = spent.get("write", 0.0) - spent.get("writer import", 0.0)
+    spent["import"] = imported - started
+    spent["other"] = total - sum(v for k, v in spent.items() if k != "sweep file")
+    spent["total"] = total
+    print(json.dumps(spent))
+
+
+# -- the parent --------------------------------------------------------------------------
+
+
+def run_once(sweep: Path, out: Path) -> dict:
+    root = Path(__file__).resolve().parent.parent
+    env = dict(
+        os.environ, PYTHONPATH=os.pathsep.join([str(root), os.environ.get("PYTHONPATH", "")])
+    )
+    started = time.perf_counter()
+    done = subprocess.run(
+        [sys.executable, __file__, "--child", str(sweep), str(out)],
+        check=True,
+        capture_output=True,
+        text=True,
+        cwd=root,
+        env=env,
+    )
+    wall = time.perf_counter() - started
+    split = json.loads(done.stdout.strip().splitlines()[-1])
+    split["start"] = wall - split.pop("total")
+    split["wall"] = wall
+    return split
+
+
+def measure(steps: tuple[int, ...], rounds: int) -> dict[int, dict]:
+    """Each length's best run (by wall time) over ``rounds`` rounds in alternation."""
+    folder = Path(tempfile.mkdtemp(prefix="bench_cli_"))
+    try:
+        files = {n: sweep_file(folder, n) for n in steps}
+        best: dict[int, dict] = {}
+        for _ in range(rounds):
+            for n in steps:
+                split = run_once(files[n], folder / "out.csv")
+                if n not in best or split["wall"] < best[n]["wall"]:
+                    best[n] = split
+        return best
+    finally:
+        for path in folder.iterdir():
+            path.unlink()
+        folder.rmdir()
+
+
+def baseline_us(steps: int = 101) -> float:
+    """The point-based formulation per step (bench_sweep.baseline, analytic Jacobian)."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from bench_sweep import baseline, issue_sweep
+
+    import pin_susp
+
+    corner = pin_susp.Corner(EXAMPLES / "double_wishbone.yaml")
+    return baseline(corner, issue_sweep(steps), "analytic", 2)["time_us_per_step"]
+
+
+def marginals(best: dict[int, dict]) -> dict[str, float]:
+    out = {}
+    for short, long in PAIRS:
+        if short in best and long in best:
+            wall = best[long]["wall"] - best[short]["wall"]
+            out[f"{short}-{long}"] = wall / (long - short) * 1e6
+    return out
+
+
+def show(best: dict[int, dict], margin: dict[str, float], base: float | None) -> None:
+    print(
+        "pin-susp sweep examples/double_wishbone.yaml (bump + steer: wheel centre z -40...120 "
+        "mm, rack -40...40 mm) to CSV, best of the rounds, s:"
+    )
+    print(f"  {'steps':>6s} {'wall':>6s}  " + " ".join(f"{p[:10]:>10s}" for p in PHASES))
+    for n, split in sorted(best.items()):
+        cells = " ".join(f"{split.get(p, 0.0):10.3f}" for p in PHASES)
+        print(f"  {n:6d} {split['wall']:6.3f}  {cells}")
+    print("marginal cost per step (difference of best wall times over the extra steps):")
+    for pair, us in margin.items():
+        flag = "" if us <= 40 else "  (target <= 40 us)"
+        print(f"  {pair:>12s} steps: {us:6.1f} us per step{flag}")
+    if 11 in best:
+        fixed = best[11]
+        named = ", ".join(f"{p} {fixed.get(p, 0.0) * 1e3:.0f} ms" for p in PHASES)
+        print(f"fixed cost (the 11-step run, {fixed['wall'] * 1e3:.0f} ms): {named}")
+    paid = {n: s for n, s in best.items() if s.get("writer import")}
+    if paid:
+        n = min(paid)
+        print(
+            f"  paid by longer tables: writer import {paid[n]['writer import'] * 1e3:.0f} ms "
+            f"(from {n} steps here: tables.FAST_CELLS cells), batched set-up "
+            f"{best[max(best)].get('batched set-up', 0.0) * 1e3:.0f} ms (from bulk.MIN_STEPS)"
+        )
+    if base is not None and margin:
+        worst = max(margin.get("201-2001", 0.0), margin.get("2001-20001", 0.0))
+        low, high = OPEN_KINEMATICS_MS
+        print(
+            f"baseline in this process: point-based least_squares (analytic Jacobian) "
+            f"{base:.0f} us per step = {base / worst:.0f}x the CLI's worst marginal "
+            f"({worst:.1f} us); open-kinematics' {low:.0f}-{high:.0f} ms per step "
+            f"(measured outside) = {low * 1e3 / worst:.0f}-{high * 1e3 / worst:.0f}x"
+        )
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--rounds", type=int, default=3, help="runs of each length")
+    parser.add_argument(
+        "--steps", default=",".join(map(str, STEPS)), help="comma-separated sweep lengths"
+    )
+    parser.add_argument("--no-baseline", action="store_true", help="skip the point-based run")
+    parser.add_argument("--json", metavar="OUT.json", help="also write the figures as JSON")
+    parser.add_argument("--child", nargs=2, metavar=("SWEEP", "OUT"), help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.child:
+        child(*args.child)
+        return
+    steps = tuple(int(s) for s in args.steps.split(","))
+    best = measure(steps, args.rounds)
+    margin = marginals(best)
+    base = None if args.no_baseline else baseline_us()
+    show(best, margin, base)
+    if args.json:
+        figures = {"best": best, "marginal_us_per_step": margin, "baseline_us_per_step": base}
+        Path(args.json).write_text(json.dumps(figures, indent=2))
+        print(f"wrote {args.json}")
+
+
+if __name__ == "__main__":
+    main()
