@@ -351,3 +351,27 @@ def test_a_parquet_stream_of_many_small_chunks_still_writes_the_same_bytes(tmp_p
         for part in chunks(results, [101] * (n // 101) + [n % 101]):
             out.write(part)
     assert (tmp_path / "s.parquet").read_bytes() == (tmp_path / "whole.parquet").read_bytes()
+
+
+@pytest.mark.parametrize("nan_null", [False, True])
+def test_arrow_arrays_from_numpys_buffers_are_pyarrows_own(nan_null):
+    # the compiled style's arrays are built on numpy's buffers (no Python conversion:
+    # pyarrow's imports pandas); each equals pyarrow's own conversion of the column
+    import pyarrow as pa
+
+    columns = edge_results(61).columns
+    for name in ("edge", "any_bits", "undefined", "fixed_tiny", "solver_converged", "step_index"):
+        for values in (columns[name], columns[name][1::3], columns[name][:0]):
+            ours = tables._arrow_from_numpy(values, pa, nan_null=nan_null)
+            theirs = pa.array(values, from_pandas=nan_null)
+            assert ours.type == theirs.type and ours.null_count == theirs.null_count, name
+            nulls = ours.is_null().to_pylist()
+            assert nulls == theirs.is_null().to_pylist(), name
+            a, b = (x.to_numpy(zero_copy_only=False) for x in (ours, theirs))
+            if values.dtype.kind == "f":  # bit for bit (-0.0, NaN)
+                assert same_bits(a, b), name
+            else:
+                assert ours.equals(theirs) and list(a) == list(values), name
+    texts = [n for n in NAMES] + ["", "ü"]
+    assert tables._text_array(texts, pa).to_pylist() == texts
+    assert [s.as_py() for s in tables._texts(texts, pa)] == texts

@@ -200,7 +200,10 @@ def _arrow_rows(columns: list):
     """Rows of CSV text (a pyarrow buffer: cells joined by commas, each row ending in \n).
 
     Every float column's values are formatted in one call, end to end; a column whose
-    every value is the same (a fixed point of the chassis) by its one value."""
+    every value is the same (a fixed point of the chassis) by its one value. Every
+    Arrow value is made from numpy's buffers (``_arrow_from_numpy``, ``_texts``), none
+    from a Python object: pyarrow converts those through a check that imports pandas
+    (~0.2 s, the whole of a mid-length sweep's writing)."""
     import pyarrow as pa
     import pyarrow.compute as pc
 
@@ -212,17 +215,17 @@ def _arrow_rows(columns: list):
         if kind == "f":
             where.append(i)
         elif kind == "b":
-            cells[i] = pc.if_else(pa.array(v), "True", "False")
+            cells[i] = pc.if_else(_arrow_from_numpy(v, pa), *_texts(["True", "False"], pa))
         elif kind in "iu":
-            cells[i] = pc.cast(pa.array(v), pa.string())
+            cells[i] = pc.cast(_arrow_from_numpy(v, pa), pa.string())
         else:  # names and mixed columns, one by one
-            cells[i] = pa.array([format_cell(x) for x in v], pa.string())
+            cells[i] = _text_array([format_cell(x) for x in v], pa)
     if where:
         floats = np.array([columns[i] for i in where], dtype=float)  # a column a row
         bits = floats.view(np.uint64)
         same = (bits == bits[:, :1]).all(axis=1)  # by bits: -0.0 is not 0.0
         values = np.concatenate([floats[~same].ravel(), floats[same, 0]])
-        text = pc.cast(pa.array(values, from_pandas=True), pa.string())
+        text = pc.cast(_arrow_from_numpy(values, pa, nan_null=True), pa.string())
         whole = np.isfinite(values) & (values == np.trunc(values))
         care = whole | np.isnan(values)  # the cells _float_cells changes
         varying = np.array(where)[~same]
@@ -245,11 +248,12 @@ def _arrow_rows(columns: list):
     if isinstance(parts[-1], str):
         parts[-1] += "\n"
     else:
-        parts[-1] = pc.binary_join_element_wise(parts[-1], "\n", "")
+        parts[-1] = pc.binary_join_element_wise(parts[-1], *_texts(["\n", ""], pa))
     if isinstance(parts[0], str) and len(parts) == 1:  # every column the same all along
-        parts = [pa.repeat(pa.scalar(parts[0]), rows)]
-    args = [pa.scalar(c) if isinstance(c, str) else c for c in parts]
-    joined = pc.binary_join_element_wise(*args, ",")
+        parts = [pa.repeat(_texts(parts, pa)[0], rows)]
+    fixed = iter(_texts([c for c in parts if isinstance(c, str)] + [","], pa))
+    args = [next(fixed) if isinstance(c, str) else c for c in parts]
+    joined = pc.binary_join_element_wise(*args, next(fixed))
     offsets = np.frombuffer(joined.buffers()[1], np.int32, len(joined) + 1, 4 * joined.offset)
     return joined.buffers()[2][offsets[0] : offsets[-1]]
 
@@ -259,9 +263,45 @@ def _float_cells(text, whole: np.ndarray, pa, pc):
     value (NaN, a null) is an empty cell; a whole number (``whole``) in fixed notation
     gets ``.0`` (``100.0``, ``-0.0``: a reader still sees a float)."""
     if whole.any():
-        plain = pc.and_(pa.array(whole), pc.invert(pc.match_substring(text, "e")))  # 1e+16
-        text = pc.if_else(plain, pc.binary_join_element_wise(text, ".0", ""), text)
-    return pc.fill_null(text, "") if text.null_count else text
+        plain = pc.and_(_arrow_from_numpy(whole, pa), pc.invert(pc.match_substring(text, "e")))
+        point, empty = _texts([".0", ""], pa)  # plain: not 1e+16
+        text = pc.if_else(plain, pc.binary_join_element_wise(text, point, empty), text)
+    return pc.fill_null(text, _texts([""], pa)[0]) if text.null_count else text
+
+
+def _arrow_from_numpy(values: np.ndarray, pa, nan_null: bool = False):
+    """A numpy column (flags, integers or floats) as an Arrow array on its own buffers:
+    ``pa.array(values, from_pandas=nan_null)``'s array (an undefined value, NaN, a null
+    where ``nan_null``) without its check of pandas' types, which imports pandas."""
+    v = np.ascontiguousarray(values)
+    n = len(v)
+    if v.dtype.kind == "b":
+        return pa.Array.from_buffers(pa.bool_(), n, [None, _bits(v, pa)])
+    valid, nulls = None, 0
+    if nan_null and v.dtype.kind == "f":
+        defined = ~np.isnan(v)
+        nulls = n - int(np.count_nonzero(defined))
+        valid = _bits(defined, pa) if nulls else None
+    return pa.Array.from_buffers(pa.from_numpy_dtype(v.dtype), n, [valid, pa.py_buffer(v)], nulls)
+
+
+def _bits(flags: np.ndarray, pa):
+    """Flags as Arrow's bitmap (least significant bit first)."""
+    return pa.py_buffer(np.packbits(flags, bitorder="little"))
+
+
+def _text_array(texts: list[str], pa):
+    """Python strings as an Arrow string array on one buffer (no Python conversion)."""
+    data = [t.encode() for t in texts]
+    offsets = np.concatenate([[0], np.cumsum([len(d) for d in data])]).astype(np.int32)
+    joined = pa.py_buffer(b"".join(data))
+    return pa.StringArray.from_buffers(len(data), pa.py_buffer(offsets), joined)
+
+
+def _texts(texts: list[str], pa) -> list:
+    """Python strings as Arrow string scalars (``_text_array``'s)."""
+    array = _text_array(texts, pa)
+    return [array[i] for i in range(len(texts))]
 
 
 # -- Parquet -----------------------------------------------------------------------------
