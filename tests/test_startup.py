@@ -111,6 +111,25 @@ def test_a_sweep_long_enough_for_the_compiled_style_imports_pyarrow_but_not_pand
     assert [int(r["step_index"]) for r in rows] == list(range(1001))
 
 
+def test_a_sweep_to_parquet_imports_pyarrow_but_not_pandas(inputs):
+    # its numbers and flags go to Arrow on numpy's buffers (tables.arrow_column)
+    import pyarrow.parquet as pq
+
+    code, modules, proc = run_cli(
+        inputs, "sweep", "double_wishbone.yaml", "bump_steer.yaml", "-o", "out.parquet", "-q"
+    )
+    assert code == 0, proc.stderr
+    assert "pyarrow.parquet" in modules
+    assert imported(modules, ("pandas", "scipy", "matplotlib")) == []
+    table = pq.read_table(inputs / "out.parquet")
+    results = pin_susp.Corner(EXAMPLES / "double_wishbone.yaml").run_sweep(
+        EXAMPLES / "bump_steer.yaml"
+    )
+    assert table.column_names == list(results.keys())
+    for name in ("camber", "roadwheel_angle", "solver_converged", "step_index"):
+        assert table.column(name).to_pylist() == list(results[name])
+
+
 @pytest.mark.parametrize(
     "argv, output",
     [

@@ -401,10 +401,13 @@ class ParquetStream(_Stream):
 
 
 def arrow_column(values):
-    """A column for Arrow (Parquet): an undefined value (NaN, a blank CSV cell) is null."""
+    """A column for Arrow (Parquet): an undefined value (NaN, a blank CSV cell) is null;
+    numbers and flags on numpy's buffers (``_arrow_from_numpy``: no pandas imported)."""
     import pyarrow as pa
 
     values = np.asarray(values)
+    if values.dtype.kind in "biuf":
+        return _arrow_from_numpy(values, pa, nan_null=values.dtype.kind == "f")
     return pa.array(values, from_pandas=values.dtype.kind == "f")
 
 
