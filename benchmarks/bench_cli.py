@@ -16,8 +16,8 @@ a child with ``--child``; the marks cost nothing measurable):
 - batched set-up: the model's tree and rows as arrays (bulk.Tree, bulk.Rows), once;
 - solve: every step (march.py; a sweep of bulk.MIN_STEPS or more solved at once);
 - columns: every metric, derivative and point column (Assembly.sweep_results);
-- writer import: pyarrow and pyarrow.compute, for a table of tables.FAST_CELLS cells
-  or more (the compiled text style), once;
+- writer import: pyarrow and its compute kernels (tables._compute), for a table of
+  tables.FAST_CELLS cells or more (the compiled text style), once;
 - write: the CSV's text and file (less the writer import);
 - other: the rest (argument parsing, the sweep file, the summary).
 
@@ -101,10 +101,9 @@ def child(sweep: str, out: str) -> None:
         setattr(owner, name, wrapper)
 
     def writer_import(stream, *_) -> None:
-        if stream.fast and "pyarrow.compute" not in sys.modules:
+        if stream.fast and not tables._KERNELS:
             t = time.perf_counter()
-            import pyarrow  # noqa: F401
-            import pyarrow.compute  # noqa: F401
+            tables._compute()  # pyarrow and its kernels (what _arrow_rows imports)
 
             spent["writer import"] = time.perf_counter() - t
 

@@ -375,3 +375,19 @@ def test_arrow_arrays_from_numpys_buffers_are_pyarrows_own(nan_null):
     texts = [n for n in NAMES] + ["", "ü"]
     assert tables._text_array(texts, pa).to_pylist() == texts
     assert [s.as_py() for s in tables._texts(texts, pa)] == texts
+
+
+def test_the_kernels_by_name_write_what_pyarrow_compute_writes(tmp_path, monkeypatch):
+    # tables._Kernels calls pyarrow's kernels by name; pyarrow.compute's own functions
+    # (its fallback) must give the same bytes on every kind of value
+    import pyarrow.compute
+
+    monkeypatch.setattr(tables, "FAST_CELLS", 0)
+    results = edge_results()
+    tables._compute()
+    assert isinstance(tables._KERNELS[0], tables._Kernels)
+    ours = tables.csv_text(results)
+    monkeypatch.setattr(tables, "_KERNELS", [pyarrow.compute])
+    assert tables.csv_text(results) == ours
+    tables.write_csv(results, tmp_path / "out.csv")
+    check_cells(results, tmp_path / "out.csv")

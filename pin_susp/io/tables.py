@@ -205,8 +205,8 @@ def _arrow_rows(columns: list):
     from a Python object: pyarrow converts those through a check that imports pandas
     (~0.2 s, the whole of a mid-length sweep's writing)."""
     import pyarrow as pa
-    import pyarrow.compute as pc
 
+    pc = _compute()
     rows = len(columns[0])
     cells: list = [None] * len(columns)
     where = []  # the float columns
@@ -267,6 +267,58 @@ def _float_cells(text, whole: np.ndarray, pa, pc):
         point, empty = _texts([".0", ""], pa)  # plain: not 1e+16
         text = pc.if_else(plain, pc.binary_join_element_wise(text, point, empty), text)
     return pc.fill_null(text, _texts([""], pa)[0]) if text.null_count else text
+
+
+class _Kernels:
+    """The pyarrow.compute functions the compiled style calls, by the same names, each
+    pyarrow's own kernel called by name (``call_function``) from pyarrow._compute, the
+    module pyarrow.compute wraps: without the Python wrapper pyarrow.compute makes for
+    each of its functions as it is imported (~25 ms, a third of what pyarrow costs a
+    mid-length sweep: benchmarks/bench_cli.py). Every argument is an Arrow value."""
+
+    def __init__(self, kernels):
+        self._call = kernels.call_function
+        self._cast = kernels.CastOptions.safe
+        self._match = kernels.MatchSubstringOptions
+
+    def cast(self, values, target):
+        return self._call("cast", [values], self._cast(target))
+
+    def if_else(self, condition, left, right):
+        return self._call("if_else", [condition, left, right])
+
+    def binary_join_element_wise(self, *strings):  # the last: the separator
+        return self._call("binary_join_element_wise", list(strings))
+
+    def and_(self, left, right):
+        return self._call("and", [left, right])
+
+    def invert(self, values):
+        return self._call("invert", [values])
+
+    def match_substring(self, values, pattern: str):
+        return self._call("match_substring", [values], self._match(pattern))
+
+    def fill_null(self, values, fill):
+        return self._call("coalesce", [values, fill])
+
+
+_KERNELS = []
+
+
+def _compute():
+    """_Kernels on pyarrow._compute, once; pyarrow.compute itself (the same names) where
+    a pyarrow has not that module's names."""
+    if not _KERNELS:
+        try:
+            from pyarrow import _compute as kernels
+
+            _KERNELS.append(_Kernels(kernels))
+        except (ImportError, AttributeError):
+            import pyarrow.compute
+
+            _KERNELS.append(pyarrow.compute)
+    return _KERNELS[0]
 
 
 def _arrow_from_numpy(values: np.ndarray, pa, nan_null: bool = False):
