@@ -1,14 +1,17 @@
 """How long `pin-susp sweep` takes through the command line, by length, and where it goes.
 
-    python benchmarks/bench_cli.py [--rounds N] [--steps 11,201,...] [--json OUT.json]
+    python benchmarks/bench_cli.py [--rounds N] [--steps 11,201,...] [--as-is] [--json OUT.json]
 
 The example corner's combined bump + steer sweep (examples/double_wishbone.yaml; wheel
 centre z −40…120 mm with the rack −40…40 mm, the sweep of issue 17) is run through the
 CLI to CSV (``python -m pin_susp sweep GEOMETRY SWEEP -o out.csv -q``) at 11, 201, 501,
 1 001, 2 001, 5 001 and 20 001 steps, in alternation, ``--rounds`` times (default 3); the
 best wall time of each length is kept (the machine is shared: the best is the quiet
-one). Each run is split by time.perf_counter marks around its parts (this file run as
-a child with ``--child``; the marks cost nothing measurable):
+one). Each child caches its bytecode in a temporary folder (PYTHONPYCACHEPREFIX), as an
+installed copy has it (``make`` compiles it), even where PYTHONDONTWRITEBYTECODE is set
+(``--as-is``: as the environment has it; pin_susp is then compiled from source by every
+run, ~0.1 s more import). Each run is split by time.perf_counter marks around its parts
+(this file run as a child with ``--child``; the marks cost nothing measurable):
 
 - start: the interpreter's start (the wall time less the child's own);
 - import: ``pin_susp.cli`` and the numerics (numpy, pinocchio, the model's modules);
@@ -23,10 +26,12 @@ a child with ``--child``; the marks cost nothing measurable):
 
 It prints each length's wall time and split, the marginal cost per step between
 lengths (the target of issue 30: <= 40 us per step between 201 and 2 001 steps and
-beyond), the fixed costs by name (the 11-step run's split), and the ratio of a
-baseline run in this process — the point-based formulation with scipy least_squares
-and its analytic Jacobian, warm-started step to step (bench_sweep.baseline) on 101
-steps of the same sweep — to the CLI's marginal cost per step. A sweep of more than
+beyond; also less each run's start and import, which do not depend on the length and
+hold most of the machine's noise), the fixed costs by name (the 11-step run's split),
+and the ratio of a baseline run in this process — the point-based formulation with
+scipy least_squares and its analytic Jacobian, warm-started step to step
+(bench_sweep.baseline) on 101 steps of the same sweep — to the CLI's marginal cost
+per step. A sweep of more than
 sweep.STREAM_STEPS steps streams: its solve, columns and write overlap (the writer is
 a second thread), so its split sums to more than its wall time.
 """
@@ -101,9 +106,13 @@ def child(sweep: str, out: str) -> None:
         setattr(owner, name, wrapper)
 
     def writer_import(stream, *_) -> None:
-        if stream.fast and not tables._KERNELS:
+        if stream.fast and "pyarrow" not in sys.modules:
             t = time.perf_counter()
-            tables._compute()  # pyarrow and its kernels (what _arrow_rows imports)
+            load = getattr(tables, "_compute", None)  # pyarrow and its kernels
+            if load is not None:
+                load()
+            else:  # before tables._compute: what _arrow_rows imported
+                import pyarrow.compute  # noqa: F401
 
             spent["writer import"] = time.perf_counter() - t
 
@@ -129,11 +138,8 @@ def child(sweep: str, out: str) -> None:
 # -- the parent --------------------------------------------------------------------------
 
 
-def run_once(sweep: Path, out: Path) -> dict:
+def run_once(sweep: Path, out: Path, env: dict) -> dict:
     root = Path(__file__).resolve().parent.parent
-    env = dict(
-        os.environ, PYTHONPATH=os.pathsep.join([str(root), os.environ.get("PYTHONPATH", "")])
-    )
     started = time.perf_counter()
     done = subprocess.run(
         [sys.executable, __file__, "--child", str(sweep), str(out)],
@@ -150,22 +156,39 @@ def run_once(sweep: Path, out: Path) -> dict:
     return split
 
 
-def measure(steps: tuple[int, ...], rounds: int) -> dict[int, dict]:
-    """Each length's best run (by wall time) over ``rounds`` rounds in alternation."""
+def child_env(folder: Path, bytecode: bool) -> dict:
+    """The children's environment: this checkout first on the path; with ``bytecode``,
+    every module's bytecode cached under ``folder`` (PYTHONPYCACHEPREFIX: as installed,
+    where `make` compiles it) even where the environment says not to write it
+    (PYTHONDONTWRITEBYTECODE: each run then compiles pin_susp from source, ~0.1 s)."""
+    root = Path(__file__).resolve().parent.parent
+    path = os.pathsep.join([str(root), os.environ.get("PYTHONPATH", "")])
+    env = dict(os.environ, PYTHONPATH=path)
+    if bytecode:
+        env.pop("PYTHONDONTWRITEBYTECODE", None)
+        env["PYTHONPYCACHEPREFIX"] = str(folder / "pycache")
+    return env
+
+
+def measure(steps: tuple[int, ...], rounds: int, bytecode: bool = True) -> dict[int, dict]:
+    """Each length's best run (by wall time) over ``rounds`` rounds in alternation,
+    after a warm-up run (which writes the bytecode)."""
+    import shutil
+
     folder = Path(tempfile.mkdtemp(prefix="bench_cli_"))
     try:
         files = {n: sweep_file(folder, n) for n in steps}
+        env = child_env(folder, bytecode)
+        run_once(files[steps[0]], folder / "out.csv", env)
         best: dict[int, dict] = {}
         for _ in range(rounds):
             for n in steps:
-                split = run_once(files[n], folder / "out.csv")
+                split = run_once(files[n], folder / "out.csv", env)
                 if n not in best or split["wall"] < best[n]["wall"]:
                     best[n] = split
         return best
     finally:
-        for path in folder.iterdir():
-            path.unlink()
-        folder.rmdir()
+        shutil.rmtree(folder)
 
 
 def baseline_us(steps: int = 101) -> float:
@@ -179,28 +202,40 @@ def baseline_us(steps: int = 101) -> float:
     return baseline(corner, issue_sweep(steps), "analytic", 2)["time_us_per_step"]
 
 
-def marginals(best: dict[int, dict]) -> dict[str, float]:
+def marginals(best: dict[int, dict], net: bool = False) -> dict[str, float]:
+    """us per step between lengths: of the best wall times, or (``net``) of the wall
+    times less the interpreter's start and the imports, which do not depend on the
+    length (the shared machine's noise is mostly there)."""
+
+    def work(split):
+        return split["wall"] - (split["start"] + split["import"] if net else 0.0)
+
     out = {}
     for short, long in PAIRS:
         if short in best and long in best:
-            wall = best[long]["wall"] - best[short]["wall"]
-            out[f"{short}-{long}"] = wall / (long - short) * 1e6
+            extra = work(best[long]) - work(best[short])
+            out[f"{short}-{long}"] = extra / (long - short) * 1e6
     return out
 
 
-def show(best: dict[int, dict], margin: dict[str, float], base: float | None) -> None:
+def show(best: dict, margin: dict, net: dict, base: float | None, bytecode: bool) -> None:
     print(
         "pin-susp sweep examples/double_wishbone.yaml (bump + steer: wheel centre z -40...120 "
-        "mm, rack -40...40 mm) to CSV, best of the rounds, s:"
+        "mm, rack -40...40 mm) to CSV, best of the rounds, s"
+        + ("" if bytecode else " (bytecode as the environment has it)")
+        + ":"
     )
     print(f"  {'steps':>6s} {'wall':>6s}  " + " ".join(f"{p[:10]:>10s}" for p in PHASES))
     for n, split in sorted(best.items()):
         cells = " ".join(f"{split.get(p, 0.0):10.3f}" for p in PHASES)
         print(f"  {n:6d} {split['wall']:6.3f}  {cells}")
-    print("marginal cost per step (difference of best wall times over the extra steps):")
+    print(
+        "marginal cost per step (difference of best wall times over the extra steps; "
+        "in brackets, less start and import):"
+    )
     for pair, us in margin.items():
         flag = "" if us <= 40 else "  (target <= 40 us)"
-        print(f"  {pair:>12s} steps: {us:6.1f} us per step{flag}")
+        print(f"  {pair:>12s} steps: {us:6.1f} us per step ({net[pair]:5.1f}){flag}")
     if 11 in best:
         fixed = best[11]
         named = ", ".join(f"{p} {fixed.get(p, 0.0) * 1e3:.0f} ms" for p in PHASES)
@@ -231,6 +266,11 @@ def main() -> None:
         "--steps", default=",".join(map(str, STEPS)), help="comma-separated sweep lengths"
     )
     parser.add_argument("--no-baseline", action="store_true", help="skip the point-based run")
+    parser.add_argument(
+        "--as-is",
+        action="store_true",
+        help="the environment's bytecode setting (default: bytecode cached, as installed)",
+    )
     parser.add_argument("--json", metavar="OUT.json", help="also write the figures as JSON")
     parser.add_argument("--child", nargs=2, metavar=("SWEEP", "OUT"), help=argparse.SUPPRESS)
     args = parser.parse_args()
@@ -238,12 +278,18 @@ def main() -> None:
         child(*args.child)
         return
     steps = tuple(int(s) for s in args.steps.split(","))
-    best = measure(steps, args.rounds)
-    margin = marginals(best)
+    best = measure(steps, args.rounds, bytecode=not args.as_is)
+    margin, net = marginals(best), marginals(best, net=True)
     base = None if args.no_baseline else baseline_us()
-    show(best, margin, base)
+    show(best, margin, net, base, not args.as_is)
     if args.json:
-        figures = {"best": best, "marginal_us_per_step": margin, "baseline_us_per_step": base}
+        figures = {
+            "best": best,
+            "marginal_us_per_step": margin,
+            "marginal_less_start_and_import": net,
+            "baseline_us_per_step": base,
+            "bytecode_cached": not args.as_is,
+        }
         Path(args.json).write_text(json.dumps(figures, indent=2))
         print(f"wrote {args.json}")
 
