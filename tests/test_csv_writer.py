@@ -391,3 +391,18 @@ def test_the_kernels_by_name_write_what_pyarrow_compute_writes(tmp_path, monkeyp
     assert tables.csv_text(results) == ours
     tables.write_csv(results, tmp_path / "out.csv")
     check_cells(results, tmp_path / "out.csv")
+
+
+def test_the_repr_styles_cells_are_numpys_str_of_each_value():
+    # a float64 cell is Python's repr; numpy's str (the style's text before) must agree
+    # on every kind of value, every exponent among them; NaN an empty cell
+    columns = edge_results(400, seed=1).columns
+    for name in ("edge", "any_bits", "whole", "zeros", "fixed_tiny", "last", "undefined"):
+        values = columns[name]
+        expected = values.astype(str)
+        expected[np.isnan(values)] = ""
+        assert tables._column_cells(values) == expected.tolist(), name
+    for name in ("step_index", "solver_iterations"):
+        assert tables._column_cells(columns[name]) == columns[name].astype(str).tolist()
+    single = np.array([0.1, 1e-05, np.nan], dtype=np.float32)  # its own shortest text
+    assert tables._column_cells(single) == ["0.1", "1e-05", ""]

@@ -174,13 +174,19 @@ def _repr_rows(columns: list) -> str:
 
 
 def _column_cells(values) -> list[str]:
-    """format_cell for a whole column at once (numpy's str of a float64 is the same
-    shortest round-trip text as repr): a column of numbers or flags in one call."""
+    """format_cell for a whole column at once: a column of numbers or flags in one call.
+    A float64's text is Python's repr (numpy's str of a float64 is the same shortest
+    round-trip text, at 2.5 times the cost); another float's, numpy's str."""
     v = np.asarray(values)
     if v.dtype.kind == "b":
         return np.where(v, "True", "False").tolist()
     if v.dtype.kind in "iu":
-        return v.astype(str).tolist()
+        return list(map(str, v.tolist()))
+    if v.dtype == np.float64:
+        text = list(map(float.__repr__, v.tolist()))
+        for i in np.flatnonzero(np.isnan(v)).tolist():
+            text[i] = ""
+        return text
     if v.dtype.kind == "f":
         text = v.astype(str)
         text[np.isnan(v)] = ""
