@@ -1,6 +1,7 @@
 """How long `pin-susp sweep` takes through the command line, by length, and where it goes.
 
-    python benchmarks/bench_cli.py [--rounds N] [--steps 11,201,...] [--as-is] [--json OUT.json]
+    python benchmarks/bench_cli.py [--rounds N] [--steps 11,201,...] [--against CHECKOUT]
+                                   [--as-is] [--no-baseline] [--json OUT.json]
 
 The example corner's combined bump + steer sweep (examples/double_wishbone.yaml; wheel
 centre z −40…120 mm with the rack −40…40 mm, the sweep of issue 17) is run through the
@@ -33,7 +34,9 @@ scipy least_squares and its analytic Jacobian, warm-started step to step
 (bench_sweep.baseline) on 101 steps of the same sweep — to the CLI's marginal cost
 per step. A sweep of more than
 sweep.STREAM_STEPS steps streams: its solve, columns and write overlap (the writer is
-a second thread), so its split sums to more than its wall time.
+a second thread), so its split sums to more than its wall time. ``--against CHECKOUT``
+runs another checkout (a git worktree of an earlier commit) in alternation with this
+one and prints its figures and each length's ratio of wall times.
 """
 
 from __future__ import annotations
@@ -138,8 +141,10 @@ def child(sweep: str, out: str) -> None:
 # -- the parent --------------------------------------------------------------------------
 
 
-def run_once(sweep: Path, out: Path, env: dict) -> dict:
-    root = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def run_once(sweep: Path, out: Path, env: dict, root: Path = ROOT) -> dict:
     started = time.perf_counter()
     done = subprocess.run(
         [sys.executable, __file__, "--child", str(sweep), str(out)],
@@ -156,36 +161,38 @@ def run_once(sweep: Path, out: Path, env: dict) -> dict:
     return split
 
 
-def child_env(folder: Path, bytecode: bool) -> dict:
-    """The children's environment: this checkout first on the path; with ``bytecode``,
-    every module's bytecode cached under ``folder`` (PYTHONPYCACHEPREFIX: as installed,
-    where `make` compiles it) even where the environment says not to write it
-    (PYTHONDONTWRITEBYTECODE: each run then compiles pin_susp from source, ~0.1 s)."""
-    root = Path(__file__).resolve().parent.parent
+def child_env(folder: Path, bytecode: bool, root: Path = ROOT) -> dict:
+    """The children's environment: the checkout ``root`` first on the path; with
+    ``bytecode``, every module's bytecode cached under ``folder`` (PYTHONPYCACHEPREFIX:
+    as installed, where `make` compiles it) even where the environment says not to
+    write it (PYTHONDONTWRITEBYTECODE: each run then compiles pin_susp from source)."""
     path = os.pathsep.join([str(root), os.environ.get("PYTHONPATH", "")])
     env = dict(os.environ, PYTHONPATH=path)
     if bytecode:
         env.pop("PYTHONDONTWRITEBYTECODE", None)
-        env["PYTHONPYCACHEPREFIX"] = str(folder / "pycache")
+        env["PYTHONPYCACHEPREFIX"] = str(folder / f"pycache_{abs(hash(str(root)))}")
     return env
 
 
-def measure(steps: tuple[int, ...], rounds: int, bytecode: bool = True) -> dict[int, dict]:
-    """Each length's best run (by wall time) over ``rounds`` rounds in alternation,
-    after a warm-up run (which writes the bytecode)."""
+def measure(steps: tuple[int, ...], rounds: int, bytecode: bool = True, roots=(ROOT,)) -> list:
+    """Each length's best run (by wall time) over ``rounds`` rounds in alternation, after
+    a warm-up run (which writes the bytecode), for each checkout in ``roots`` (this one,
+    then any other: ``--against``), the checkouts in alternation too."""
     import shutil
 
     folder = Path(tempfile.mkdtemp(prefix="bench_cli_"))
     try:
         files = {n: sweep_file(folder, n) for n in steps}
-        env = child_env(folder, bytecode)
-        run_once(files[steps[0]], folder / "out.csv", env)
-        best: dict[int, dict] = {}
+        envs = [child_env(folder, bytecode, root) for root in roots]
+        for root, env in zip(roots, envs, strict=True):
+            run_once(files[steps[0]], folder / "out.csv", env, root)
+        best: list[dict[int, dict]] = [{} for _ in roots]
         for _ in range(rounds):
             for n in steps:
-                split = run_once(files[n], folder / "out.csv", env)
-                if n not in best or split["wall"] < best[n]["wall"]:
-                    best[n] = split
+                for k, (root, env) in enumerate(zip(roots, envs, strict=True)):
+                    split = run_once(files[n], folder / "out.csv", env, root)
+                    if n not in best[k] or split["wall"] < best[k][n]["wall"]:
+                        best[k][n] = split
         return best
     finally:
         shutil.rmtree(folder)
@@ -272,24 +279,39 @@ def main() -> None:
         help="the environment's bytecode setting (default: bytecode cached, as installed)",
     )
     parser.add_argument("--json", metavar="OUT.json", help="also write the figures as JSON")
+    parser.add_argument(
+        "--against",
+        metavar="CHECKOUT",
+        type=Path,
+        help="another checkout of pin_susp (e.g. a git worktree of main) run in alternation: "
+        "its figures and each length's wall-time ratio this / it",
+    )
     parser.add_argument("--child", nargs=2, metavar=("SWEEP", "OUT"), help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child:
         child(*args.child)
         return
     steps = tuple(int(s) for s in args.steps.split(","))
-    best = measure(steps, args.rounds, bytecode=not args.as_is)
-    margin, net = marginals(best), marginals(best, net=True)
+    roots = (ROOT,) if args.against is None else (ROOT, args.against.resolve())
+    bests = measure(steps, args.rounds, bytecode=not args.as_is, roots=roots)
     base = None if args.no_baseline else baseline_us()
-    show(best, margin, net, base, not args.as_is)
-    if args.json:
-        figures = {
+    figures = {"baseline_us_per_step": base, "bytecode_cached": not args.as_is}
+    for root, best in zip(roots, bests, strict=True):
+        margin, net = marginals(best), marginals(best, net=True)
+        print(f"\n{root}:")
+        show(best, margin, net, base, not args.as_is)
+        figures[str(root)] = {
             "best": best,
             "marginal_us_per_step": margin,
             "marginal_less_start_and_import": net,
-            "baseline_us_per_step": base,
-            "bytecode_cached": not args.as_is,
         }
+    if len(bests) == 2:
+        ours, theirs = bests
+        ratios = {n: ours[n]["wall"] / theirs[n]["wall"] for n in ours}
+        figures["wall_ratio_this_over_against"] = ratios
+        cells = ", ".join(f"{n} steps {r:.2f}" for n, r in ratios.items())
+        print(f"\nwall time, this checkout / {roots[1]}: {cells}")
+    if args.json:
         Path(args.json).write_text(json.dumps(figures, indent=2))
         print(f"wrote {args.json}")
 
