@@ -372,6 +372,9 @@ def test_arrow_arrays_from_numpys_buffers_are_pyarrows_own(nan_null):
                 assert same_bits(a, b), name
             else:
                 assert ours.equals(theirs) and list(a) == list(values), name
+    swapped = columns["any_bits"].astype(">f8")  # another byte order: the same values
+    ours = tables._arrow_from_numpy(swapped, pa, nan_null=nan_null)
+    assert same_bits(ours.to_numpy(zero_copy_only=False), columns["any_bits"])
     texts = [n for n in NAMES] + ["", "ü"]
     assert tables._text_array(texts, pa).to_pylist() == texts
     assert [s.as_py() for s in tables._texts(texts, pa)] == texts

@@ -332,6 +332,8 @@ def _arrow_from_numpy(values: np.ndarray, pa, nan_null: bool = False):
     ``pa.array(values, from_pandas=nan_null)``'s array (an undefined value, NaN, a null
     where ``nan_null``) without its check of pandas' types, which imports pandas."""
     v = np.ascontiguousarray(values)
+    if not v.dtype.isnative:  # Arrow's buffers are little-endian, as the machine's
+        v = v.astype(v.dtype.newbyteorder("="))
     n = len(v)
     if v.dtype.kind == "b":
         return pa.Array.from_buffers(pa.bool_(), n, [None, _bits(v, pa)])
