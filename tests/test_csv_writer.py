@@ -351,3 +351,61 @@ def test_a_parquet_stream_of_many_small_chunks_still_writes_the_same_bytes(tmp_p
         for part in chunks(results, [101] * (n // 101) + [n % 101]):
             out.write(part)
     assert (tmp_path / "s.parquet").read_bytes() == (tmp_path / "whole.parquet").read_bytes()
+
+
+@pytest.mark.parametrize("nan_null", [False, True])
+def test_arrow_arrays_from_numpys_buffers_are_pyarrows_own(nan_null):
+    # the compiled style's arrays are built on numpy's buffers (no Python conversion:
+    # pyarrow's imports pandas); each equals pyarrow's own conversion of the column
+    import pyarrow as pa
+
+    columns = edge_results(61).columns
+    for name in ("edge", "any_bits", "undefined", "fixed_tiny", "solver_converged", "step_index"):
+        for values in (columns[name], columns[name][1::3], columns[name][:0]):
+            ours = tables._arrow_from_numpy(values, pa, nan_null=nan_null)
+            theirs = pa.array(values, from_pandas=nan_null)
+            assert ours.type == theirs.type and ours.null_count == theirs.null_count, name
+            nulls = ours.is_null().to_pylist()
+            assert nulls == theirs.is_null().to_pylist(), name
+            a, b = (x.to_numpy(zero_copy_only=False) for x in (ours, theirs))
+            if values.dtype.kind == "f":  # bit for bit (-0.0, NaN)
+                assert same_bits(a, b), name
+            else:
+                assert ours.equals(theirs) and list(a) == list(values), name
+    swapped = columns["any_bits"].astype(">f8")  # another byte order: the same values
+    ours = tables._arrow_from_numpy(swapped, pa, nan_null=nan_null)
+    assert same_bits(ours.to_numpy(zero_copy_only=False), columns["any_bits"])
+    texts = [n for n in NAMES] + ["", "ü"]
+    assert tables._text_array(texts, pa).to_pylist() == texts
+    assert [s.as_py() for s in tables._texts(texts, pa)] == texts
+
+
+def test_the_kernels_by_name_write_what_pyarrow_compute_writes(tmp_path, monkeypatch):
+    # tables._Kernels calls pyarrow's kernels by name; pyarrow.compute's own functions
+    # (its fallback) must give the same bytes on every kind of value
+    import pyarrow.compute
+
+    monkeypatch.setattr(tables, "FAST_CELLS", 0)
+    results = edge_results()
+    tables._compute()
+    assert isinstance(tables._KERNELS[0], tables._Kernels)
+    ours = tables.csv_text(results)
+    monkeypatch.setattr(tables, "_KERNELS", [pyarrow.compute])
+    assert tables.csv_text(results) == ours
+    tables.write_csv(results, tmp_path / "out.csv")
+    check_cells(results, tmp_path / "out.csv")
+
+
+def test_the_repr_styles_cells_are_numpys_str_of_each_value():
+    # a float64 cell is Python's repr; numpy's str (the style's text before) must agree
+    # on every kind of value, every exponent among them; NaN an empty cell
+    columns = edge_results(400, seed=1).columns
+    for name in ("edge", "any_bits", "whole", "zeros", "fixed_tiny", "last", "undefined"):
+        values = columns[name]
+        expected = values.astype(str)
+        expected[np.isnan(values)] = ""
+        assert tables._column_cells(values) == expected.tolist(), name
+    for name in ("step_index", "solver_iterations"):
+        assert tables._column_cells(columns[name]) == columns[name].astype(str).tolist()
+    single = np.array([0.1, 1e-05, np.nan], dtype=np.float32)  # its own shortest text
+    assert tables._column_cells(single) == ["0.1", "1e-05", ""]

@@ -88,6 +88,49 @@ def test_a_plain_sweep_to_csv_imports_nothing_heavy(inputs):
     assert [float(r["roadwheel_angle"]) for r in rows] == list(results["roadwheel_angle"])
 
 
+def test_a_sweep_long_enough_for_the_compiled_style_imports_pyarrow_alone(inputs):
+    # 1 001 rows of the corner's columns: past tables.FAST_CELLS, written by pyarrow from
+    # numpy's buffers (pyarrow's conversion of a Python object would import pandas)
+    from pin_susp.io.tables import fast_style
+
+    sweep = yaml.safe_load((EXAMPLES / "bump_steer.yaml").read_text()) | {"steps": 1001}
+    (inputs / "long.yaml").write_text(yaml.safe_dump(sweep))
+    code, modules, proc = run_cli(
+        inputs, "sweep", "double_wishbone.yaml", "long.yaml", "-o", "out.csv", "-q"
+    )
+    assert code == 0, proc.stderr
+    # pyarrow's kernels by name from pyarrow._compute: not pyarrow.compute's wrappers
+    assert "pyarrow._compute" in modules and "pyarrow.compute" not in modules
+    assert imported(modules, ("pandas", "scipy", "matplotlib")) == []
+    lines = (inputs / "out.csv").read_text().splitlines()
+    rows = list(csv.DictReader(line for line in lines if not line.startswith("#")))
+    assert fast_style(len(rows), len(rows[0]))
+    results = pin_susp.Corner(EXAMPLES / "double_wishbone.yaml").run_sweep(inputs / "long.yaml")
+    for name in ("camber", "roadwheel_angle", "solver_max_residual"):
+        assert [float(r[name]) for r in rows] == list(results[name])
+    assert [r["solver_converged"] for r in rows] == ["True"] * 1001
+    assert [int(r["step_index"]) for r in rows] == list(range(1001))
+
+
+def test_a_sweep_to_parquet_imports_pyarrow_but_not_pandas(inputs):
+    # its numbers and flags go to Arrow on numpy's buffers (tables.arrow_column)
+    import pyarrow.parquet as pq
+
+    code, modules, proc = run_cli(
+        inputs, "sweep", "double_wishbone.yaml", "bump_steer.yaml", "-o", "out.parquet", "-q"
+    )
+    assert code == 0, proc.stderr
+    assert "pyarrow.parquet" in modules
+    assert imported(modules, ("pandas", "scipy", "matplotlib")) == []
+    table = pq.read_table(inputs / "out.parquet")
+    results = pin_susp.Corner(EXAMPLES / "double_wishbone.yaml").run_sweep(
+        EXAMPLES / "bump_steer.yaml"
+    )
+    assert table.column_names == list(results.keys())
+    for name in ("camber", "roadwheel_angle", "solver_converged", "step_index"):
+        assert table.column(name).to_pylist() == list(results[name])
+
+
 @pytest.mark.parametrize(
     "argv, output",
     [

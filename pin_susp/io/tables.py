@@ -174,13 +174,19 @@ def _repr_rows(columns: list) -> str:
 
 
 def _column_cells(values) -> list[str]:
-    """format_cell for a whole column at once (numpy's str of a float64 is the same
-    shortest round-trip text as repr): a column of numbers or flags in one call."""
+    """format_cell for a whole column at once: a column of numbers or flags in one call.
+    A float64's text is Python's repr (numpy's str of a float64 is the same shortest
+    round-trip text, at 2.5 times the cost); another float's, numpy's str."""
     v = np.asarray(values)
     if v.dtype.kind == "b":
         return np.where(v, "True", "False").tolist()
     if v.dtype.kind in "iu":
-        return v.astype(str).tolist()
+        return list(map(str, v.tolist()))
+    if v.dtype == np.float64:
+        text = list(map(float.__repr__, v.tolist()))
+        for i in np.flatnonzero(np.isnan(v)).tolist():
+            text[i] = ""
+        return text
     if v.dtype.kind == "f":
         text = v.astype(str)
         text[np.isnan(v)] = ""
@@ -200,10 +206,13 @@ def _arrow_rows(columns: list):
     """Rows of CSV text (a pyarrow buffer: cells joined by commas, each row ending in \n).
 
     Every float column's values are formatted in one call, end to end; a column whose
-    every value is the same (a fixed point of the chassis) by its one value."""
+    every value is the same (a fixed point of the chassis) by its one value. Every
+    Arrow value is made from numpy's buffers (``_arrow_from_numpy``, ``_texts``), none
+    from a Python object: pyarrow converts those through a check that imports pandas
+    (~0.2 s, the whole of a mid-length sweep's writing)."""
     import pyarrow as pa
-    import pyarrow.compute as pc
 
+    pc = _compute()
     rows = len(columns[0])
     cells: list = [None] * len(columns)
     where = []  # the float columns
@@ -212,17 +221,17 @@ def _arrow_rows(columns: list):
         if kind == "f":
             where.append(i)
         elif kind == "b":
-            cells[i] = pc.if_else(pa.array(v), "True", "False")
+            cells[i] = pc.if_else(_arrow_from_numpy(v, pa), *_texts(["True", "False"], pa))
         elif kind in "iu":
-            cells[i] = pc.cast(pa.array(v), pa.string())
+            cells[i] = pc.cast(_arrow_from_numpy(v, pa), pa.string())
         else:  # names and mixed columns, one by one
-            cells[i] = pa.array([format_cell(x) for x in v], pa.string())
+            cells[i] = _text_array([format_cell(x) for x in v], pa)
     if where:
         floats = np.array([columns[i] for i in where], dtype=float)  # a column a row
         bits = floats.view(np.uint64)
         same = (bits == bits[:, :1]).all(axis=1)  # by bits: -0.0 is not 0.0
         values = np.concatenate([floats[~same].ravel(), floats[same, 0]])
-        text = pc.cast(pa.array(values, from_pandas=True), pa.string())
+        text = pc.cast(_arrow_from_numpy(values, pa, nan_null=True), pa.string())
         whole = np.isfinite(values) & (values == np.trunc(values))
         care = whole | np.isnan(values)  # the cells _float_cells changes
         varying = np.array(where)[~same]
@@ -245,11 +254,12 @@ def _arrow_rows(columns: list):
     if isinstance(parts[-1], str):
         parts[-1] += "\n"
     else:
-        parts[-1] = pc.binary_join_element_wise(parts[-1], "\n", "")
+        parts[-1] = pc.binary_join_element_wise(parts[-1], *_texts(["\n", ""], pa))
     if isinstance(parts[0], str) and len(parts) == 1:  # every column the same all along
-        parts = [pa.repeat(pa.scalar(parts[0]), rows)]
-    args = [pa.scalar(c) if isinstance(c, str) else c for c in parts]
-    joined = pc.binary_join_element_wise(*args, ",")
+        parts = [pa.repeat(_texts(parts, pa)[0], rows)]
+    fixed = iter(_texts([c for c in parts if isinstance(c, str)] + [","], pa))
+    args = [next(fixed) if isinstance(c, str) else c for c in parts]
+    joined = pc.binary_join_element_wise(*args, next(fixed))
     offsets = np.frombuffer(joined.buffers()[1], np.int32, len(joined) + 1, 4 * joined.offset)
     return joined.buffers()[2][offsets[0] : offsets[-1]]
 
@@ -259,9 +269,99 @@ def _float_cells(text, whole: np.ndarray, pa, pc):
     value (NaN, a null) is an empty cell; a whole number (``whole``) in fixed notation
     gets ``.0`` (``100.0``, ``-0.0``: a reader still sees a float)."""
     if whole.any():
-        plain = pc.and_(pa.array(whole), pc.invert(pc.match_substring(text, "e")))  # 1e+16
-        text = pc.if_else(plain, pc.binary_join_element_wise(text, ".0", ""), text)
-    return pc.fill_null(text, "") if text.null_count else text
+        plain = pc.and_(_arrow_from_numpy(whole, pa), pc.invert(pc.match_substring(text, "e")))
+        point, empty = _texts([".0", ""], pa)  # plain: not 1e+16
+        text = pc.if_else(plain, pc.binary_join_element_wise(text, point, empty), text)
+    return pc.fill_null(text, _texts([""], pa)[0]) if text.null_count else text
+
+
+class _Kernels:
+    """The pyarrow.compute functions the compiled style calls, by the same names, each
+    pyarrow's own kernel called by name (``call_function``) from pyarrow._compute, the
+    module pyarrow.compute wraps: without the Python wrapper pyarrow.compute makes for
+    each of its functions as it is imported (~25 ms, a third of what pyarrow costs a
+    mid-length sweep: benchmarks/bench_cli.py). Every argument is an Arrow value."""
+
+    def __init__(self, kernels):
+        self._call = kernels.call_function
+        self._cast = kernels.CastOptions.safe
+        self._match = kernels.MatchSubstringOptions
+
+    def cast(self, values, target):
+        return self._call("cast", [values], self._cast(target))
+
+    def if_else(self, condition, left, right):
+        return self._call("if_else", [condition, left, right])
+
+    def binary_join_element_wise(self, *strings):  # the last: the separator
+        return self._call("binary_join_element_wise", list(strings))
+
+    def and_(self, left, right):
+        return self._call("and", [left, right])
+
+    def invert(self, values):
+        return self._call("invert", [values])
+
+    def match_substring(self, values, pattern: str):
+        return self._call("match_substring", [values], self._match(pattern))
+
+    def fill_null(self, values, fill):
+        return self._call("coalesce", [values, fill])
+
+
+_KERNELS = []
+
+
+def _compute():
+    """_Kernels on pyarrow._compute, once; pyarrow.compute itself (the same names) where
+    a pyarrow has not that module's names."""
+    if not _KERNELS:
+        try:
+            from pyarrow import _compute as kernels
+
+            _KERNELS.append(_Kernels(kernels))
+        except (ImportError, AttributeError):
+            import pyarrow.compute
+
+            _KERNELS.append(pyarrow.compute)
+    return _KERNELS[0]
+
+
+def _arrow_from_numpy(values: np.ndarray, pa, nan_null: bool = False):
+    """A numpy column (flags, integers or floats) as an Arrow array on its own buffers:
+    ``pa.array(values, from_pandas=nan_null)``'s array (an undefined value, NaN, a null
+    where ``nan_null``) without its check of pandas' types, which imports pandas."""
+    v = np.ascontiguousarray(values)
+    if not v.dtype.isnative:  # Arrow's buffers are little-endian, as the machine's
+        v = v.astype(v.dtype.newbyteorder("="))
+    n = len(v)
+    if v.dtype.kind == "b":
+        return pa.Array.from_buffers(pa.bool_(), n, [None, _bits(v, pa)])
+    valid, nulls = None, 0
+    if nan_null and v.dtype.kind == "f":
+        defined = ~np.isnan(v)
+        nulls = n - int(np.count_nonzero(defined))
+        valid = _bits(defined, pa) if nulls else None
+    return pa.Array.from_buffers(pa.from_numpy_dtype(v.dtype), n, [valid, pa.py_buffer(v)], nulls)
+
+
+def _bits(flags: np.ndarray, pa):
+    """Flags as Arrow's bitmap (least significant bit first)."""
+    return pa.py_buffer(np.packbits(flags, bitorder="little"))
+
+
+def _text_array(texts: list[str], pa):
+    """Python strings as an Arrow string array on one buffer (no Python conversion)."""
+    data = [t.encode() for t in texts]
+    offsets = np.concatenate([[0], np.cumsum([len(d) for d in data])]).astype(np.int32)
+    joined = pa.py_buffer(b"".join(data))
+    return pa.StringArray.from_buffers(len(data), pa.py_buffer(offsets), joined)
+
+
+def _texts(texts: list[str], pa) -> list:
+    """Python strings as Arrow string scalars (``_text_array``'s)."""
+    array = _text_array(texts, pa)
+    return [array[i] for i in range(len(texts))]
 
 
 # -- Parquet -----------------------------------------------------------------------------
@@ -361,10 +461,13 @@ class ParquetStream(_Stream):
 
 
 def arrow_column(values):
-    """A column for Arrow (Parquet): an undefined value (NaN, a blank CSV cell) is null."""
+    """A column for Arrow (Parquet): an undefined value (NaN, a blank CSV cell) is null;
+    numbers and flags on numpy's buffers (``_arrow_from_numpy``: no pandas imported)."""
     import pyarrow as pa
 
     values = np.asarray(values)
+    if values.dtype.kind in "biuf":
+        return _arrow_from_numpy(values, pa, nan_null=values.dtype.kind == "f")
     return pa.array(values, from_pandas=values.dtype.kind == "f")
 
 
