@@ -180,10 +180,12 @@ class HardpointSensitivity:
         return self.points[f].jacobian(self.kin)
 
     # -- evaluation -------------------------------------------------------------
-    def at(self, q: np.ndarray, targets: list[Target] | None = None, step: int = 0) -> Sensitivity:
+    def at(
+        self, q: np.ndarray, targets: list[Target] | None = None, step: int = 0, only=None
+    ) -> Sensitivity:
         """Sensitivities at the solved configuration q (of the corner's model),
         holding ``targets`` (default: wheel-centre height and rack at design)."""
-        return self._collect(*self.jets(q, targets), step)
+        return self._collect(*self.jets(q, targets), step, only)
 
     def jets(self, q: np.ndarray, targets: list[Target] | None = None) -> tuple[dict, dict]:
         """Every point at q, and its design position, as nested jet.Duals: outside, the
@@ -302,22 +304,31 @@ class HardpointSensitivity:
         u_dot = (E - np.outer(u, u)) @ ((jb - ja) @ v) / n
         return (u_dot @ (jb - ja) + u @ (db - da))[None]
 
-    def _collect(self, points, design, step) -> Sensitivity:
+    def _collect(self, points, design, step, only=None) -> Sensitivity:
+        """``only``: the columns wanted (a study's), else every one."""
         g = self.corner.geometry
         ps = PointSet(points, design, g)
         n = len(self.hardpoints)
         values, units, metrics = {}, {}, {}
+        wanted = derivative_columns(g)
+        if only is not None:
+            wanted = [d for d in wanted if d.name in only]
+            needed = set(only) | {d.metric.name for d in wanted}
         with np.errstate(invalid="ignore", divide="ignore"):
-            evaluated = {m.name: m.function(ps) * m.scale for m in METRICS if m.applies(g)}
+            evaluated = {
+                m.name: m.function(ps) * m.scale
+                for m in METRICS
+                if m.applies(g) and (only is None or m.name in needed)
+            }
         for m in METRICS:
-            if m.name not in evaluated:
+            if m.name not in evaluated or only is not None and m.name not in only:
                 continue
             v = evaluated[m.name]
             metrics[m.name] = float(v.val.val[0])
             values[m.name] = v.der.val[:, 0, 0].reshape(n, 3) * 1e-3
             units[m.name] = f"{m.unit}/mm"
         drivers = self.corner.drivers
-        for d in derivative_columns(g):
+        for d in wanted:
             v = evaluated[d.metric.name]
             i = drivers.index(d.driver)
             metrics[d.name] = float(v.val.der[i, 0]) * 1e-3
