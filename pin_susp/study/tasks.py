@@ -21,8 +21,10 @@ def run_batch(job: Job, index: int, ids: np.ndarray, table: np.ndarray, steps: b
 
     sweep = load_sweep(job.sweep)
     rows, frames = [], []
+    # (--steps writes each step as pin-susp sweep does: its solver's columns too, marched)
+    guess = None if steps else guess_of(job, sweep)
     for vid, deltas in zip(ids, table, strict=True):
-        v = Variant(job, deltas, sweep, every_column=steps)
+        v = Variant(job, deltas, sweep, every_column=steps, guess=guess)
         rows.append(_row(job, int(vid), deltas, v))
         if steps and v.results is not None:
             frames.append(_steps_table(v.results, int(vid)))
@@ -40,11 +42,16 @@ def run_start(job: Job, index: int, ids: np.ndarray, table: np.ndarray, steps: b
     low, high = job.bounds
     cache = {}
 
+    # the last solved evaluation's, from the design's (--steps: marched, as a sweep)
+    guess = [None if steps else guess_of(job, sweep)]
+
     def solved(x: np.ndarray) -> Variant:
         key = x.tobytes()
         if key not in cache:
             cache.clear()
-            cache[key] = Variant(job, x, sweep, every_column=steps)
+            cache[key] = v = Variant(job, x, sweep, every_column=steps, guess=guess[0])
+            if v.solved is not None and not steps:
+                guess[0] = v.solved
         return cache[key]
 
     def fun(x):
@@ -73,6 +80,17 @@ def run_start(job: Job, index: int, ids: np.ndarray, table: np.ndarray, steps: b
     row["evaluations"] = int(fit.nfev)
     frames = [_steps_table(best.results, int(ids[0]))] if steps and best.results else []
     return {"index": index, "variants": _ipc(_variants_table([row])), "steps": _ipc_many(frames)}
+
+
+def guess_of(job: Job, sweep) -> np.ndarray | None:
+    """The design variant's configuration at every step (None if some step failed):
+    every variant's steps solved at once from it (Variant's ``guess``); worked out once
+    per process that runs the job's tasks (kept on the job)."""
+    key = "_guess"
+    if key not in job.__dict__:
+        design = Variant(job, np.zeros(len(job.variables)), sweep, every_column=False)
+        job.__dict__[key] = design.solved
+    return job.__dict__[key]
 
 
 def _row(job: Job, vid: int, deltas, v: Variant) -> dict:

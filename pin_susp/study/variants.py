@@ -98,7 +98,13 @@ def at_design(sweep):
 class Variant:
     """One variant's geometry solved through the sweep: its results and design state."""
 
-    def __init__(self, job: Job, deltas: np.ndarray, sweep=None, every_column: bool = True):
+    def __init__(
+        self, job: Job, deltas: np.ndarray, sweep=None, every_column: bool = True, guess=None
+    ):
+        """``guess``: each step's configuration near its own (the design variant's
+        solutions: tasks.guess_of), every step of a corner's sweep then solved at once from
+        it where that converges (else marched, as a sweep; an axle's and a vehicle's are
+        marched: their roll centres, far out, would move in their last digits)."""
         from ..model.sweep import load_sweep
 
         self.job = job
@@ -112,7 +118,7 @@ class Variant:
                 warnings.simplefilter("ignore")
                 self.subject = build(data, "variant", variant=True)
                 only = None if every_column else job.needs
-                self.results, self.static = self.subject.sweep_and_design(self.sweep, only)
+                self.results, self.static = self.subject.sweep_and_design(self.sweep, only, guess)
         except PinSuspError as exc:
             self.subject = None
             self.error = str(exc)
@@ -121,6 +127,12 @@ class Variant:
             # its row, not allowed to stop the thousands of others
             self.subject = None
             self.error = f"variant: cannot be solved ({type(exc).__name__}: {exc})"
+
+    @property
+    def solved(self) -> np.ndarray | None:
+        """Each step's configuration (n, nq) where every step converged, else None: a
+        guess for the next variants (the same tree)."""
+        return self.results.meta["q"] if self.converged else None
 
     @property
     def converged(self) -> bool:

@@ -163,15 +163,16 @@ class Corner(Assembly, Linkage):
         return Corner(corners[""], warn=False)
 
     # Assembly surface for study
-    def sweep_and_design(self, sweep: Sweep, only=None) -> tuple[Results, dict]:
+    def sweep_and_design(self, sweep: Sweep, only=None, guess=None) -> tuple[Results, dict]:
         # one pass of the columns over the design state and the steps: the steps solved
         # as run_sweep solves them, the design row column-wise the same
         tangents = []
-        solutions = self.solve_steps(sweep, tangents=tangents)
+        solutions = self.solve_steps(sweep, tangents=tangents, guess=guess)
         design = Solution(self.q_design.copy(), True, 0, 0.0)
-        both = Results.from_solutions(
-            self, [design, *solutions], sweep, [None, *tangents] if tangents else None, only
-        )
+        if tangents:  # the design state's too (else every step's would be worked out again)
+            self._drive.evaluate(self.q_design)
+            tangents = [self._drive.tangent(self.drive_rhs), *tangents]
+        both = Results.from_solutions(self, [design, *solutions], sweep, tangents or None, only)
         columns = {k: v[1:] for k, v in both.columns.items()}
         columns["step_index"] = np.arange(len(solutions))
         meta = dict(both.meta, q=both.meta["q"][1:], why=both.meta["why"][1:])
