@@ -1,7 +1,7 @@
 """The fast paths of a study (docs/studies.md, Speed) give what the slow ones give: a
 variant's model copied from its structure's first one is the model parsed from its own
-URDF, bit for bit; every step solved at once from the design variant's solutions gives
-each variant's summary as its own direct sweep does, and flags the same variants."""
+URDF, bit for bit; every variant's every step solved together from the design variant's solutions
+gives each variant's summary as its own direct sweep does, and flags the same variants."""
 
 from __future__ import annotations
 
@@ -16,8 +16,7 @@ import yaml
 
 from pin_susp import Corner, load_sweep
 from pin_susp.model.urdf import read_closures, tree_to_urdf
-from pin_susp.solve import march
-from pin_susp.study import load_study, run_study, tasks, variant_data, variant_table
+from pin_susp.study import batch, load_study, run_study, tasks, variant_data, variant_table
 from pin_susp.study.variants import build
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
@@ -32,6 +31,20 @@ def write_study(
     path = folder / f"study_{Path(geometry).stem}.yaml"
     path.write_text(yaml.safe_dump(data, sort_keys=False))
     return path
+
+
+def counted(monkeypatch) -> list:
+    """(variants offered, variants solved) of each batch solved together."""
+    out = []
+    together = batch._together
+
+    def counting(variants, *args):
+        solved = together(variants, *args)
+        out.append((len(variants), len(solved)))
+        return solved
+
+    monkeypatch.setattr(batch, "_together", counting)
+    return out
 
 
 def tolerances(tmp_path, geometry: str, tolerance: float, samples: int, sweep: Path = BUMP):
@@ -108,17 +121,11 @@ def test_variants_solved_at_once_equal_their_own_direct_sweeps(tmp_path, monkeyp
     """A random sample of a Monte Carlo's variants: each summary equals its own corner's
     direct sweep (Corner(variant geometry).run_sweep, marched) to 1e-9, every variant's
     steps having been solved at once from the design variant's solutions."""
-    at_once = []
-    solve_guessed = march.solve_guessed
-    monkeypatch.setattr(
-        march,
-        "solve_guessed",
-        lambda *a, **k: at_once.append(solve_guessed(*a, **k)) or at_once[-1],
-    )
+    together = counted(monkeypatch)
     study = tolerances(tmp_path, "double_wishbone.yaml", 1.5, 12)
     outcome = run_study(study, tmp_path / "out", scheduler=None)
     variants = outcome.variants
-    assert len(at_once) == len(variants) and all(s is not None for s in at_once)
+    assert sum(n for n, _ in together) == len(variants) == sum(k for _, k in together)
     sweep = load_sweep(BUMP)
     design = load_sweep(
         {
@@ -170,17 +177,10 @@ def test_failed_variants_are_flagged_as_when_marched(tmp_path, monkeypatch):
         "summary": ["camber", "roadwheel_angle"],
     }
     study = load_study(write_study(tmp_path, body, "double_wishbone.yaml", sweep))
-    at_once = []
-    solve_guessed = march.solve_guessed
-
-    def counted(*args, **kwargs):
-        solved = solve_guessed(*args, **kwargs)
-        at_once.append(solved is not None)
-        return solved
-
-    monkeypatch.setattr(march, "solve_guessed", counted)
+    together = counted(monkeypatch)
     fast = run_study(study, tmp_path / "fast", scheduler=None).variants
-    assert any(at_once) and not all(at_once)  # some solved at once, some marched
+    solved = sum(k for _, k in together)  # some solved together, some marched
+    assert 0 < solved < sum(n for n, _ in together)
     monkeypatch.undo()
     monkeypatch.setattr(tasks, "guess_of", lambda job, sweep: None)
     marched = run_study(study, tmp_path / "marched", scheduler=None).variants

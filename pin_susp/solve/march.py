@@ -48,8 +48,14 @@ def march(
     when that does not apply or any step fails there; ``extra``: more right-hand sides
     solved with each tangent there (newton_all's), its columns after the targets'.
     ``guess`` (n, nq): a configuration near each step's (a study's design variant's
-    solutions): with ``bulk``, every step is first solved at once from it (solve_guessed).
+    solutions): with ``bulk``, every step is first solved at once from it (solve_guessed);
+    or (solutions, tangents (n, nv, k)): the steps already solved (stacked.py).
     """
+    if isinstance(guess, tuple):  # the steps solved already (stacked.py), as solve_sweep's
+        solutions, T = guess
+        if tangents is not None:
+            tangents.extend(T if keep is None else keep(T))
+        return solutions
     if bulk and step_times is None:
         solved = None if guess is None else solve_guessed(solver, values, guess, extra)
         if solved is None:

@@ -8,6 +8,7 @@ import json
 
 import numpy as np
 
+from .batch import solve_batch
 from .data import Job
 from .derivatives import objective_jacobian
 from .variants import Variant
@@ -23,8 +24,9 @@ def run_batch(job: Job, index: int, ids: np.ndarray, table: np.ndarray, steps: b
     rows, frames = [], []
     # (--steps writes each step as pin-susp sweep does: its solver's columns too, marched)
     guess = None if steps else guess_of(job, sweep)
-    for vid, deltas in zip(ids, table, strict=True):
-        v = Variant(job, deltas, sweep, every_column=steps, guess=guess)
+    for vid, deltas, v in zip(
+        ids, table, solve_batch(job, table, sweep, guess, steps), strict=True
+    ):
         rows.append(_row(job, int(vid), deltas, v))
         if steps and v.results is not None:
             frames.append(_steps_table(v.results, int(vid)))

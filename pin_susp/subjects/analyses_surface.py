@@ -242,6 +242,9 @@ class AnalysesSurface:
 
     # -- studies (study/) -----------------------------------------------------------
 
+    # a study's variants may be solved together (solve/stacked.py: a corner's)
+    solves_stacked = False
+
     def sweep_and_design(self, sweep, only=None, guess=None) -> tuple[object, dict]:
         """A sweep's results and its design state's columns (name → a one-value array),
         each solved as ``pin-susp sweep`` solves it (the design: every target at its

@@ -163,6 +163,8 @@ class Corner(Assembly, Linkage):
         return Corner(corners[""], warn=False)
 
     # Assembly surface for study
+    solves_stacked = True
+
     def sweep_and_design(self, sweep: Sweep, only=None, guess=None) -> tuple[Results, dict]:
         # one pass of the columns over the design state and the steps: the steps solved
         # as run_sweep solves them, the design row column-wise the same
