@@ -16,6 +16,7 @@ import yaml
 
 from pin_susp import Corner, load_sweep
 from pin_susp.model.urdf import read_closures, tree_to_urdf
+from pin_susp.solve.bulk import Tree, tree_of
 from pin_susp.study import batch, load_study, run_study, tasks, variant_data, variant_table
 from pin_susp.study.variants import build
 
@@ -108,6 +109,12 @@ def test_a_variants_model_is_the_one_parsed_from_its_urdf(tmp_path, geometry):
     for a, b in zip(list(model.frames)[: parsed.nframes], parsed.frames, strict=True):
         assert (a.name, a.parentJoint, a.type) == (b.name, b.parentJoint, b.type)
         assert np.array_equal(a.placement.homogeneous, b.placement.homogeneous)
+    # its bulk tree (Tree.like, from the first's) as one built from its model
+    given, built = tree_of(subject.kin), Tree(model)
+    assert given.model is model and given._identity == built._identity
+    for a, b in zip(given.joints, built.joints, strict=True):
+        assert a[0] == b[0] and a[1] == b[1] and a[5] == b[5]
+        assert all(np.array_equal(x, y) for x, y in zip(a[2:5], b[2:5], strict=True))
     # the closures' anchors (frames added after the URDF's) as the text says
     for spec, closure in zip(read_closures(text), subject.tree.closures, strict=True):
         for i, (link, offset) in enumerate(spec.anchors):

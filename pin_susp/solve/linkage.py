@@ -34,7 +34,7 @@ from ..model.compose import compose_tree
 from ..model.deadcentre import dead_centres
 from ..model.geometry import DERIVED_POINTS, Geometry, contact_patch, unit
 from ..model.urdf import read_closures, tree_to_urdf
-from .bulk import rows_of, solve_all, tree_of
+from .bulk import rows_of, seed_tree, solve_all, tree_of
 from .solver import NewtonSolver
 from .template import variant_model
 
@@ -50,8 +50,9 @@ class Built:
         """``template``: a study's variant, on a copy of the first model of its tree's
         structure (template.py); its URDF text is written when first read."""
         self._tree, self._comment, self._urdf = tree, comment, None
+        known = None  # its bulk tree, where a template gives it
         if template:
-            self.model, specs = variant_model(tree, self._parse)
+            self.model, specs, known = variant_model(tree, self._parse)
         else:
             self.model, specs = self._parse(tree)
         anchors = {}
@@ -59,6 +60,8 @@ class Built:
             for i, (link, offset) in enumerate(spec.anchors):
                 anchors[spec.name, i] = self._add_anchor(f"{spec.name}/{i}", link, offset)
         self.kin = Kinematics(self.model)  # data after every frame is added
+        if known is not None:
+            seed_tree(self.kin, known)
         self.points = {
             name: FramePoint(name, self.model.getFrameId(name), body)
             for name, (body, _) in tree.points.items()

@@ -111,6 +111,14 @@ class _Template:
                     return False
         return True
 
+    def tree_like(self, model: pin.Model):
+        """The bulk.Tree of a placed copy (from the template model's, built once)."""
+        from .bulk import Tree
+
+        if "_tree" not in self.__dict__:
+            self._tree = Tree(self.model)
+        return Tree.like(self._tree, model)
+
     def place(self, tree, steps) -> pin.Model:
         """A copy of the model with the tree's joint origins, axes and frame offsets."""
         model = pin.Model(self.model)
@@ -143,12 +151,12 @@ class _Template:
 
 
 def variant_model(tree, parse):
-    """(model, closure specs) of a variant's tree: a copy of the model of the first tree
-    of its structure with its own numbers (``parse(tree)`` → (model, specs) builds one
-    from the URDF text, for the first of each structure and for any tree this module
-    cannot place)."""
+    """(model, closure specs, its bulk.Tree or None) of a variant's tree: a copy of the
+    model of the first tree of its structure with its own numbers, and its bulk tree
+    likewise (``parse(tree)`` → (model, specs) builds one from the URDF text, for the
+    first of each structure and for any tree this module cannot place)."""
     if tree.floating is not None:
-        return parse(tree)
+        return (*parse(tree), None)
     steps = joint_steps(tree)
     key = _signature(tree, steps)
     template = _TEMPLATES.get(key)
@@ -157,7 +165,8 @@ def variant_model(tree, parse):
         if len(_TEMPLATES) >= _KEEP:
             _TEMPLATES.pop(next(iter(_TEMPLATES)))
         _TEMPLATES[key] = _Template(model, tree, steps)
-        return model, specs
+        return model, specs, None
     if not template.ok:
-        return parse(tree)
-    return template.place(tree, steps), closure_specs(tree, _origins(tree, steps))
+        return (*parse(tree), None)
+    model = template.place(tree, steps)
+    return model, closure_specs(tree, _origins(tree, steps)), template.tree_like(model)
