@@ -38,6 +38,7 @@ def _together(variants: list, sweep, guess: np.ndarray) -> dict:
     for v in variants:
         try:
             solvers.append(v.subject.solver_for(sweep.targets, sweep.source))
+            v.subject.keep_solver(sweep.targets, solvers[-1])  # for its own solve after
             values.append(v.subject.target_values(sweep.targets))
         except (PinSuspError, ArithmeticError, ValueError, np.linalg.LinAlgError):
             return {}  # that variant's own solve says why

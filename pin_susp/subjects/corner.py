@@ -165,6 +165,18 @@ class Corner(Assembly, Linkage):
     # Assembly surface for study
     solves_stacked = True
 
+    def keep_solver(self, targets: list, solver) -> None:
+        """The solver built for ``targets`` (this very list, a study's sweep's) handed back
+        by solver_for instead of building it again (a study's variant, solved together
+        first: study/batch.py)."""
+        self._kept_solver = (targets, solver)
+
+    def solver_for(self, targets: list, source: str = "<targets>"):
+        kept = self.__dict__.get("_kept_solver")
+        if kept is not None and kept[0] is targets:
+            return kept[1]
+        return super().solver_for(targets, source)
+
     def sweep_and_design(self, sweep: Sweep, only=None, guess=None) -> tuple[Results, dict]:
         # one pass of the columns over the design state and the steps: the steps solved
         # as run_sweep solves them, the design row column-wise the same
