@@ -27,7 +27,7 @@ sensitivities — no finite differences anywhere.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import pinocchio as pin
@@ -47,6 +47,7 @@ from ..model.geometry import contact_patch, unit, wheel_points
 from ..model.sweep import Target
 from ..model.tree import Body, Joint, Tree
 from ..model.urdf import tree_to_urdf
+from ..solve.template import variant_model
 
 V = "__v_"  # marks virtual joints and links
 AXES = "xyz"
@@ -76,7 +77,9 @@ class HardpointSensitivity:
         g = corner.geometry
         self.hardpoints = list(g.hardpoints)
         tree, self.params = _augment(corner.tree)
-        self.model = pin.buildModelFromXML(tree_to_urdf(tree))
+        # (kinematic: without shapes; a study's later corners of one structure copy the
+        # first's model with their own numbers, bit for bit the parsed one: template.py)
+        self.model = variant_model(replace(tree, visuals=[]), _parse, closures=False)[0]
         self.kin = Kinematics(self.model)
         m = self.model
         self.real = np.array(
@@ -335,6 +338,10 @@ class HardpointSensitivity:
             values[d.name] = v.der.der[:, i, 0].reshape(n, 3) * 1e-6
             units[d.name] = f"{d.unit}/mm"
         return Sensitivity(step, self.hardpoints, values, units, metrics)
+
+
+def _parse(tree: Tree) -> tuple:
+    return pin.buildModelFromXML(tree_to_urdf(tree)), None
 
 
 def _augment(tree: Tree) -> tuple[Tree, dict]:

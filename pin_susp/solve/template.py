@@ -150,11 +150,12 @@ class _Template:
         return model
 
 
-def variant_model(tree, parse):
+def variant_model(tree, parse, closures: bool = True):
     """(model, closure specs, its bulk.Tree or None) of a variant's tree: a copy of the
     model of the first tree of its structure with its own numbers, and its bulk tree
     likewise (``parse(tree)`` → (model, specs) builds one from the URDF text, for the
-    first of each structure and for any tree this module cannot place)."""
+    first of each structure and for any tree this module cannot place); ``closures``:
+    the specs read (else None)."""
     if tree.floating is not None:
         return (*parse(tree), None)
     steps = joint_steps(tree)
@@ -169,4 +170,5 @@ def variant_model(tree, parse):
     if not template.ok:
         return (*parse(tree), None)
     model = template.place(tree, steps)
-    return model, closure_specs(tree, _origins(tree, steps)), template.tree_like(model)
+    specs = closure_specs(tree, _origins(tree, steps)) if closures else None
+    return model, specs, template.tree_like(model)
