@@ -24,7 +24,8 @@ def objective_jacobian(v: Variant, sweep) -> np.ndarray:
     n = sweep.steps
     if v.results is None:
         return np.zeros((len(job.terms) * n, k))
-    at_design, steps = sensitivities(v.subject, sweep, v.results, job.needs)
+    wanted = {t.metric for t in job.terms} | {t.curve_x for t in job.terms if t.curve_x}
+    at_design, steps = sensitivities(v.subject, sweep, v.results, wanted)
     columns = _columns(at_design.hardpoints, job.variables)
     blocks = []
     for t, w in zip(job.terms, shares(job.terms, n), strict=True):
