@@ -180,7 +180,9 @@ class SubjectSensitivity:
         out[corner] = q[whole]
         return out
 
-    def at(self, q: np.ndarray | None = None, step: int = 0, targets=None) -> Sensitivity:
+    def at(
+        self, q: np.ndarray | None = None, step: int = 0, targets=None, only=None
+    ) -> Sensitivity:
         """At the subject's solved configuration q (default: its design state), holding
         ``targets`` (``Assembly.held_at``; default: each wheel centre's height and the
         rack where q has them)."""
@@ -188,7 +190,9 @@ class SubjectSensitivity:
         for s, h in self.sides.items():
             qs = h.corner.q_design if q is None else self.side_q(q, s)
             jets[s] = h.jets(qs, targets)
-            per_side[s] = h._collect(*jets[s], step)
+            suffix = self.model.suffix(s)
+            mine = None if only is None else {_unsuffixed(n, suffix) for n in only}
+            per_side[s] = h._collect(*jets[s], step, mine)
         n = len(self.hardpoints)
         values, units, metrics = {}, {}, {}
         for s, side in per_side.items():
@@ -197,7 +201,7 @@ class SubjectSensitivity:
                 key = name + self.model.suffix(s)
                 values[key] = v if lift is None else (lift @ v.ravel()).reshape(n, 3)
                 units[key], metrics[key] = side.units[name], side.metrics[name]
-        own = self.model.sensitivity_columns
+        own = [n for n in self.model.sensitivity_columns if only is None or n in only]
         if own:
             with np.errstate(invalid="ignore", divide="ignore"):
                 columns = self._own_columns(jets)
@@ -332,3 +336,8 @@ def subject_sensitivities(sens: SubjectSensitivity, sweep=None, progress=None):
 
 AxleSensitivity = SubjectSensitivity  # an axle's, by its old name
 axle_sensitivities = subject_sensitivities  # (sens, sweep, progress), by its old name
+
+
+def _unsuffixed(name: str, suffix: str) -> str:
+    """A side's column's name without its side's suffix (``camber_left`` → ``camber``)."""
+    return name[: -len(suffix)] if suffix and name.endswith(suffix) else name

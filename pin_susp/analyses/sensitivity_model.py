@@ -27,7 +27,7 @@ sensitivities — no finite differences anywhere.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import pinocchio as pin
@@ -48,6 +48,7 @@ from ..model.packaging import placed_points
 from ..model.sweep import Target
 from ..model.tree import Body, Joint, Tree
 from ..model.urdf import tree_to_urdf
+from ..solve.template import variant_model
 
 V = "__v_"  # marks virtual joints and links
 AXES = "xyz"
@@ -77,7 +78,9 @@ class HardpointSensitivity:
         g = corner.geometry
         self.hardpoints = list(g.hardpoints)
         tree, self.params = _augment(corner.tree)
-        self.model = pin.buildModelFromXML(tree_to_urdf(tree))
+        # (kinematic: without shapes; a study's later corners of one structure copy the
+        # first's model with their own numbers, bit for bit the parsed one: template.py)
+        self.model = variant_model(replace(tree, visuals=[]), _parse, closures=False)[0]
         self.kin = Kinematics(self.model)
         m = self.model
         self.real = np.array(
@@ -179,10 +182,12 @@ class HardpointSensitivity:
         return self.points[f].jacobian(self.kin)
 
     # -- evaluation -------------------------------------------------------------
-    def at(self, q: np.ndarray, targets: list[Target] | None = None, step: int = 0) -> Sensitivity:
+    def at(
+        self, q: np.ndarray, targets: list[Target] | None = None, step: int = 0, only=None
+    ) -> Sensitivity:
         """Sensitivities at the solved configuration q (of the corner's model),
         holding ``targets`` (default: wheel-centre height and rack at design)."""
-        return self._collect(*self.jets(q, targets), step)
+        return self._collect(*self.jets(q, targets), step, only)
 
     def jets(self, q: np.ndarray, targets: list[Target] | None = None) -> tuple[dict, dict]:
         """Every point at q, and its design position, as nested jet.Duals: outside, the
@@ -301,28 +306,41 @@ class HardpointSensitivity:
         u_dot = (E - np.outer(u, u)) @ ((jb - ja) @ v) / n
         return (u_dot @ (jb - ja) + u @ (db - da))[None]
 
-    def _collect(self, points, design, step) -> Sensitivity:
+    def _collect(self, points, design, step, only=None) -> Sensitivity:
+        """``only``: the columns wanted (a study's), else every one."""
         g = self.corner.geometry
         ps = PointSet(points, design, g)
         n = len(self.hardpoints)
         values, units, metrics = {}, {}, {}
+        wanted = derivative_columns(g)
+        if only is not None:
+            wanted = [d for d in wanted if d.name in only]
+            needed = set(only) | {d.metric.name for d in wanted}
         with np.errstate(invalid="ignore", divide="ignore"):
-            evaluated = {m.name: m.function(ps) * m.scale for m in METRICS if m.applies(g)}
+            evaluated = {
+                m.name: m.function(ps) * m.scale
+                for m in METRICS
+                if m.applies(g) and (only is None or m.name in needed)
+            }
         for m in METRICS:
-            if m.name not in evaluated:
+            if m.name not in evaluated or only is not None and m.name not in only:
                 continue
             v = evaluated[m.name]
             metrics[m.name] = float(v.val.val[0])
             values[m.name] = v.der.val[:, 0, 0].reshape(n, 3) * 1e-3
             units[m.name] = f"{m.unit}/mm"
         drivers = self.corner.drivers
-        for d in derivative_columns(g):
+        for d in wanted:
             v = evaluated[d.metric.name]
             i = drivers.index(d.driver)
             metrics[d.name] = float(v.val.der[i, 0]) * 1e-3
             values[d.name] = v.der.der[:, i, 0].reshape(n, 3) * 1e-6
             units[d.name] = f"{d.unit}/mm"
         return Sensitivity(step, self.hardpoints, values, units, metrics)
+
+
+def _parse(tree: Tree) -> tuple:
+    return pin.buildModelFromXML(tree_to_urdf(tree)), None
 
 
 def _augment(tree: Tree) -> tuple[Tree, dict]:

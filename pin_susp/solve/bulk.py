@@ -56,6 +56,11 @@ def tree_of(kin):
     return tree
 
 
+def seed_tree(kin, tree) -> None:
+    """A Kinematics' model tree given (Tree.like) rather than built when first asked for."""
+    _TREES[kin] = tree
+
+
 def rows_of(solver):
     """A NewtonSolver's rows for many configurations at once (Rows), built when first
     asked for."""
@@ -115,6 +120,25 @@ class Tree:
                 ks = [k for k in support if self.joints[k - 1][1] == revolute]
                 kinds.append((ks, [self.joints[k - 1][5] for k in ks]))
             self._moves.append(tuple(kinds))
+
+    @classmethod
+    def like(cls, base: Tree, model: pin.Model) -> Tree:
+        """The tree of a model of ``base``'s structure (a study's variant: template.py)
+        with its own joint axes and placements, without evaluating its joints again."""
+        tree = cls.__new__(cls)
+        tree.__dict__.update(base.__dict__)
+        tree.model = model
+        tree.joints = []
+        for i, (parent, revolute, axis, _, _, k) in enumerate(base.joints, start=1):
+            joint = model.joints[i]
+            if joint.shortname().endswith("Unaligned"):  # its motion subspace: its axis
+                axis = np.array(joint.extract().axis, dtype=float)
+            placement = model.jointPlacements[i]
+            R, p = placement.rotation.copy(), placement.translation.copy()
+            tree.joints.append((parent, revolute, axis, R, p, k))
+        tree._identity = [True] + [np.array_equal(j[3], np.eye(3)) for j in tree.joints]
+        tree._skew = [None] + [_skew(j[2]) for j in tree.joints]
+        return tree
 
     def moved_by(self, joint: int) -> list[int]:
         """The indices in v of the joints that move a joint (its supports, the universe

@@ -34,8 +34,9 @@ from ..model.compose import compose_tree
 from ..model.deadcentre import dead_centres
 from ..model.geometry import DERIVED_POINTS, Geometry, contact_patch, unit
 from ..model.urdf import read_closures, tree_to_urdf
-from .bulk import rows_of, solve_all, tree_of
+from .bulk import rows_of, seed_tree, solve_all, tree_of
 from .solver import NewtonSolver
+from .template import variant_model
 
 RACK_HELD = "rack held at design (the sweep gives no rack target)"
 
@@ -45,15 +46,22 @@ class Built:
     FramePoint per named point, the loop closures read back from the same text
     (lengths from the design frames) and each loop's branch at design."""
 
-    def __init__(self, tree, comment: str = ""):
-        self.urdf = tree_to_urdf(tree, comment=comment)
-        self.model = pin.buildModelFromXML(self.urdf)
-        specs = read_closures(self.urdf)
+    def __init__(self, tree, comment: str = "", template: bool = False):
+        """``template``: a study's variant, on a copy of the first model of its tree's
+        structure (template.py); its URDF text is written when first read."""
+        self._tree, self._comment, self._urdf = tree, comment, None
+        known = None  # its bulk tree, where a template gives it
+        if template:
+            self.model, specs, known = variant_model(tree, self._parse)
+        else:
+            self.model, specs = self._parse(tree)
         anchors = {}
         for spec in specs:
             for i, (link, offset) in enumerate(spec.anchors):
                 anchors[spec.name, i] = self._add_anchor(f"{spec.name}/{i}", link, offset)
         self.kin = Kinematics(self.model)  # data after every frame is added
+        if known is not None:
+            seed_tree(self.kin, known)
         self.points = {
             name: FramePoint(name, self.model.getFrameId(name), body)
             for name, (body, _) in tree.points.items()
@@ -79,6 +87,16 @@ class Built:
             for c in tree.closures
             if c.branch
         ]
+
+    @property
+    def urdf(self) -> str:
+        if self._urdf is None:
+            self._urdf = tree_to_urdf(self._tree, comment=self._comment)
+        return self._urdf
+
+    def _parse(self, tree) -> tuple:
+        model = pin.buildModelFromXML(self.urdf)
+        return model, read_closures(self.urdf)
 
     def _add_anchor(self, name: str, link: str, offset: np.ndarray) -> FramePoint:
         parent = self.model.frames[self.model.getFrameId(link)]
@@ -275,8 +293,10 @@ class Composed:
         # links near dead centre at design (warned when the file was read): the
         # failure report names them as the cause of steps out of reach
         self.dead_centres = dead_centres(self.tree)
-        built = Built(self.tree if visuals else replace(self.tree, visuals=[]), comment)
-        self.urdf, self.model, self.kin = built.urdf, built.model, built.kin
+        built = Built(
+            self.tree if visuals else replace(self.tree, visuals=[]), comment, not visuals
+        )
+        self._built, self.model, self.kin = built, built.model, built.kin
         self.points: dict[str, FramePoint | ContactPatchPoint] = dict(built.points)
         self.corner_points = {}
         for label, g in corners.items():
@@ -307,6 +327,11 @@ class Composed:
             self.output_points += [n for n in extras if label and n.startswith(p)]
         self.output_points += [n for n in extras if not prefixes or not n.startswith(prefixes)]
         self.design_positions = self.positions(self.q_design)
+
+    @property
+    def urdf(self) -> str:
+        """The model's URDF text (written when first read)."""
+        return self._built.urdf
 
     def positions(self, q: np.ndarray) -> dict[str, np.ndarray]:
         """World position (m) of every named point (prefixed by its label) at q."""

@@ -32,6 +32,7 @@ def march(
     keep=None,
     bulk: bool = False,
     extra=None,
+    guess=None,
 ) -> list[Solution]:
     """Solve a sweep's steps (``values``: a row of target values each) in order, each
     from a prediction off the last solutions (halving toward it on failure).
@@ -46,9 +47,19 @@ def march(
     (n, nv, k): it must act on the last axes alone; the sweep is marched step by step
     when that does not apply or any step fails there; ``extra``: more right-hand sides
     solved with each tangent there (newton_all's), its columns after the targets'.
+    ``guess`` (n, nq): a configuration near each step's (a study's design variant's
+    solutions): with ``bulk``, every step is first solved at once from it (solve_guessed);
+    or (solutions, tangents (n, nv, k)): the steps already solved (stacked.py).
     """
+    if isinstance(guess, tuple):  # the steps solved already (stacked.py), as solve_sweep's
+        solutions, T = guess
+        if tangents is not None:
+            tangents.extend(T if keep is None else keep(T))
+        return solutions
     if bulk and step_times is None:
-        solved = solve_sweep(solver, values, q, previous, progress, extra)
+        solved = None if guess is None else solve_guessed(solver, values, guess, extra)
+        if solved is None:
+            solved = solve_sweep(solver, values, q, previous, progress, extra)
         if solved is not None:
             solutions, T = solved
             if tangents is not None:
@@ -182,6 +193,23 @@ def solve_sweep(
     if progress is not None:
         progress(n, n)
     return solutions, T
+
+
+def solve_guessed(solver: NewtonSolver, values: np.ndarray, guess: np.ndarray, extra=None):
+    """Every step solved at once from a guess of its configuration (a study's variant
+    from its design variant's solutions): (solutions, tangents (n, nv, k)) as
+    solve_sweep's, or None where that does not apply, or any step does not converge to
+    the tolerance or leaves a loop's design branch (then the sweep is marched)."""
+    n = values.shape[0]
+    rows = rows_of(solver)
+    if not rows.supported or guess.shape != (n, solver.kin.model.nq):
+        return None
+    if len(solver.targets) != values.shape[1] or rows.nrows != solver.kin.model.nv:
+        return None
+    qs, T, iterations, error = newton_all(rows, guess, values, TOLERANCE, extra)
+    if qs is None or not on_branches(solver, qs):
+        return None
+    return list(map(Solution, qs, [True] * n, iterations.tolist(), error.tolist())), T
 
 
 def coarse_path(solver, rows, values: np.ndarray, q, previous, start_tangent):

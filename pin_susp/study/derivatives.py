@@ -24,7 +24,8 @@ def objective_jacobian(v: Variant, sweep) -> np.ndarray:
     n = sweep.steps
     if v.results is None:
         return np.zeros((len(job.terms) * n, k))
-    at_design, steps = sensitivities(v.subject, sweep, v.results)
+    wanted = {t.metric for t in job.terms} | {t.curve_x for t in job.terms if t.curve_x}
+    at_design, steps = sensitivities(v.subject, sweep, v.results, wanted)
     columns = _columns(at_design.hardpoints, job.variables)
     blocks = []
     for t, w in zip(job.terms, shares(job.terms, n), strict=True):
@@ -56,21 +57,21 @@ def _pick(s, name: str, columns) -> np.ndarray:
     return np.nan_to_num(s.values[name][columns])
 
 
-def sensitivities(subject, sweep, results) -> tuple:
+def sensitivities(subject, sweep, results, only=None) -> tuple:
     """The exact hardpoint sensitivities at design and at each converged step, holding
     there what the subject holds (``Assembly.held_at``): (Sensitivity, {step:
     Sensitivity}), one-sided names (``left_…``) on labelled corners; no steps where the
     sweep holds other than they hold (``Assembly.sensitivities_hold``: an axle's roll or
-    heave sweep)."""
+    heave sweep); ``only``: the columns wanted (the objective's, the summary's)."""
     from ..analyses.sensitivity import SubjectSensitivity
 
     model = SubjectSensitivity(subject, one_sided=True)
-    at_design, steps = model.at(), {}
+    at_design, steps = model.at(only=only), {}
     if subject.sensitivities_hold(sweep):  # else the steps' would hold other quantities
         for i in range(len(results)):
             if results["solver_converged"][i]:
                 held = subject.held_at(sweep, i)
-                steps[i] = model.at(results.meta["q"][i], step=i, targets=held)
+                steps[i] = model.at(results.meta["q"][i], step=i, targets=held, only=only)
     return at_design, steps
 
 
@@ -87,7 +88,7 @@ def linear_prediction(study: Study, variants) -> dict[str, np.ndarray] | None:
     design = Variant(job, np.zeros(len(study.variables)), sweep, every_column=True)
     if design.results is None or not design.converged:
         return None
-    at_design, steps = sensitivities(design.subject, sweep, design.results)
+    at_design, steps = sensitivities(design.subject, sweep, design.results, set(study.summary))
     columns = _columns(at_design.hardpoints, study.variables)
     d = variants[study.names].to_numpy(dtype=float)
     out = {}

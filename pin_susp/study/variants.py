@@ -21,26 +21,26 @@ if TYPE_CHECKING:
 
 def variant_table(study: Study) -> np.ndarray:
     """Every variant's variables (n, k), mm from design; deterministic for a seed."""
-    from scipy.stats import qmc
-
     low, high = study.low, study.high
     k = len(study.variables)
     if study.kind == "doe" and study.method == "full_factorial":
         axes = [np.linspace(a, b, study.levels) for a, b in zip(low, high, strict=True)]
         grid = np.meshgrid(*axes, indexing="ij")
         return np.stack([g.ravel() for g in grid], axis=1)
+    if study.kind == "monte_carlo":  # (before scipy.stats, a second to import)
+        rng = np.random.default_rng(study.seed)
+        if study.distribution == "uniform":
+            return rng.uniform(low, high, size=(study.samples, k))
+        mean, sigma = 0.5 * (low + high), (high - low) / 6.0  # range = ±3σ
+        return mean + sigma * rng.standard_normal((study.samples, k))
+    from scipy.stats import qmc
+
     if study.kind == "doe":
         if study.method == "latin_hypercube":
             unit = qmc.LatinHypercube(d=k, seed=study.seed).random(study.samples)
         else:
             unit = _sobol(k, study.samples, study.seed)
         return qmc.scale(unit, low, high)
-    if study.kind == "monte_carlo":
-        rng = np.random.default_rng(study.seed)
-        if study.distribution == "uniform":
-            return rng.uniform(low, high, size=(study.samples, k))
-        mean, sigma = 0.5 * (low + high), (high - low) / 6.0  # range = ±3σ
-        return mean + sigma * rng.standard_normal((study.samples, k))
     # optimise: the first start at design (or the box's centre), then a Sobol spread
     first = np.clip(np.zeros(k), low, high)
     if study.starts == 1:
@@ -98,7 +98,21 @@ def at_design(sweep):
 class Variant:
     """One variant's geometry solved through the sweep: its results and design state."""
 
-    def __init__(self, job: Job, deltas: np.ndarray, sweep=None, every_column: bool = True):
+    def __init__(
+        self,
+        job: Job,
+        deltas: np.ndarray,
+        sweep=None,
+        every_column: bool = True,
+        guess=None,
+        later: bool = False,
+    ):
+        """``guess``: each step's configuration near its own (the design variant's
+        solutions: tasks.guess_of), every step of a corner's sweep then solved at once from
+        it where that converges (else marched, as a sweep; an axle's and a vehicle's are
+        marched: their roll centres, far out, would move in their last digits). ``later``:
+        the subject built, its sweep left to ``solve`` (a batch's variants solved
+        together first: batch.py)."""
         from ..model.sweep import load_sweep
 
         self.job = job
@@ -106,21 +120,43 @@ class Variant:
         self.sweep = sweep if sweep is not None else load_sweep(job.sweep)
         self.error = ""
         self.results = self.static = None
+        self.every_column = every_column
         data = variant_data(job.geometry, job.variables, self.deltas)
+        self.subject = self._guarded(lambda: build(data, "variant", variant=True))
+        if not later:
+            self.solve(guess)
+
+    def solve(self, guess=None) -> None:
+        """The sweep and the design state solved (``guess``: as the constructor's, or the
+        steps solved already: (solutions, tangents), march's)."""
+        if self.subject is None:
+            return
+        only = None if self.every_column else self.job.needs
+        solved = self._guarded(lambda: self.subject.sweep_and_design(self.sweep, only, guess))
+        if solved is not None:
+            self.results, self.static = solved
+
+    def _guarded(self, work):
+        """``work()``, or None with the variant's error set (and no subject): a variant
+        that cannot be built or solved is reported in its row, never allowed to stop the
+        thousands of others."""
         try:
             with warnings.catch_warnings():  # a variant's plausibility: the design's was shown
                 warnings.simplefilter("ignore")
-                self.subject = build(data, "variant", variant=True)
-                only = None if every_column else job.needs
-                self.results, self.static = self.subject.sweep_and_design(self.sweep, only)
+                return work()
         except PinSuspError as exc:
-            self.subject = None
             self.error = str(exc)
         except (ArithmeticError, ValueError, np.linalg.LinAlgError) as exc:
-            # a degenerate variant (a link of zero length, a singular pose): reported in
-            # its row, not allowed to stop the thousands of others
-            self.subject = None
+            # a degenerate variant (a link of zero length, a singular pose)
             self.error = f"variant: cannot be solved ({type(exc).__name__}: {exc})"
+        self.subject = None
+        return None
+
+    @property
+    def solved(self) -> np.ndarray | None:
+        """Each step's configuration (n, nq) where every step converged, else None: a
+        guess for the next variants (the same tree)."""
+        return self.results.meta["q"] if self.converged else None
 
     @property
     def converged(self) -> bool:

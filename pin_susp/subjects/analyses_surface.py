@@ -242,11 +242,14 @@ class AnalysesSurface:
 
     # -- studies (study/) -----------------------------------------------------------
 
-    def sweep_and_design(self, sweep, only=None) -> tuple[object, dict]:
+    # a study's variants may be solved together (solve/stacked.py: a corner's)
+    solves_stacked = False
+
+    def sweep_and_design(self, sweep, only=None, guess=None) -> tuple[object, dict]:
         """A sweep's results and its design state's columns (name → a one-value array),
         each solved as ``pin-susp sweep`` solves it (the design: every target at its
         design value); ``only``: the columns wanted (a subject may give every one): a
-        study's variant."""
+        study's variant; ``guess``: a corner's (marched here, as a sweep)."""
         from ..model.sweep import Sweep
 
         design = Sweep([t.at_design() for t in sweep.targets], sweep.source, sweep.sha256)

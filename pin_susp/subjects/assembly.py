@@ -333,20 +333,19 @@ class Assembly(SteeringSurface, Composed, AnalysesSurface):
         q_start: np.ndarray | None = None,
         step_times=None,
         tangents: list | None = None,
+        guess=None,
     ) -> list[Solution]:
         """Solve the sweep's steps in order, each from a prediction off the last ones
-        (march.py: marched, or a long sweep solved at once).
-
+        (march.py: marched, a long sweep solved at once, or every step from ``guess``).
         ``q_start``: a solved configuration of the sweep's first step's predecessor
         (default: the design state); ``step_times``: a list that receives each step's
-        solve time in seconds (for benchmarks); ``tangents``: a list that receives each
-        step's exact tangent per driver (dq per unit of each corner's hub z, the rack)
-        where the solve has it (``tangents_by_drivers``, or the targets are the
-        drivers) — it stays empty otherwise. Each solution keeps its own
-        (``drive_tangent``). Where ``tangents_by_targets`` instead: each step's tangent
-        per target, then each closure driver's, where the sweep is solved at once (None
-        per step marched: its Jacobian there is the last iterate's), for its
-        measured_at and own_columns alone (no solution's drive_tangent)."""
+        solve time in seconds (benchmarks); ``tangents``: a list that receives each step's
+        exact tangent per driver (dq per unit of each corner's hub z, the rack) where the
+        solve has it (``tangents_by_drivers``, or the targets are the drivers) — it stays
+        empty otherwise. Each solution keeps its own (``drive_tangent``). Where
+        ``tangents_by_targets`` instead: each step's tangent per target, then each closure
+        driver's, where the sweep is solved at once (None per step marched: its Jacobian
+        there is the last iterate's), for its measured_at and own_columns alone."""
         check_held(sweep)
         solver = self.solver_for(sweep.targets, sweep.source)
         values = self.target_values(sweep.targets)
@@ -379,6 +378,7 @@ class Assembly(SteeringSurface, Composed, AnalysesSurface):
             keep=keep,
             bulk=True,
             extra=extra,
+            guess=guess,
         )
         if found is None:
             return solutions

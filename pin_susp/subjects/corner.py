@@ -167,15 +167,30 @@ class Corner(Assembly, Linkage):
         return Corner(corners[""], warn=False)
 
     # Assembly surface for study
-    def sweep_and_design(self, sweep: Sweep, only=None) -> tuple[Results, dict]:
+    solves_stacked = True
+
+    def keep_solver(self, targets: list, solver) -> None:
+        """The solver built for ``targets`` (this very list, a study's sweep's) handed back
+        by solver_for instead of building it again (a study's variant, solved together
+        first: study/batch.py)."""
+        self._kept_solver = (targets, solver)
+
+    def solver_for(self, targets: list, source: str = "<targets>"):
+        kept = self.__dict__.get("_kept_solver")
+        if kept is not None and kept[0] is targets:
+            return kept[1]
+        return super().solver_for(targets, source)
+
+    def sweep_and_design(self, sweep: Sweep, only=None, guess=None) -> tuple[Results, dict]:
         # one pass of the columns over the design state and the steps: the steps solved
         # as run_sweep solves them, the design row column-wise the same
         tangents = []
-        solutions = self.solve_steps(sweep, tangents=tangents)
+        solutions = self.solve_steps(sweep, tangents=tangents, guess=guess)
         design = Solution(self.q_design.copy(), True, 0, 0.0)
-        both = Results.from_solutions(
-            self, [design, *solutions], sweep, [None, *tangents] if tangents else None, only
-        )
+        if tangents:  # the design state's too (else every step's would be worked out again)
+            self._drive.evaluate(self.q_design)
+            tangents = [self._drive.tangent(self.drive_rhs), *tangents]
+        both = Results.from_solutions(self, [design, *solutions], sweep, tangents or None, only)
         columns = {k: v[1:] for k, v in both.columns.items()}
         columns["step_index"] = np.arange(len(solutions))
         meta = dict(both.meta, q=both.meta["q"][1:], why=both.meta["why"][1:])

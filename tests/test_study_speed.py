@@ -1,0 +1,200 @@
+"""The fast paths of a study (docs/studies.md, Speed) give what the slow ones give: a
+variant's model copied from its structure's first one is the model parsed from its own
+URDF, bit for bit; every variant's every step solved together from the design variant's solutions
+gives each variant's summary as its own direct sweep does, and flags the same variants."""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import pytest
+import yaml
+
+from pin_susp import Corner, load_sweep
+from pin_susp.model.urdf import read_closures, tree_to_urdf
+from pin_susp.solve.bulk import Tree, tree_of
+from pin_susp.study import batch, load_study, run_study, tasks, variant_data, variant_table
+from pin_susp.study.variants import build
+
+EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+BUMP = EXAMPLES / "bump_rack_held.yaml"
+SUMMARY = ["camber", "roadwheel_angle", "deriv_roadwheel_angle_wrt_hub_z"]
+
+
+def write_study(
+    folder: Path, body: dict, geometry: str = "double_wishbone.yaml", sweep: Path = BUMP
+) -> Path:
+    data = {"version": 1, "geometry": str(EXAMPLES / geometry), "sweep": str(sweep)} | body
+    path = folder / f"study_{Path(geometry).stem}.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return path
+
+
+def counted(monkeypatch) -> list:
+    """(variants offered, variants solved) of each batch solved together."""
+    out = []
+    together = batch._together
+
+    def counting(variants, *args):
+        solved = together(variants, *args)
+        out.append((len(variants), len(solved)))
+        return solved
+
+    monkeypatch.setattr(batch, "_together", counting)
+    return out
+
+
+def tolerances(tmp_path, geometry: str, tolerance: float, samples: int, sweep: Path = BUMP):
+    body = {
+        "variables": {"all_hardpoints": {"tolerance": tolerance}},
+        "kind": "monte_carlo",
+        "monte_carlo": {"samples": samples, "seed": 4},
+        "summary": SUMMARY
+        if sweep == BUMP
+        else ["camber" + ("_left" if "axle" in geometry else "")],
+    }
+    return load_study(write_study(tmp_path, body, geometry, sweep))
+
+
+@pytest.mark.parametrize(
+    "geometry",
+    [
+        "double_wishbone.yaml",
+        "macpherson.yaml",
+        "multilink_front.yaml",
+        "multilink_rear.yaml",
+        "pushrod_rocker.yaml",
+        "semi_trailing_arm.yaml",
+        "fixed_toe_link.yaml",
+        "axle_front.yaml",
+    ],
+)
+def test_a_variants_model_is_the_one_parsed_from_its_urdf(tmp_path, geometry):
+    """Each later variant of a structure is a copy of the first's model with its own
+    joint origins, axes and frame offsets: compared with a fresh parse of its own URDF
+    (every joint placement, joint kind and axis, frame and closure anchor, bit for bit)."""
+    if geometry.startswith("axle"):
+        sweep = EXAMPLES / "roll.yaml"
+    else:  # a bump alone: every kind of corner takes it (a rack's held)
+        sweep = tmp_path / "bump.yaml"
+        targets = [
+            {
+                "point": "wheel_center",
+                "direction": {"axis": "z"},
+                "mode": "relative",
+                "values": [0.0, 10.0],
+            }
+        ]
+        sweep.write_text(yaml.safe_dump({"version": 1, "targets": targets}))
+    study = tolerances(tmp_path, geometry, 0.8, 3, sweep)
+    job = study.job()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for deltas in variant_table(study):  # the first primes its structure's model
+            subject = build(variant_data(job.geometry, job.variables, deltas), "v", True)
+    text = tree_to_urdf(replace(subject.tree, visuals=[]))
+    parsed = pin.buildModelFromXML(text)
+    model = subject.model
+    assert list(model.names) == list(parsed.names)
+    for a, b in zip(model.jointPlacements, parsed.jointPlacements, strict=True):
+        assert np.array_equal(a.homogeneous, b.homogeneous)
+    for a, b in zip(model.joints, parsed.joints, strict=True):
+        assert a.shortname() == b.shortname() and (a.idx_q, a.idx_v) == (b.idx_q, b.idx_v)
+        if a.shortname().endswith("Unaligned"):
+            assert np.array_equal(a.extract().axis, b.extract().axis)
+    for a, b in zip(list(model.frames)[: parsed.nframes], parsed.frames, strict=True):
+        assert (a.name, a.parentJoint, a.type) == (b.name, b.parentJoint, b.type)
+        assert np.array_equal(a.placement.homogeneous, b.placement.homogeneous)
+    # its bulk tree (Tree.like, from the first's) as one built from its model
+    given, built = tree_of(subject.kin), Tree(model)
+    assert given.model is model and given._identity == built._identity
+    for a, b in zip(given.joints, built.joints, strict=True):
+        assert a[0] == b[0] and a[1] == b[1] and a[5] == b[5]
+        assert all(np.array_equal(x, y) for x, y in zip(a[2:5], b[2:5], strict=True))
+    # the closures' anchors (frames added after the URDF's) as the text says
+    for spec, closure in zip(read_closures(text), subject.tree.closures, strict=True):
+        for i, (link, offset) in enumerate(spec.anchors):
+            frame = model.frames[model.getFrameId(f"{closure.name}/{i}")]
+            parent = parsed.frames[parsed.getFrameId(link)]
+            expected = parent.placement * pin.SE3(np.eye(3), offset)
+            assert np.array_equal(frame.placement.homogeneous, expected.homogeneous)
+
+
+def test_variants_solved_at_once_equal_their_own_direct_sweeps(tmp_path, monkeypatch):
+    """A random sample of a Monte Carlo's variants: each summary equals its own corner's
+    direct sweep (Corner(variant geometry).run_sweep, marched) to 1e-9, every variant's
+    steps having been solved at once from the design variant's solutions."""
+    together = counted(monkeypatch)
+    study = tolerances(tmp_path, "double_wishbone.yaml", 1.5, 12)
+    outcome = run_study(study, tmp_path / "out", scheduler=None)
+    variants = outcome.variants
+    assert sum(n for n, _ in together) == len(variants) == sum(k for _, k in together)
+    sweep = load_sweep(BUMP)
+    design = load_sweep(
+        {
+            "version": 1,
+            "targets": [
+                {
+                    "point": "wheel_center",
+                    "direction": {"axis": "z"},
+                    "mode": "relative",
+                    "values": [0.0],
+                }
+            ],
+        }
+    )
+    for vid in np.random.default_rng(7).choice(len(variants), 4, replace=False):
+        row = variants.iloc[vid]
+        data = variant_data(study.geometry_data, study.variables, row[study.names].to_numpy())
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            corner = Corner(data)
+            direct, static = corner.run_sweep(sweep), corner.run_sweep(design)
+        assert row["converged"] and direct["solver_converged"].all()
+        for m in SUMMARY:
+            assert row[f"{m}_min"] == pytest.approx(np.min(direct[m]), abs=1e-9)
+            assert row[f"{m}_max"] == pytest.approx(np.max(direct[m]), abs=1e-9)
+            assert row[f"{m}_static"] == pytest.approx(static[m][0], abs=1e-9)
+
+
+def test_failed_variants_are_flagged_as_when_marched(tmp_path, monkeypatch):
+    """A DOE over a box so wide that some variants' sweeps fail part way (±200 mm of
+    travel): the same rows — converged, steps failed, error, summaries — whether each
+    variant's steps are first solved at once from the design variant's (where that
+    converges: some here) or marched from the start (no guess)."""
+    sweep = tmp_path / "deep.yaml"
+    targets = [
+        {"point": "wheel_center", "direction": {"axis": "z"}, "mode": "relative"},
+        {"point": "trackrod_inboard", "direction": {"axis": "y"}, "mode": "relative"},
+    ]
+    targets[0] |= {"start": -200, "stop": 200}
+    targets[1] |= {"start": 0, "stop": 0}
+    sweep.write_text(yaml.safe_dump({"version": 1, "steps": 21, "targets": targets}))
+    body = {
+        "variables": [
+            {"point": "upper_wishbone_inboard_front", "axis": "z", "range": [-250, 250]},
+            {"point": "lower_wishbone_outboard", "axis": "y", "range": [-150, 150]},
+        ],
+        "kind": "doe",
+        "doe": {"method": "full_factorial", "levels": 3},
+        "summary": ["camber", "roadwheel_angle"],
+    }
+    study = load_study(write_study(tmp_path, body, "double_wishbone.yaml", sweep))
+    together = counted(monkeypatch)
+    fast = run_study(study, tmp_path / "fast", scheduler=None).variants
+    solved = sum(k for _, k in together)  # some solved together, some marched
+    assert 0 < solved < sum(n for n, _ in together)
+    monkeypatch.undo()
+    monkeypatch.setattr(tasks, "guess_of", lambda job, sweep: None)
+    marched = run_study(study, tmp_path / "marched", scheduler=None).variants
+    assert (~fast["converged"]).sum() >= 2 and (fast["steps_failed"] < 21).all()
+    for c in ("variant_id", "converged", "steps_failed", "error"):
+        assert (fast[c] == marched[c]).all(), c
+    numbers = [c for c in fast.columns if c.endswith(("_static", "_min", "_max"))]
+    a, b = fast[numbers].to_numpy(float), marched[numbers].to_numpy(float)
+    assert np.array_equal(np.isnan(a), np.isnan(b))
+    assert np.allclose(a, b, atol=1e-9, rtol=0.0, equal_nan=True)
