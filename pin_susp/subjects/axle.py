@@ -75,7 +75,8 @@ class AxleModel(AxleAssembly):
     c_factor_key = "axle_config.steering.c_factor"  # docs/axle.md
 
     labels = SIDES
-    # every command but export, which writes one corner's points (docs/interop.md)
+    # every command but export, which writes one corner's points (docs/interop.md); a
+    # vehicle takes these but study (Vehicle.commands)
     commands = (
         "sweep",
         "attitude",

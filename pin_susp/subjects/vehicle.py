@@ -35,6 +35,7 @@ from ..model.geometry import contact_patch, summary_repr
 from ..model.mechanisms import xml_name
 from ..model.steering import Steering, c_factor_of, steer_sense
 from ..solve.linkage import RACK_HELD, Linkage
+from .axle import AxleModel
 from .axle_file import AxleGeometry
 from .corner import Results
 from .elements import elements_of, rack
@@ -110,21 +111,8 @@ class Vehicle(VehicleExport, VehicleViews, VehicleTangents, VehicleAssembly):
 
     labels = LABELS
     noun = "vehicle"
-    commands = (
-        "sweep",
-        "attitude",
-        "urdf",
-        "mjcf",
-        "validate",
-        "view",
-        "draw",
-        "loads",
-        "setup",
-        "sensitivity",
-        "clearance",
-        "envelope",
-        "kc",
-    )  # docs/vehicle.md: the rest not yet
+    # an axle's commands but a study's (docs/vehicle.md: the rest not yet)
+    commands = tuple(c for c in AxleModel.commands if c != "study")
     reports = True
     on_road = True
     summary_columns = tuple(
