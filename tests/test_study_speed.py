@@ -15,9 +15,11 @@ import pytest
 import yaml
 
 from pin_susp import Corner, load_sweep
+from pin_susp.model.sweep import Sweep
 from pin_susp.model.urdf import read_closures, tree_to_urdf
 from pin_susp.solve.bulk import Tree, tree_of
 from pin_susp.study import batch, load_study, run_study, tasks, variant_data, variant_table
+from pin_susp.study.together import Together
 from pin_susp.study.variants import build
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
@@ -35,17 +37,38 @@ def write_study(
 
 
 def counted(monkeypatch) -> list:
-    """(variants offered, variants solved) of each batch solved together."""
+    """(variants offered, variants solved, how) of each batch solved together: "measured"
+    from their trees' numbers (together.py), or "built" and then solved together (batch.py:
+    the rest of a batch, offered after the measured)."""
     out = []
-    together = batch._together
+    together, measure = batch._together, Together.measure
 
     def counting(variants, *args):
         solved = together(variants, *args)
-        out.append((len(variants), len(solved)))
+        out.append((len(variants), len(solved), "built"))
         return solved
 
+    def measuring(self, table):
+        measured = measure(self, table)
+        out.append((len(table), sum(m is not None for m in measured), "measured"))
+        return measured
+
     monkeypatch.setattr(batch, "_together", counting)
+    monkeypatch.setattr(Together, "measure", measuring)
     return out
+
+
+def direct(study, deltas) -> tuple:
+    """A variant's own corner's direct sweep (marched) and its design state."""
+    job = study.job()
+    data = variant_data(study.geometry_data, study.variables, deltas)
+    sweep = load_sweep(job.sweep)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        corner = Corner(data)
+        return corner.run_sweep(sweep), corner.run_sweep(
+            Sweep([t.at_design() for t in sweep.targets], "design")
+        )
 
 
 def tolerances(tmp_path, geometry: str, tolerance: float, samples: int, sweep: Path = BUMP):
@@ -124,41 +147,85 @@ def test_a_variants_model_is_the_one_parsed_from_its_urdf(tmp_path, geometry):
             assert np.array_equal(frame.placement.homogeneous, expected.homogeneous)
 
 
-def test_variants_solved_at_once_equal_their_own_direct_sweeps(tmp_path, monkeypatch):
+@pytest.mark.parametrize("way", ["measured", "built"])
+def test_variants_solved_at_once_equal_their_own_direct_sweeps(tmp_path, monkeypatch, way):
     """A random sample of a Monte Carlo's variants: each summary equals its own corner's
     direct sweep (Corner(variant geometry).run_sweep, marched) to 1e-9, every variant's
-    steps having been solved at once from the design variant's solutions."""
+    steps having been solved at once from the design variant's solutions — measured from
+    the trees' numbers alone (together.py), or (that way turned off) each variant built
+    and the batch's steps then solved together (batch.py)."""
+    if way == "built":
+        monkeypatch.setattr(batch, "_together_of", lambda *args: None)
     together = counted(monkeypatch)
     study = tolerances(tmp_path, "double_wishbone.yaml", 1.5, 12)
     outcome = run_study(study, tmp_path / "out", scheduler=None)
     variants = outcome.variants
-    assert sum(n for n, _ in together) == len(variants) == sum(k for _, k in together)
-    sweep = load_sweep(BUMP)
-    design = load_sweep(
-        {
-            "version": 1,
-            "targets": [
-                {
-                    "point": "wheel_center",
-                    "direction": {"axis": "z"},
-                    "mode": "relative",
-                    "values": [0.0],
-                }
-            ],
-        }
-    )
+    assert sum(k for _, k, _ in together) == len(variants)  # each solved together
+    measured = sum(k for _, k, how in together if how == "measured")
+    assert measured == (len(variants) if way == "measured" else 0)
     for vid in np.random.default_rng(7).choice(len(variants), 4, replace=False):
         row = variants.iloc[vid]
-        data = variant_data(study.geometry_data, study.variables, row[study.names].to_numpy())
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            corner = Corner(data)
-            direct, static = corner.run_sweep(sweep), corner.run_sweep(design)
-        assert row["converged"] and direct["solver_converged"].all()
+        steps, static = direct(study, row[study.names].to_numpy())
+        assert row["converged"] and steps["solver_converged"].all()
         for m in SUMMARY:
-            assert row[f"{m}_min"] == pytest.approx(np.min(direct[m]), abs=1e-9)
-            assert row[f"{m}_max"] == pytest.approx(np.max(direct[m]), abs=1e-9)
+            assert row[f"{m}_min"] == pytest.approx(np.min(steps[m]), abs=1e-9)
+            assert row[f"{m}_max"] == pytest.approx(np.max(steps[m]), abs=1e-9)
             assert row[f"{m}_static"] == pytest.approx(static[m][0], abs=1e-9)
+
+
+CORNERS = {  # every mechanism, spring and steering kind of the examples: a study's sweep
+    "double_wishbone.yaml": "bump_steer.yaml",
+    "macpherson.yaml": "bump_rack_held.yaml",
+    "multilink_front.yaml": "bump_steer.yaml",
+    "multilink_rear.yaml": "bump.yaml",
+    "pushrod_rocker.yaml": "bump_steer.yaml",
+    "semi_trailing_arm.yaml": "bump.yaml",
+    "fixed_toe_link.yaml": "bump.yaml",
+    "packaging.yaml": "bump_steer.yaml",
+    "wheel_centre.yaml": "bump_steer.yaml",
+    "camber_shim.yaml": "bump_rack_held.yaml",  # (a setup solve per variant: built)
+}
+
+
+@pytest.mark.parametrize("geometry", sorted(CORNERS))
+def test_every_mechanisms_variants_measured_together_equal_their_direct_sweeps(
+    tmp_path, monkeypatch, geometry
+):
+    """Each example corner (every mechanism; rocker, torsion bar, toe link): a Monte
+    Carlo's variants (every hardpoint within ±1 mm) measured together from their trees'
+    numbers, each summary — camber, toe, its derivative by hub z, the motion ratio where
+    the summary may read it — equal to its own direct sweep's to 1e-9."""
+    sweep = EXAMPLES / CORNERS[geometry]
+    summary = ["camber", "roadwheel_angle", "deriv_roadwheel_angle_wrt_hub_z", "fvic_z"]
+    summary += ["scrub_radius", "wheel_travel"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        if "motion_ratio" in Corner(EXAMPLES / geometry).run_sweep(sweep):  # a spring's
+            summary.append("motion_ratio")
+    body = {
+        "variables": {"all_hardpoints": {"tolerance": 1.0}},
+        "kind": "monte_carlo",
+        "monte_carlo": {"samples": 6, "seed": 2},
+        "summary": summary,
+    }
+    study = load_study(write_study(tmp_path, body, geometry, sweep))
+    together = counted(monkeypatch)
+    variants = run_study(study, tmp_path / "out", scheduler=None).variants
+    measured = sum(k for _, k, how in together if how == "measured")
+    assert measured == (0 if geometry == "camber_shim.yaml" else len(variants))
+    assert variants["converged"].all()
+    for vid in (0, 3, 5):
+        row = variants.iloc[vid]
+        steps, static = direct(study, row[study.names].to_numpy())
+        for m in summary:
+            values = steps[m][np.isfinite(steps[m])]
+            if not values.size:  # (undefined: a trailing arm's scrub radius)
+                assert np.isnan(row[f"{m}_min"]) and np.isnan(row[f"{m}_max"]), m
+                continue
+            assert row[f"{m}_min"] == pytest.approx(values.min(), rel=1e-9, abs=1e-9), m
+            assert row[f"{m}_max"] == pytest.approx(values.max(), rel=1e-9, abs=1e-9), m
+            at = pytest.approx(static[m][0], rel=1e-9, abs=1e-9, nan_ok=True)
+            assert row[f"{m}_static"] == at, m
 
 
 def test_failed_variants_are_flagged_as_when_marched(tmp_path, monkeypatch):
@@ -186,8 +253,8 @@ def test_failed_variants_are_flagged_as_when_marched(tmp_path, monkeypatch):
     study = load_study(write_study(tmp_path, body, "double_wishbone.yaml", sweep))
     together = counted(monkeypatch)
     fast = run_study(study, tmp_path / "fast", scheduler=None).variants
-    solved = sum(k for _, k in together)  # some solved together, some marched
-    assert 0 < solved < sum(n for n, _ in together)
+    solved = sum(k for _, k, _ in together)  # some solved together, some marched
+    assert 0 < solved < len(fast)
     monkeypatch.undo()
     monkeypatch.setattr(tasks, "guess_of", lambda job, sweep: None)
     marched = run_study(study, tmp_path / "marched", scheduler=None).variants

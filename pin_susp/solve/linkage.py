@@ -222,7 +222,7 @@ class FrameMotion:
             live = [i for i, c in enumerate(picks) if moving[:, :, c].any()]
             if not live:
                 continue
-            v, w = _twist(tree, j, o, a, T)  # (k, n, 3) each
+            v, w = twist(tree, j, o, a, T)  # (k, n, 3) each
             arms = np.ascontiguousarray(arms)[:, None]
             for i in live:
                 c = picks[i]
@@ -239,7 +239,7 @@ class FrameMotion:
         return out_pos, out_rates
 
 
-def _twist(tree, joint: int, o: np.ndarray, a: np.ndarray, T: np.ndarray) -> tuple:
+def twist(tree, joint: int, o: np.ndarray, a: np.ndarray, T: np.ndarray) -> tuple:
     """The velocity of a joint's origin and its angular velocity (k, n, 3) along each
     tangent column (T: (n, nv, k)): Tree.twist_jacobian times T, in the joints that move
     it alone (a revolute one k moves the origin at a_k × (o − o_k) and turns it at a_k, a

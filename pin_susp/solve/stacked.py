@@ -120,6 +120,23 @@ class Stack:
             plain = Frames(base.tree, guard_ids)
             self._guard = StackedFrames(plain, tree, numbers["guard"])
 
+    @classmethod
+    def of(cls, base: Rows, numbers: dict, lengths: dict, loops=None) -> Stack:
+        """A Stack of ``base``'s rows over configurations whose numbers are given: per
+        configuration (arrays (N, 3) or (N,)) each joint's axis and origin in its parent
+        (``numbers["axes"]``, ``["offsets"]``: lists over joints, None for the
+        universe), each of base's frames' offset in its joint (``["frames"]``), the
+        length of each distance closure (``lengths``: index in base.items → (N,)); with
+        ``loops`` — (kind, frame ids) per loop guarded, their signs (N,) each, the
+        guard's frame ids — each of those frames' offset (``["guard"]``)."""
+        rows, by_length = [], []
+        for index, (row, k, i) in enumerate(base.items):
+            if index in lengths:
+                row = copy.copy(row)
+                by_length.append((row, lengths[index]))
+            rows.append((row, k, i))
+        return cls(base, dict(numbers), rows, by_length, loops or ((), (), []))
+
     def solve(self, guess: np.ndarray, values: np.ndarray):
         """Every configuration's Newton iterations (guess (N, nq), values (N, k)):
         q, tangents per target (N, nv, k), iterations, max |r| and whether each converged

@@ -38,7 +38,7 @@ def _origins(tree, steps) -> dict:
     return origin
 
 
-def _signature(tree, steps) -> tuple:
+def signature(tree, steps) -> tuple:
     """What a model parsed from the tree's URDF is made of, without its numbers: a
     joint along a coordinate axis is another kind of Pinocchio joint than one along
     any other axis."""
@@ -159,7 +159,7 @@ def variant_model(tree, parse, closures: bool = True):
     if tree.floating is not None:
         return (*parse(tree), None)
     steps = joint_steps(tree)
-    key = _signature(tree, steps)
+    key = signature(tree, steps)
     template = _TEMPLATES.get(key)
     if template is None:
         model, specs = parse(tree)

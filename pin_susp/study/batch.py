@@ -16,7 +16,47 @@ from .variants import Variant
 
 
 def solve_batch(job: Job, table: np.ndarray, sweep, guess, every_column: bool) -> list:
-    """The batch's Variants (``table``: each one's variables), each solved."""
+    """The batch's Variants (``table``: each one's variables), each solved: a corner's
+    measured together from their trees' numbers where they can be (together.py), the
+    others built and solved as below."""
+    measured = [None] * len(table)
+    if guess is not None and not every_column:
+        together = _together_of(job, sweep, guess)
+        if together is not None:
+            measured = together.measure(table)
+    rest = [i for i, m in enumerate(measured) if m is None]
+    for i, v in zip(rest, _built(job, table[rest], sweep, guess, every_column), strict=True):
+        measured[i] = v
+    return measured
+
+
+_TOGETHER: dict = {}  # id(job) → (job, its Together or None): the job's tasks' process's
+
+
+def _together_of(job: Job, sweep, guess):
+    """The job's Together (its design corner's structure, read once per process), or
+    None where its variants cannot be measured so."""
+    from .together import Together
+    from .variants import design_of
+
+    kept = _TOGETHER.get(id(job))
+    if kept is None or kept[0] is not job:
+        design = design_of(job, sweep)
+        together = None
+        if design.subject is not None and design.subject.solves_stacked:
+            try:
+                together = Together(job, design.subject, sweep, guess)
+            except (PinSuspError, ArithmeticError, ValueError, np.linalg.LinAlgError):
+                together = None
+            together = together if together is not None and together.ok else None
+        if len(_TOGETHER) >= 4:
+            _TOGETHER.clear()
+        kept = _TOGETHER[id(job)] = (job, together)
+    return kept[1]
+
+
+def _built(job: Job, table: np.ndarray, sweep, guess, every_column: bool) -> list:
+    """Variants built one by one, then solved together where they can be (below)."""
     variants = [Variant(job, d, sweep, every_column, later=True) for d in table]
     together = [v for v in variants if v.subject is not None and v.subject.solves_stacked]
     solved = _together(together, sweep, guess) if guess is not None and together else {}

@@ -11,7 +11,7 @@ import numpy as np
 from .batch import solve_batch
 from .data import Job
 from .derivatives import objective_jacobian
-from .variants import Variant
+from .variants import Variant, design_of
 
 
 def run_batch(job: Job, index: int, ids: np.ndarray, table: np.ndarray, steps: bool) -> dict:
@@ -88,8 +88,7 @@ def guess_of(job: Job, sweep) -> np.ndarray | None:
     per process that runs the job's tasks (kept on the job)."""
     key = "_guess"
     if key not in job.__dict__:
-        design = Variant(job, np.zeros(len(job.variables)), sweep, every_column=False)
-        job.__dict__[key] = design.solved
+        job.__dict__[key] = design_of(job, sweep).solved
     return job.__dict__[key]
 
 
@@ -97,11 +96,7 @@ def _row(job: Job, vid: int, deltas, v: Variant) -> dict:
     row = {"variant_id": vid}
     row.update({var.name: float(d) for var, d in zip(job.variables, deltas, strict=True)})
     row["converged"] = v.converged
-    row["steps_failed"] = (
-        len(v.sweep.targets[0].values)
-        if v.results is None
-        else int((~v.results["solver_converged"]).sum())
-    )
+    row["steps_failed"] = v.steps_failed
     row.update(v.summary_row())
     row["error"] = v.error
     return row

@@ -162,6 +162,13 @@ class Variant:
     def converged(self) -> bool:
         return self.results is not None and bool(self.results["solver_converged"].all())
 
+    @property
+    def steps_failed(self) -> int:
+        """How many of its sweep's steps did not converge (every one if none was solved)."""
+        if self.results is None:
+            return len(self.sweep.targets[0].values)
+        return int((~self.results["solver_converged"]).sum())
+
     def summary_row(self) -> dict:
         row = {}
         n = len(self.sweep.targets[0].values)
@@ -183,3 +190,18 @@ class Variant:
         if self.results is None:
             return missed(self.job.terms, len(self.sweep.targets[0].values))
         return objective_residuals(self.job.terms, self.results, self.static)
+
+
+_DESIGNS: dict = {}  # id(job) → (job, its design Variant), this process's
+
+
+def design_of(job: Job, sweep) -> Variant:
+    """The job's design variant (every variable 0), solved through the sweep: built
+    once per process that runs the job's tasks."""
+    kept = _DESIGNS.get(id(job))
+    if kept is None or kept[0] is not job:
+        if len(_DESIGNS) >= 4:
+            _DESIGNS.clear()
+        design = Variant(job, np.zeros(len(job.variables)), sweep, every_column=False)
+        kept = _DESIGNS[id(job)] = (job, design)
+    return kept[1]

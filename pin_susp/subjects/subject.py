@@ -127,6 +127,12 @@ class SubjectKind:
 
 
 class _CornerKind(SubjectKind):
+    def variant_data(self, data: dict) -> dict:
+        """A copy in which its hardpoints are its own (the rest is only read: shared)."""
+        out = dict(data)
+        out["hardpoints"] = {k: copy.copy(v) for k, v in data["hardpoints"].items()}
+        return out
+
     def build(self, data: dict, source: str, variant: bool = False) -> Assembly:
         from ..io.yamlio import Reader
         from ..model.geometry import parse_geometry, warn_dead_centres

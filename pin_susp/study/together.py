@@ -1,0 +1,386 @@
+"""A batch of a study's corner variants solved and measured together, from the numbers
+of their trees alone (docs/studies.md, Speed).
+
+Every variant of one corner has the design's tree with other numbers: its joints at
+other origins along other axes, its points and closure anchors elsewhere, its
+distance closures of other lengths (solve/template.py). Those numbers are read here
+straight from each variant's tree — no model, solver or URDF built per variant — and
+the batch is then one set of configurations (every variant's design state and every
+step of its sweep) on the design model's tree with each configuration's own numbers
+(solve/stacked.py):
+
+- the sweep's steps by Newton iterations together from the design variant's
+  solutions, each kept on its own loops' design branches;
+- each configuration's tangent per driver (the drivers' rows, solved at once);
+- every point's position and rates along the drivers, the contact patch by the chain
+  rule, and the summary's metric columns over all of them in one call of
+  ``metric_columns``, each variant's design positions its own.
+
+A variant is measured so only where that is the row it would have alone: its tree
+of the design's structure, its geometry needing no setup solve, its loops' branches
+told apart at design by the same points as the design's, its closures independent
+and its wheel free in bump at design, every step converged on its branches. Any
+other variant (and every variant of a job this cannot serve: ``Together.ok``) is
+built and solved on its own, as before (batch.py).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+
+from ..columns.metrics import metric_columns
+from ..constraints.branch import MEASURES_MANY, LoopBranch
+from ..errors import PinSuspError
+from ..io.yamlio import Reader
+from ..maths.jet import Dual, cross
+from ..model.geometry import parse_geometry, unit
+from ..model.tree import joint_steps
+from ..model.wheel import contact_patch
+from ..solve.bulk import rows_of, solve_all
+from ..solve.linkage import twist
+from ..solve.stacked import Stack, StackedTree
+from ..solve.template import signature
+from .variants import variant_data
+
+
+class Measured:
+    """A variant measured together with its batch: its summary row, every step converged
+    (the Variant interface run_batch reads)."""
+
+    converged = True
+    error = ""
+    steps_failed = 0
+
+    def __init__(self, row: dict):
+        self._row = row
+
+    def summary_row(self) -> dict:
+        return dict(self._row)
+
+
+def _world(tree, steps) -> dict:
+    """name → world position at design of every frame a model of the tree has: each
+    point (and its fixed joint), each link and joint frame, each closure's anchors."""
+    world = {}
+    for s in steps:
+        world[s.child] = world[s.name] = s.origin
+    for name, (body, position) in tree.points.items():
+        world[name] = world[f"{body}_to_{name}"] = position
+    for c in tree.closures:
+        for i, (_, p) in enumerate(c.anchors):
+            world[f"{c.name}/{i}"] = p
+    return world
+
+
+class Together:
+    """What every variant of a job's corner shares, read once from the design corner
+    (its model, its sweep's solver and its drivers' rows): ``ok`` where its variants can
+    be measured together; ``measure(table)`` → per variant a Measured, or None (that
+    variant to be built and solved on its own)."""
+
+    def __init__(self, job, design, sweep, guess: np.ndarray):
+        self.ok = False
+        self.job, self.design, self.sweep, self.guess = job, design, sweep, guess
+        self.needs = set(job.needs)
+        g = design.geometry
+        if self._tree(np.zeros(len(job.variables))) is None:
+            return  # (its setup solved per variant, or no tree of its own)
+        if "motion_ratio" in self.needs and g.spring == "torsion_bar":
+            return  # (a setup solve per variant; a bar's sense read per variant)
+        if set(design.corner_points) != {""} or design.shared:
+            return
+        model = design.model
+        self.solver = design.solver_for(sweep.targets, sweep.source)
+        self.rows, self.drive = rows_of(self.solver), rows_of(design._drive)
+        for rows in (self.rows, self.drive):
+            tree = rows.tree
+            if not rows.supported or not all(tree._identity) or rows.nrows != tree.nv:
+                return
+        self.held = design.held_targets(sweep.targets)
+        if any(t.quantity is not None for t in self.held):
+            return
+        if guess.shape != (len(self.held[0].values), model.nq):
+            return
+        steps = joint_steps(design.tree)
+        self.signature = signature(design.tree, steps)
+        self.parents = [0] + [model.parents[i] for i in range(1, model.njoints)]
+        # the loops: each one's candidate points (the primary, the fallback) and which
+        # the design picked; the guard (solve_steps') holds the non-degenerate ones
+        self.loops = []
+        by_name = {c.name: c for c in design.tree.closures}
+        for loop in design.branches:
+            c = by_name[loop.name]
+            sets = [[design.points[n] for n in c.branch]]
+            if c.branch_fallback:
+                sets.append([design.points[n] for n in c.branch_fallback])
+            pick = [p.frame_id for p in loop.points]
+            chosen = next(i for i, s in enumerate(sets) if [p.frame_id for p in s] == pick)
+            self.loops.append((loop, sets, chosen))
+        guarded = [lp.name for lp in self.solver.branches.loops]
+        self.guarded = [i for i, (lp, _, _) in enumerate(self.loops) if lp.name in guarded]
+        if [self.loops[i][0].name for i in self.guarded] != guarded:
+            return
+        # the frames read: the rows', the loops', every output point's
+        motion_names = [n for n in design.output_points if "contact_patch_center" not in n]
+        self.motion = [(n, design.points[n].frame_id) for n in motion_names]
+        ids = set(self.rows.frames.ids) | set(self.drive.frames.ids)
+        ids |= {p.frame_id for _, sets, _ in self.loops for s in sets for p in s}
+        ids |= {f for _, f in self.motion}
+        self.ids = sorted(ids)
+        self.names = [model.frames[f].name for f in self.ids]
+        self.column = {f: i for i, f in enumerate(self.ids)}
+        self.joint_of = np.array([model.frames[f].parentJoint for f in self.ids])
+        self.joint_names = [model.names[i] for i in range(1, model.njoints)]
+        # a distance closure's length: |its anchors' distance| at design
+        self.lengths = {}
+        for rows in (self.rows, self.drive):
+            self.lengths[id(rows)] = [
+                (index, self.column[row.frames[0].frame_id], self.column[row.frames[1].frame_id])
+                for index, (row, _, _) in enumerate(rows.items)
+                if isinstance(vars(row).get("length"), float)
+            ]
+        self.ok = self._same(design)
+
+    # ---------------------------------------------------------------- numbers
+
+    def numbers(self, tree) -> tuple | None:
+        """A variant tree's frame positions (F, 3), joint origins and axes (nj, 3) at
+        design, or None where its structure is not the design's."""
+        steps = joint_steps(tree)
+        if signature(tree, steps) != self.signature:
+            return None
+        world = _world(tree, steps)
+        by_name = {s.name: s for s in steps}
+        try:
+            E = np.array([world[n] if n in world else np.zeros(3) for n in self.names])
+            J = np.array([np.zeros(3)] + [by_name[n].origin for n in self.joint_names])
+            A = np.array([np.zeros(3)] + [by_name[n].axis for n in self.joint_names])
+        except KeyError:
+            return None
+        A[1:] /= np.linalg.norm(A[1:], axis=1, keepdims=True)
+        return E, J, A
+
+    def _same(self, design) -> bool:
+        """Whether the design's own numbers, read from its tree as a variant's are, give
+        its model's joint placements, axes, frame offsets and closure lengths (else no
+        variant is measured together)."""
+        got = self.numbers(design.tree)
+        if got is None:
+            return False
+        E, J, A = (x[None] for x in got)
+        model = design.model
+        axes, offsets, frames = self._placed(E, J, A)
+        for i in range(1, model.njoints):
+            if not np.allclose(offsets[i][0], model.jointPlacements[i].translation, 0, 1e-15):
+                return False
+            if not np.allclose(axes[i][0], self.rows.tree.joints[i - 1][2], 0, 1e-15):
+                return False
+        for c, f in enumerate(self.ids):
+            if not np.allclose(frames[c][0], model.frames[f].placement.translation, 0, 1e-15):
+                return False
+        for rows in (self.rows, self.drive):
+            for index, a, b in self.lengths[id(rows)]:
+                length = rows.items[index][0].length
+                if not math.isclose(np.linalg.norm(E[0, b] - E[0, a]), length, rel_tol=1e-14):
+                    return False
+        return True
+
+    def _placed(self, E, J, A) -> tuple:
+        """Per joint its axis and its origin in its parent (lists over joints of
+        (n, 3)), per read frame its offset in its joint (list over frames of (n, 3))."""
+        nj = J.shape[1]
+        axes = [None] + [A[:, i] for i in range(1, nj)]
+        offsets = [None] + [J[:, i] - J[:, self.parents[i]] for i in range(1, nj)]
+        frames = [E[:, c] - J[:, j] for c, j in enumerate(self.joint_of)]
+        return axes, offsets, frames
+
+    # ---------------------------------------------------------------- measuring
+
+    def measure(self, table: np.ndarray) -> list:
+        """Per variant of the batch (its variables' rows) a Measured, or None."""
+        out = [None] * len(table)
+        trees, which = [], []
+        for i, deltas in enumerate(table):
+            tree = self._tree(deltas)
+            got = None if tree is None else self.numbers(tree)
+            if got is not None:
+                trees.append(got)
+                which.append(i)
+        if not which:
+            return out
+        E, J, A = (np.array([t[k] for t in trees]) for k in range(3))
+        keep, signs = self._branches(E)
+        if not keep.any():
+            return out
+        E, J, A, signs = E[keep], J[keep], A[keep], signs[:, keep]
+        which = [w for w, k in zip(which, keep, strict=True) if k]
+        rows = self._measured(E, J, A, signs)
+        for w, row in zip(which, rows, strict=True):
+            out[w] = None if row is None else Measured(row)
+        return out
+
+    def _tree(self, deltas):
+        """A variant's tree, or None where its geometry is refused or needs a setup
+        solve (its own build then says why, or solves it)."""
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                data = variant_data(self.job.geometry, self.job.variables, deltas)
+                g = parse_geometry(data, Reader("<dict>"), None)
+                if g.needs_setup:
+                    return None
+                return g.mechanism.tree(g)
+        except (PinSuspError, ArithmeticError, ValueError, np.linalg.LinAlgError):
+            return None
+
+    def _branches(self, E: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Which variants tell each loop's branches apart at design by the design's own
+        points (so that their guards are the design's), and each guarded loop's sign."""
+        n = len(E)
+        keep = np.ones(n, dtype=bool)
+        degenerate = LoopBranch.DEGENERATE
+        signs = np.ones((len(self.guarded), n))
+        for k, (loop, sets, chosen) in enumerate(self.loops):
+            values = [
+                MEASURES_MANY[loop.kind](*(E[:, self.column[p.frame_id]] for p in s)) for s in sets
+            ]
+            clear = [np.abs(v) >= degenerate * (1 + 1e-9) for v in values]
+            blurred = [np.abs(np.abs(v) - degenerate) <= 1e-9 * degenerate for v in values]
+            pick = np.where(clear[0], 0, np.where(clear[-1], len(sets) - 1, 0))
+            keep &= pick == chosen
+            keep &= ~np.any(blurred, axis=0)
+            keep &= clear[chosen] != loop.degenerate
+            if k in self.guarded:
+                signs[self.guarded.index(k)] = np.copysign(1.0, values[chosen])
+        return keep, signs
+
+    def _stack(self, rows, which, E, J, A, signs=None) -> Stack:
+        """A Stack of ``rows`` (the sweep's or the drivers') over configurations, each
+        configuration ``which[c]``'s variant numbers."""
+        axes, offsets, frames = self._placed(E[which], J[which], A[which])
+        col = [self.column[f] for f in rows.frames.ids]
+        numbers = {"axes": axes, "offsets": offsets, "frames": [frames[c] for c in col]}
+        lengths = {
+            index: np.linalg.norm(E[which, b] - E[which, a], axis=1)
+            for index, a, b in self.lengths[id(rows)]
+        }
+        loops = None
+        if signs is not None and self.guarded:
+            kinds = []
+            for k in self.guarded:
+                loop, sets, chosen = self.loops[k]
+                kinds.append((loop.kind, tuple(p.frame_id for p in sets[chosen])))
+            loops = (kinds, [s[which] for s in signs], self.ids)
+            numbers["guard"] = frames
+        return Stack.of(rows, numbers, lengths, loops)
+
+    def _measured(self, E, J, A, signs) -> list:
+        """Each variant's summary row, or None where some step did not converge on its
+        branches or its design state is singular."""
+        n, steps = len(E), len(self.held[0].values)
+        design = self._design_positions(E)
+        values = np.column_stack([self._values(t, design) for t in self.held])  # (n·steps, k)
+        on = np.repeat(np.arange(n), steps)
+        solve = self._stack(self.rows, on, E, J, A, signs)
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+            q, _, _, _, ok = solve.solve(np.tile(self.guess, (n, 1)), values)
+            ok &= solve.on_branches(q)
+        good = ok.reshape(n, steps).all(axis=1)
+        # every configuration measured: each variant's design state, then its steps
+        every = np.repeat(np.arange(n), steps + 1)
+        Q = np.zeros((n, steps + 1, q.shape[1]))
+        Q[:, 1:] = q.reshape(n, steps, -1)
+        Q = Q.reshape(-1, q.shape[1])
+        drive = self._stack(self.drive, every, E, J, A)
+        tree = drive.rows.tree
+        placed = tree.placements(Q)
+        zero = np.zeros((len(Q), len(self.design._drive.targets)))
+        _, Jd = drive.rows.evaluate(Q, zero, placed=placed)
+        good &= self._free(Jd.reshape(n, steps + 1, *Jd.shape[1:])[:, 0])
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+            T = solve_all(Jd, self.design.drive_rhs)
+            if T is None:
+                return [None] * n
+            columns = self._columns(tree, placed, T, E, J, every, design)
+        out = []
+        for v in range(n):
+            if not good[v]:
+                out.append(None)
+                continue
+            mine = slice(v * (steps + 1), (v + 1) * (steps + 1))
+            out.append(_summary(self.job.summary, {m: columns[m][0][mine] for m in columns}))
+        return out
+
+    def _free(self, J0: np.ndarray) -> np.ndarray:
+        """Whether each variant's closures are independent and its wheel moves in bump at
+        design (Linkage._check_mobility's tests: else its own build refuses it)."""
+        closures = len(J0[0]) - len(self.design._drive.targets)
+        ok = np.ones(len(J0), dtype=bool)
+        for rows in (J0[:, :closures], J0):
+            if rows.shape[1]:
+                s = np.linalg.svd(rows, compute_uv=False)
+                ok &= s[:, -1] > 1e-9 * s[:, 0]
+        return ok
+
+    def _design_positions(self, E: np.ndarray) -> dict:
+        """name → each variant's design position (n, 3) of every corner point."""
+        out = {name: E[:, self.column[f]] for name, f in self.motion}
+        radius = self.design.geometry.wheel.radius
+        spin = unit(out["axle_outboard"] - out["axle_inboard"])
+        out["contact_patch_center"] = contact_patch(out["wheel_center"], spin, radius)
+        return out
+
+    def _values(self, t, design: dict) -> np.ndarray:
+        """A held target's values at every variant's every step (target_values')."""
+        values = np.asarray(t.values, dtype=float) * 1e-3
+        n = len(next(iter(design.values())))
+        if t.mode != "relative":
+            return np.tile(values, n)
+        along = design[self.design.point_of(t)] @ t.unit_direction
+        return (values[None, :] + along[:, None]).ravel()
+
+    def _columns(self, tree: StackedTree, placed, T, E, J, every, design) -> dict:
+        """The summary's metric columns at every configuration (label_motion's points,
+        then metric_columns)."""
+        R, o = placed
+        a = tree.axes(R)
+        k = self.design.driver_columns[""]
+        T = T[:, :, k]
+        points = {}
+        for name, f in self.motion:
+            c = self.column[f]
+            j = self.joint_of[c]
+            if j == 0:
+                pos = E[every, c]
+                points[name] = {"": Dual(pos, np.zeros((len(k), *pos.shape)))}
+                continue
+            arm = np.einsum("nij,nj->ni", R[j], E[every, c] - J[every, j])
+            v, w = twist(tree, j, o, a, T)
+            points[name] = {"": Dual(arm + o[j], v + cross(w, arm[None]))}
+        g = self.design.geometry
+        wheel, inboard, outboard = (
+            points[n][""] for n in ("wheel_center", "axle_inboard", "axle_outboard")
+        )
+        points["contact_patch_center"] = {
+            "": contact_patch(wheel, unit(outboard - inboard), g.wheel.radius)
+        }
+        names = self.design.corner_points[""]
+        own = {name: points[name][""] for name in names}
+        at = {name: design[name][every] for name in names}
+        return metric_columns(g, own, at, self.design.spring_sense, self.needs)
+
+
+def _summary(summary: list, columns: dict) -> dict:
+    """Variant.summary_row's figures from a variant's columns (its design state first,
+    then its steps, every one converged)."""
+    row = {}
+    for m in summary:
+        values = columns[m][1:]
+        finite = values[np.isfinite(values)]
+        row[f"{m}_static"] = float(columns[m][0])
+        row[f"{m}_min"] = float(finite.min()) if finite.size else math.nan
+        row[f"{m}_max"] = float(finite.max()) if finite.size else math.nan
+    return row
