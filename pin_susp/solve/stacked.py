@@ -54,12 +54,17 @@ class StackedTree(Tree):
         R = np.empty((len(self.joints) + 1, n, 3, 3))
         o = np.empty((len(self.joints) + 1, n, 3))
         R[0], o[0] = np.eye(3), 0.0
+        eye = np.eye(3)
         for i, (parent, revolute, _, _, _, k) in enumerate(self.joints, start=1):
             base = R[parent]
-            origin = o[parent] + _apply_many(base, self.offset_n[i])
-            if revolute:
+            # (a joint on the universe: its parent's placement is the identity)
+            origin = (
+                self.offset_n[i] if parent == 0 else o[parent] + _apply_many(base, self.offset_n[i])
+            )
+            if revolute:  # base·(I + sin θ K + (1 − cos θ) K²), one stacked product
                 s, c = np.sin(q[:, k])[:, None, None], np.cos(q[:, k])[:, None, None]
-                R[i] = base + s * (base @ self.K_n[i]) + (1.0 - c) * (base @ self.K2_n[i])
+                turn = eye + s * self.K_n[i] + (1.0 - c) * self.K2_n[i]
+                R[i] = turn if parent == 0 else base @ turn
                 o[i] = origin
             else:
                 R[i] = base
