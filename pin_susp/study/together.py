@@ -142,7 +142,7 @@ class Together:
                 for index, (row, _, _) in enumerate(rows.items)
                 if isinstance(vars(row).get("length"), float)
             ]
-        self.ok = self._same(design)
+        self.ok = self._same(design, self.rows, self.drive) and self._probe()
 
     # ---------------------------------------------------------------- numbers
 
@@ -163,30 +163,53 @@ class Together:
         A[1:] /= np.linalg.norm(A[1:], axis=1, keepdims=True)
         return E, J, A
 
-    def _same(self, design) -> bool:
-        """Whether the design's own numbers, read from its tree as a variant's are, give
-        its model's joint placements, axes, frame offsets and closure lengths (else no
-        variant is measured together)."""
-        got = self.numbers(design.tree)
+    def _same(self, subject, rows, drive) -> bool:
+        """Whether a subject's numbers, read from its tree as a variant's are, give its
+        model's joint placements and axes, its frames' offsets and its closures' lengths
+        (``rows``, ``drive``: its solver's and its drivers' Rows)."""
+        got = self.numbers(subject.tree)
         if got is None:
             return False
         E, J, A = (x[None] for x in got)
-        model = design.model
+        model = subject.model
         axes, offsets, frames = self._placed(E, J, A)
         for i in range(1, model.njoints):
             if not np.allclose(offsets[i][0], model.jointPlacements[i].translation, 0, 1e-15):
                 return False
-            if not np.allclose(axes[i][0], self.rows.tree.joints[i - 1][2], 0, 1e-15):
+            if not np.allclose(axes[i][0], rows.tree.joints[i - 1][2], 0, 1e-15):
                 return False
         for c, f in enumerate(self.ids):
             if not np.allclose(frames[c][0], model.frames[f].placement.translation, 0, 1e-15):
                 return False
-        for rows in (self.rows, self.drive):
-            for index, a, b in self.lengths[id(rows)]:
-                length = rows.items[index][0].length
+        for mine, theirs in ((self.rows, rows), (self.drive, drive)):
+            for index, a, b in self.lengths[id(mine)]:
+                length = theirs.items[index][0].length
                 if not math.isclose(np.linalg.norm(E[0, b] - E[0, a]), length, rel_tol=1e-14):
                     return False
         return True
+
+    def _probe(self) -> bool:
+        """One variant (every variable moved by 1 µm) built as its own corner: its rows
+        differ from the design's in their lengths alone (stacked.stack's test), and its
+        numbers read from its tree are its model's (else no variant is measured
+        together: some number of its rows would be the design's)."""
+        from ..solve.stacked import stack
+        from .variants import build
+
+        deltas = np.full(len(self.job.variables), 1e-3)
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                data = variant_data(self.job.geometry, self.job.variables, deltas)
+                probe = build(data, "probe", variant=True)
+                solver = probe.solver_for(self.sweep.targets, self.sweep.source)
+        except (PinSuspError, ArithmeticError, ValueError, np.linalg.LinAlgError):
+            return False
+        if stack([self.solver, solver], 1) is None:
+            return False
+        if stack([self.design._drive, probe._drive], 1) is None:
+            return False
+        return self._same(probe, rows_of(solver), rows_of(probe._drive))
 
     def _placed(self, E, J, A) -> tuple:
         """Per joint its axis and its origin in its parent (lists over joints of
