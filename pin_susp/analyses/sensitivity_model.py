@@ -40,6 +40,7 @@ from ..constraints import (
     FramePoint,
     JointTarget,
     Kinematics,
+    ManyFrames,
     PointTarget,
 )
 from ..maths.jet import Dual
@@ -88,7 +89,7 @@ class HardpointSensitivity:
             self.kin = Kinematics(m, like.kin.data)
             self.real, self.virt, self.frames = like.real, like.virt, like.frames
             self.points = dict(like.points)
-            self.rated = like.rated
+            self.rated, self.columns = like.rated, like.columns
         else:
             self.kin = Kinematics(m)
             self.real = np.array(
@@ -99,6 +100,7 @@ class HardpointSensitivity:
             )
             self.virt = np.setdiff1d(np.arange(m.nv), self.real)
             self.rated = set()  # the sets of columns that read the rates (evaluated)
+            self.columns = {j: m.joints[m.getJointId(j)].idx_v for j in self.params}  # in v
             self.frames = [n for n in corner.point_names if n != "contact_patch_center"]
             self.points = {
                 n: FramePoint(n, m.getFrameId(n), corner.body_of(n)) for n in self.frames
@@ -153,10 +155,9 @@ class HardpointSensitivity:
                 d = derived[point].der
             moves[f] = d
         B = np.zeros((self.model.nv, n_h))
-        m = self.model
         tilts = {}  # a pivot's, by its end points (each pivot's three tilt joints share them)
         for joint, (kind, owner, a, extra) in self.params.items():
-            v = m.joints[m.getJointId(joint)].idx_v
+            v = self.columns[joint]
             if kind == "point":
                 B[v] = moves[owner][:, a]
             elif kind in ("origin", "origin_back"):
@@ -233,12 +234,17 @@ class HardpointSensitivity:
         rates (k, S, 3); d rates/dh (n_h, k, S, 3). Without ``rates``, k = 0: no driver
         (a derivative column cannot be read, a metric of the rates is NaN)."""
         c = self.corner
-        each = [self._state(q, targets, rates) for q, targets in states]
-        n, n_h = len(each), self.B.shape[1]
+        n, n_h = len(states), self.B.shape[1]
+        at_once = None if rates else self._at_once(states)
+        if rates:
+            each = [self._state(q, targets, rates) for q, targets in states]
         points = {}
         for f in self.frames:
-            pos = np.stack([e[0][f] for e in each])
-            sens = np.stack([e[1][f] for e in each], axis=1)[:, None]
+            if at_once is not None:
+                pos, sens = at_once[0][f], at_once[1][f][:, None]
+            else:
+                pos = np.stack([e[0][f] for e in each])
+                sens = np.stack([e[1][f] for e in each], axis=1)[:, None]
             if rates:
                 rate = np.stack([e[2][f] for e in each], axis=1)
                 mixed = np.stack([e[3][f] for e in each], axis=2)
@@ -318,6 +324,75 @@ class HardpointSensitivity:
             for f in self.frames:
                 mixed[f][:, i] = (jdot[f] @ dx + jac[f][:, self.real] @ dt).T
         return pos, sens, rate, mixed
+
+    def _at_once(self, states: list[tuple]) -> tuple:
+        """Without the rates, every state at once but for Pinocchio's frames, read one
+        state after another: the rows in their batched forms (constraints/row.py,
+        ManyFrames) and one linear solve per set of rows; each frame's positions (S, 3)
+        and d/dh (n_h, S, 3), as ``_state`` gives them one by one (to rounding)."""
+        m, kin, c = self.model, self.kin, self.corner
+        n, n_h = len(states), self.B.shape[1]
+        default = [Target("wheel_center", "z", 0.0)]
+        held = [c.held_targets(default if t is None else t) for _, t in states]
+        groups: dict[tuple, list[int]] = {}  # the states of one set of rows
+        for i, targets in enumerate(held):
+            key = tuple((t.point, *t.unit_direction) for t in targets)
+            groups.setdefault(key, []).append(i)
+        rows = {}
+        for key, at in groups.items():
+            kept = [PointTarget(self.points[t.point], t.unit_direction) for t in held[at[0]]]
+            rows[key] = list(self.closures) + kept
+        # the points' frames, then any other frame that a row reads (a closure's anchor)
+        ids = [self.points[f].frame_id for f in self.frames]
+        for group in rows.values():
+            ids += [p.frame_id for row in group for p in row.frames if p.frame_id not in ids]
+        P = np.empty((len(ids), n, 3))
+        J = np.empty((len(ids), n, 3, m.nv))
+        qa = pin.neutral(m)
+        for s, (q, _) in enumerate(states):
+            qa[self.real] = q
+            kin.update(qa)
+            for i, frame in enumerate(ids):
+                P[i, s] = kin.data.oMf[frame].translation
+                J[i, s] = kin.frame_jacobian(frame)[:3]
+        # dq/dh holding the closures and the targets
+        dx = np.empty((n, m.nv, n_h))
+        dx[:, self.virt] = self.B_virt
+        everywhere = [np.arange(m.nv)] * len(ids)
+        closures = np.vstack(self._closure_explicit())
+        for key, at in groups.items():
+            frames = ManyFrames(
+                list(P[:, at]),
+                everywhere,
+                list(J[:, at].transpose(0, 3, 1, 2)),
+                None,
+                None,
+                None,
+                m.nv,
+            )
+            nrows = sum(row.size for row in rows[key])
+            r, Jr = np.empty((len(at), nrows)), np.zeros((len(at), nrows, m.nv))
+            i = 0
+            for row in rows[key]:
+                k = [ids.index(p.frame_id) for p in row.frames]
+                value = None if i < len(closures) else np.zeros(len(at))
+                row.fill_many(frames, k, value, r, Jr, i)
+                i += row.size
+            explicit = np.zeros((len(at), nrows, n_h))
+            first = len(closures)
+            explicit[:, :first] = closures
+            for j, s in enumerate(at):
+                for t, target in enumerate(held[s]):
+                    if target.mode == "relative":
+                        d = target.unit_direction
+                        explicit[j, first + t] = -(d @ self._design_rate(target.point))
+            F = Jr[:, :, self.virt] @ self.B_virt + explicit
+            dx[np.ix_(at, self.real)] = -np.linalg.solve(Jr[:, :, self.real], F)
+        positions, rates = {}, {}
+        for i, f in enumerate(self.frames):
+            positions[f] = P[i]
+            rates[f] = (J[i] @ dx).transpose(2, 0, 1)
+        return positions, rates
 
     def _closure_explicit(self) -> list[np.ndarray]:
         """Each closure's explicit change with the hardpoints (cl.size, n_h): a distance
@@ -433,15 +508,12 @@ def _tilts(o: np.ndarray, e: np.ndarray) -> list[np.ndarray]:
 
 def _same_structure(a: HardpointSensitivity, b: HardpointSensitivity) -> bool:
     """Whether two sensitivity models are of one structure, their Pinocchio data then
-    interchangeable: the same joints, of the same kinds, and frames, and each joint along
-    an axis of its own (a pivot's) along the same axis — the data keeps it, from the
-    model it was made for."""
+    interchangeable: the same joints, of the same kinds, and as many frames (named by
+    the points and links: the tree's structure), and each joint along an axis of its
+    own (a pivot's) along the same axis — the data keeps it, from the model it was
+    made for."""
     ma, mb = a.model, b.model
-    if not (
-        a.hardpoints == b.hardpoints
-        and list(ma.names) == list(mb.names)
-        and [f.name for f in ma.frames] == [f.name for f in mb.frames]
-    ):
+    if a.hardpoints != b.hardpoints or ma.nframes != mb.nframes or list(ma.names) != list(mb.names):
         return False
     for x, y in zip(ma.joints, mb.joints, strict=True):
         kind = x.shortname()
