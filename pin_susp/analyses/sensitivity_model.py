@@ -84,7 +84,8 @@ class HardpointSensitivity:
         tree, self.params = _augment(corner.tree)
         # (kinematic: without shapes; a study's later corners of one structure copy the
         # first's model with their own numbers, bit for bit the parsed one: template.py)
-        self.model = m = variant_model(replace(tree, visuals=[]), _parse, closures=False)[0]
+        kinematic = replace(tree, visuals=[])
+        self.model = m = variant_model(kinematic, _parse, closures=False, bulk=False)[0]
         if like is not None and _same_structure(like, self):
             self.kin = Kinematics(m, like.kin.data)
             self.real, self.virt, self.frames = like.real, like.virt, like.frames
