@@ -324,6 +324,9 @@ def test_many_states_at_once_and_a_shared_model_give_each_states_own(geometry):
         for z in (-25.0, 10.0, 30.0):
             targets = [pin_susp.Target("wheel_center", "z", z)] + held
             out.append((corner.solve_pose(targets).q, targets))
+        # other rows (the states of each set of rows solved together): the contact patch
+        targets = [pin_susp.Target("contact_patch_center", "z", 15.0)] + held
+        out.insert(2, (corner.solve_pose(targets).q, targets))
         return out
 
     data = example(geometry)

@@ -23,6 +23,13 @@ derivatives, with J̇ from ``computeJointJacobiansTimeVariation``. Points go
 into the metric functions as nested dual numbers (jet.Dual), which return
 the metric, its derivative along the motion, and both their hardpoint
 sensitivities — no finite differences anywhere.
+
+Many states (a sweep's steps, an optimiser's every evaluation) go through the
+metric functions at once, the states stacked along the points' last axis; where
+no column asked for reads the drivers' rates (a study's objective of plain
+metrics) the tangent and its change are left out, and the states' rows are
+solved together. A study's variants, which differ only in their numbers, share
+one model's frames and Pinocchio data.
 """
 
 from __future__ import annotations
@@ -359,29 +366,21 @@ class HardpointSensitivity:
         # dq/dh holding the closures and the targets
         dx = np.empty((n, m.nv, n_h))
         dx[:, self.virt] = self.B_virt
-        everywhere = [np.arange(m.nv)] * len(ids)
-        closures = np.vstack(self._closure_explicit())
+        dense, Jc = [np.arange(m.nv)] * len(ids), J.transpose(0, 3, 1, 2)  # (ManyFrames')
+        closure_rows = np.vstack(self._closure_explicit())
         for key, at in groups.items():
-            frames = ManyFrames(
-                list(P[:, at]),
-                everywhere,
-                list(J[:, at].transpose(0, 3, 1, 2)),
-                None,
-                None,
-                None,
-                m.nv,
-            )
+            frames = ManyFrames(list(P[:, at]), dense, list(Jc[:, :, at]), None, None, None, m.nv)
             nrows = sum(row.size for row in rows[key])
             r, Jr = np.empty((len(at), nrows)), np.zeros((len(at), nrows, m.nv))
             i = 0
             for row in rows[key]:
                 k = [ids.index(p.frame_id) for p in row.frames]
-                value = None if i < len(closures) else np.zeros(len(at))
+                value = None if i < len(closure_rows) else np.zeros(len(at))
                 row.fill_many(frames, k, value, r, Jr, i)
                 i += row.size
             explicit = np.zeros((len(at), nrows, n_h))
-            first = len(closures)
-            explicit[:, :first] = closures
+            first = len(closure_rows)
+            explicit[:, :first] = closure_rows
             for j, s in enumerate(at):
                 for t, target in enumerate(held[s]):
                     if target.mode == "relative":
@@ -389,11 +388,11 @@ class HardpointSensitivity:
                         explicit[j, first + t] = -(d @ self._design_rate(target.point))
             F = Jr[:, :, self.virt] @ self.B_virt + explicit
             dx[np.ix_(at, self.real)] = -np.linalg.solve(Jr[:, :, self.real], F)
-        positions, rates = {}, {}
+        positions, moves = {}, {}
         for i, f in enumerate(self.frames):
             positions[f] = P[i]
-            rates[f] = (J[i] @ dx).transpose(2, 0, 1)
-        return positions, rates
+            moves[f] = (J[i] @ dx).transpose(2, 0, 1)
+        return positions, moves
 
     def _closure_explicit(self) -> list[np.ndarray]:
         """Each closure's explicit change with the hardpoints (cl.size, n_h): a distance
