@@ -287,33 +287,33 @@ def test_sensitivity_cli_writes_long_format_and_a_table(tmp_path, capsys):
     assert units["camber"] == "deg/mm" and units["deriv_camber_wrt_hub_z"] == "deg/mm/mm"
 
 
-def same_sensitivities(a, b, columns=None, rounding: float = 0.0) -> None:
-    """Two lists of Sensitivity equal (in ``columns``, else every one): bit for bit, or
-    to ``rounding`` relative to each column's largest entry (at least 1 of its unit)."""
+def same_sensitivities(a, b, columns=None) -> None:
+    """Two lists of Sensitivity equal bit for bit (in ``columns``, else every one)."""
     assert len(a) == len(b)
     for x, y in zip(a, b, strict=True):
         names = list(x.values) if columns is None else columns
         assert names and x.step == y.step and x.hardpoints == y.hardpoints
         for name in names:
-            u, v = x.values[name], y.values[name]
-            assert np.array_equal(np.isnan(u), np.isnan(v)), name
-            scale = rounding * np.nanmax(np.abs(v), initial=1.0)
-            assert np.nanmax(np.abs(u - v), initial=0.0) <= scale, name
-            m, n = x.metrics[name], y.metrics[name]
-            both_nan = np.isnan(m) and np.isnan(n)
-            assert m == n or both_nan or abs(m - n) <= rounding * max(abs(n), 1.0), name
+            assert np.array_equal(x.values[name], y.values[name], equal_nan=True), name
+            assert np.array_equal(x.metrics[name], y.metrics[name], equal_nan=True), name
 
 
 @pytest.mark.parametrize(
     "geometry",
-    ["double_wishbone.yaml", "macpherson.yaml", "multilink_rear.yaml", "pushrod_rocker.yaml"],
+    [
+        "double_wishbone.yaml",
+        "macpherson.yaml",
+        "multilink_rear.yaml",
+        "pushrod_rocker.yaml",
+        "semi_trailing_arm.yaml",  # (no closure: its arm's pivot alone)
+    ],
 )
 def test_many_states_at_once_and_a_shared_model_give_each_states_own(geometry):
-    """HardpointSensitivity.at_many (the states' metric functions run once for all)
-    gives what ``at`` gives at each state alone, bit for bit, and to rounding where no
-    column asked for reads the drivers' rates (needs_rates: they are left out, the
-    states' rows solved together); a variant's model that shares another's frames and
-    Pinocchio data (``like``, a study's) gives what its own gives, bit for bit."""
+    """HardpointSensitivity.at_many (the states' metric functions run once for all) gives
+    what ``at`` gives at each state alone, bit for bit — also where no column asked for
+    reads the drivers' rates (needs_rates: they are left out, the states' dq/dh solved
+    together) — and so does a variant's model that shares another's frames and
+    Pinocchio data (``like``, a study's) what its own gives."""
     from pin_susp.analyses.sensitivity_model import needs_rates
     from pin_susp.columns.metrics import METRICS
 
@@ -340,9 +340,12 @@ def test_many_states_at_once_and_a_shared_model_give_each_states_own(geometry):
     plain = [m.name for m in METRICS if not m.rates and m.applies(g)]
     assert not needs_rates(g, set(plain)) and needs_rates(g, {"deriv_camber_wrt_hub_z"})
     steps = list(range(len(at)))
-    same_sensitivities(first.at_many(at, steps, set(plain)), alone, plain, 1e-12)
-    rest = [n for n in plain if not n.startswith(("svic", "fvic", "svsa", "fvsa", "anti"))]
-    same_sensitivities(first.at_many(at, steps, set(rest)), alone, rest, 1e-12)
+    same_sensitivities(first.at_many(at, steps, set(plain)), alone, plain)
+    # (a column unknown at a state — a trailing arm's kingpin — is worked out again with
+    # the rates, in case they are what it lacks)
+    known = [n for n in plain if all(np.isfinite(s.values[n]).all() for s in alone)]
+    rest = [n for n in known if not n.startswith(("svic", "fvic", "svsa", "fvsa", "anti"))]
+    same_sensitivities(first.at_many(at, steps, set(rest)), alone, rest)
     assert frozenset(rest) not in first.rated  # (computed without the rates)
     if geometry == "multilink_rear.yaml":  # its instant centres come from its motion
         assert np.isfinite(alone[1].values["svic_x"]).all()
@@ -353,6 +356,8 @@ def test_many_states_at_once_and_a_shared_model_give_each_states_own(geometry):
     link, pivot = "trackrod_outboard", "lower_wishbone_inboard_front"
     if geometry == "multilink_rear.yaml":  # (a universal joint at its lower front link)
         link, pivot = "toe_link_outboard", "lower_front_link_outboard"
+    if geometry == "semi_trailing_arm.yaml":
+        link, pivot = "strut_top", "arm_pivot_outboard"
     for point, shares in ((link, True), (pivot, False)):
         moved = copy.deepcopy(data)
         moved["hardpoints"][point]["z"] += 7.0
@@ -362,7 +367,7 @@ def test_many_states_at_once_and_a_shared_model_give_each_states_own(geometry):
         at = states(variant)
         own = HardpointSensitivity(variant).at_many(at, list(range(len(at))))
         same_sensitivities(shared.at_many(at, list(range(len(at)))), own)
-        assert not np.array_equal(own[1].values["camber"], alone[1].values["camber"])
+        assert any(not np.array_equal(v, alone[1].values[k]) for k, v in own[1].values.items())
 
 
 def test_an_axles_sensitivities_at_many_states_are_each_states_own():

@@ -27,7 +27,7 @@ sensitivities — no finite differences anywhere.
 Many states (a sweep's steps, an optimiser's every evaluation) go through the
 metric functions at once, the states stacked along the points' last axis; where
 no column asked for reads the drivers' rates (a study's objective of plain
-metrics) the tangent and its change are left out, and the states' rows are
+metrics) the tangent and its change are left out, and the states' dq/dh are
 solved together. A study's variants, which differ only in their numbers, share
 one model's frames and Pinocchio data.
 """
@@ -47,7 +47,6 @@ from ..constraints import (
     FramePoint,
     JointTarget,
     Kinematics,
-    ManyFrames,
     PointTarget,
 )
 from ..maths.jet import Dual
@@ -334,59 +333,43 @@ class HardpointSensitivity:
         return pos, sens, rate, mixed
 
     def _at_once(self, states: list[tuple]) -> tuple:
-        """Without the rates, every state at once but for Pinocchio's frames, read one
-        state after another: the rows in their batched forms (constraints/row.py,
-        ManyFrames) and one linear solve per set of rows; each frame's positions (S, 3)
-        and d/dh (n_h, S, 3), as ``_state`` gives them one by one (to rounding)."""
+        """Without the rates: ``_state``'s numbers for every state, its rows and frames
+        read from Pinocchio state after state, the linear algebra done for all states at
+        once (the states of each number of rows together): each frame's positions
+        (S, 3) and d/dh (n_h, S, 3)."""
         m, kin, c = self.model, self.kin, self.corner
         n, n_h = len(states), self.B.shape[1]
-        default = [Target("wheel_center", "z", 0.0)]
-        held = [c.held_targets(default if t is None else t) for _, t in states]
-        groups: dict[tuple, list[int]] = {}  # the states of one set of rows
-        for i, targets in enumerate(held):
-            key = tuple((t.point, *t.unit_direction) for t in targets)
-            groups.setdefault(key, []).append(i)
-        rows = {}
-        for key, at in groups.items():
-            kept = [PointTarget(self.points[t.point], t.unit_direction) for t in held[at[0]]]
-            rows[key] = list(self.closures) + kept
-        # the points' frames, then any other frame that a row reads (a closure's anchor)
-        ids = [self.points[f].frame_id for f in self.frames]
-        for group in rows.values():
-            ids += [p.frame_id for row in group for p in row.frames if p.frame_id not in ids]
-        P = np.empty((len(ids), n, 3))
-        J = np.empty((len(ids), n, 3, m.nv))
+        P = np.empty((len(self.frames), n, 3))
+        J = np.empty((len(self.frames), n, 3, m.nv))
+        rows, explicit = [], []
         qa = pin.neutral(m)
-        for s, (q, _) in enumerate(states):
+        for s, (q, targets) in enumerate(states):
+            if targets is None:
+                targets = [Target("wheel_center", "z", 0.0)]
             qa[self.real] = q
             kin.update(qa)
-            for i, frame in enumerate(ids):
-                P[i, s] = kin.data.oMf[frame].translation
-                J[i, s] = kin.frame_jacobian(frame)[:3]
+            r = [cl.jacobian(kin) for cl in self.closures]
+            e = list(self._closure_explicit())
+            for t in c.held_targets(targets):
+                d = t.unit_direction
+                r.append((d @ self.points[t.point].jacobian(kin))[None])
+                e.append(np.zeros((1, n_h)))
+                if t.mode == "relative":
+                    e[-1][0] = -(d @ self._design_rate(t.point))
+            rows.append(np.vstack(r))
+            explicit.append(np.vstack(e))
+            for i, f in enumerate(self.frames):
+                P[i, s] = self.points[f].position(kin)
+                J[i, s] = self._jac(f)
         # dq/dh holding the closures and the targets
-        dx = np.empty((n, m.nv, n_h))
+        dx = np.zeros((n, m.nv, n_h))
         dx[:, self.virt] = self.B_virt
-        dense, Jc = [np.arange(m.nv)] * len(ids), J.transpose(0, 3, 1, 2)  # (ManyFrames')
-        closure_rows = np.vstack(self._closure_explicit())
-        for key, at in groups.items():
-            frames = ManyFrames(list(P[:, at]), dense, list(Jc[:, :, at]), None, None, None, m.nv)
-            nrows = sum(row.size for row in rows[key])
-            r, Jr = np.empty((len(at), nrows)), np.zeros((len(at), nrows, m.nv))
-            i = 0
-            for row in rows[key]:
-                k = [ids.index(p.frame_id) for p in row.frames]
-                value = None if i < len(closure_rows) else np.zeros(len(at))
-                row.fill_many(frames, k, value, r, Jr, i)
-                i += row.size
-            explicit = np.zeros((len(at), nrows, n_h))
-            first = len(closure_rows)
-            explicit[:, :first] = closure_rows
-            for j, s in enumerate(at):
-                for t, target in enumerate(held[s]):
-                    if target.mode == "relative":
-                        d = target.unit_direction
-                        explicit[j, first + t] = -(d @ self._design_rate(target.point))
-            F = Jr[:, :, self.virt] @ self.B_virt + explicit
+        groups: dict[int, list[int]] = {}
+        for s, r in enumerate(rows):
+            groups.setdefault(len(r), []).append(s)
+        for at in groups.values():
+            Jr = np.stack([rows[s] for s in at])
+            F = Jr[:, :, self.virt] @ self.B_virt + np.stack([explicit[s] for s in at])
             dx[np.ix_(at, self.real)] = -np.linalg.solve(Jr[:, :, self.real], F)
         positions, moves = {}, {}
         for i, f in enumerate(self.frames):
