@@ -285,3 +285,114 @@ def test_sensitivity_cli_writes_long_format_and_a_table(tmp_path, capsys):
     assert per_step % (12 * 3) == 0  # 12 hardpoints × xyz per metric
     units = {r[1]: r[5] for r in rows}
     assert units["camber"] == "deg/mm" and units["deriv_camber_wrt_hub_z"] == "deg/mm/mm"
+
+
+def same_sensitivities(a, b, columns=None) -> None:
+    """Two lists of Sensitivity equal bit for bit (in ``columns``, else every one)."""
+    assert len(a) == len(b)
+    for x, y in zip(a, b, strict=True):
+        names = list(x.values) if columns is None else columns
+        assert names and x.step == y.step and x.hardpoints == y.hardpoints
+        for name in names:
+            assert np.array_equal(x.values[name], y.values[name], equal_nan=True), name
+            assert np.array_equal(x.metrics[name], y.metrics[name], equal_nan=True), name
+
+
+@pytest.mark.parametrize(
+    "geometry",
+    [
+        "double_wishbone.yaml",
+        "macpherson.yaml",
+        "multilink_rear.yaml",
+        "pushrod_rocker.yaml",
+        "semi_trailing_arm.yaml",  # (no closure: its arm's pivot alone)
+    ],
+)
+def test_many_states_at_once_and_a_shared_model_give_each_states_own(geometry):
+    """HardpointSensitivity.at_many (the states' metric functions run once for all) gives
+    what ``at`` gives at each state alone, bit for bit — also where no column asked for
+    reads the drivers' rates (needs_rates: they are left out, the states' dq/dh solved
+    together) — and so does a variant's model that shares another's frames and
+    Pinocchio data (``like``, a study's) what its own gives."""
+    from pin_susp.analyses.sensitivity_model import needs_rates
+    from pin_susp.columns.metrics import METRICS
+
+    def states(corner):
+        rack = [pin_susp.Target("trackrod_inboard", "y", 4.0)]
+        held = rack if corner.geometry.steering == "rack" else []
+        out = [(corner.q_design, None)]
+        for z in (-25.0, 10.0, 30.0):
+            targets = [pin_susp.Target("wheel_center", "z", z)] + held
+            out.append((corner.solve_pose(targets).q, targets))
+        # other rows (the states of each set of rows solved together): the contact patch
+        targets = [pin_susp.Target("contact_patch_center", "z", 15.0)] + held
+        out.insert(2, (corner.solve_pose(targets).q, targets))
+        return out
+
+    data = example(geometry)
+    corner = pin_susp.Corner(data)
+    first = HardpointSensitivity(corner)
+    at = states(corner)
+    alone = [first.at(q, targets, step=i) for i, (q, targets) in enumerate(at)]
+    same_sensitivities(first.at_many(at, list(range(len(at)))), alone)
+    # the columns of positions alone (Metric.rates False), without the drivers' rates
+    g = corner.geometry
+    plain = [m.name for m in METRICS if not m.rates and m.applies(g)]
+    assert not needs_rates(g, set(plain)) and needs_rates(g, {"deriv_camber_wrt_hub_z"})
+    steps = list(range(len(at)))
+    same_sensitivities(first.at_many(at, steps, set(plain)), alone, plain)
+    # (a column unknown at a state — a trailing arm's kingpin — is worked out again with
+    # the rates, in case they are what it lacks)
+    known = [n for n in plain if all(np.isfinite(s.values[n]).all() for s in alone)]
+    rest = [n for n in known if not n.startswith(("svic", "fvic", "svsa", "fvsa", "anti"))]
+    same_sensitivities(first.at_many(at, steps, set(rest)), alone, rest)
+    assert frozenset(rest) not in first.rated  # (computed without the rates)
+    if geometry == "multilink_rear.yaml":  # its instant centres come from its motion
+        assert np.isfinite(alone[1].values["svic_x"]).all()
+        first.at_many(at, steps, {"svic_x"})
+        assert frozenset({"svic_x"}) in first.rated  # found unknown without the rates
+    # variants: a link end moved, its model sharing the first's frames and data; a
+    # pivot's end moved (its axis turned: the data keeps a pivot's axis), not sharing
+    link, pivot = "trackrod_outboard", "lower_wishbone_inboard_front"
+    if geometry == "multilink_rear.yaml":  # (a universal joint at its lower front link)
+        link, pivot = "toe_link_outboard", "lower_front_link_outboard"
+    if geometry == "semi_trailing_arm.yaml":
+        link, pivot = "strut_top", "arm_pivot_outboard"
+    for point, shares in ((link, True), (pivot, False)):
+        moved = copy.deepcopy(data)
+        moved["hardpoints"][point]["z"] += 7.0
+        variant = pin_susp.Corner(moved)
+        shared = HardpointSensitivity(variant, like=first)
+        assert (shared.kin.data is first.kin.data) == shares
+        at = states(variant)
+        own = HardpointSensitivity(variant).at_many(at, list(range(len(at))))
+        same_sensitivities(shared.at_many(at, list(range(len(at)))), own)
+        assert any(not np.array_equal(v, alone[1].values[k]) for k, v in own[1].values.items())
+
+
+def test_an_axles_sensitivities_at_many_states_are_each_states_own():
+    """SubjectSensitivity.at_many on an axle (its own columns, of both corners: roll
+    centre, track, the roll rates) equals ``at`` state by state, bit for bit."""
+    from pin_susp.analyses.sensitivity import SubjectSensitivity
+    from pin_susp.model.sweep import load_sweep
+    from pin_susp.subjects.axle import AxleModel, load_axle, solve_axle_sweep
+
+    model = AxleModel(load_axle(EXAMPLES / "axle_front.yaml"))
+    rack = {"point": "trackrod_inboard", "side": "left", "direction": {"axis": "y"}}
+    roll = load_sweep(
+        {
+            "targets": [
+                {"quantity": "roll", "values": [-2.0, 0.5, 3.0]},
+                {"quantity": "heave", "values": [10.0, 0.0, -5.0]},
+                rack | {"values": [3.0, 0.0, -2.0]},
+            ]
+        }
+    )
+    states = [(None, 0, None)] + [
+        (solution.q, i + 1, None) for i, solution in enumerate(solve_axle_sweep(model, roll))
+    ]
+    for one_sided in (False, True):
+        sens = SubjectSensitivity(model, one_sided)
+        alone = [sens.at(q, step, targets) for q, step, targets in states]
+        assert "roll_center_z" in alone[0].values
+        same_sensitivities(sens.at_many(states), alone)

@@ -14,7 +14,7 @@ from ..columns.metrics import METRIC_BY_NAME, PointSet
 from ..errors import InputError
 from ..maths.jet import Dual
 from ..subjects.axle_file import AXLE_COLUMNS as AXLE_COLUMNS  # the axle's own, by its old address
-from .sensitivity_model import AXES, HardpointSensitivity, Sensitivity
+from .sensitivity_model import AXES, HardpointSensitivity, Sensitivity, of_state
 from .sensitivity_model import V as V  # the model's names, by their old address
 
 
@@ -134,10 +134,16 @@ class SubjectSensitivity:
     heave link's own points are not among the hardpoints: they move no column here.
     """
 
-    def __init__(self, model, one_sided: bool = False):
+    def __init__(self, model, one_sided: bool = False, like: SubjectSensitivity | None = None):
+        """``like``: the SubjectSensitivity of another subject of this one's structure (a
+        study's variant), whose corners' models lend theirs their frames and Pinocchio
+        data (HardpointSensitivity's ``like``)."""
         self.model, self.one_sided = model, one_sided
         labels = model.labels
-        self.sides = {s: HardpointSensitivity(model.corner_linkage(s)) for s in labels}
+        self.sides = {
+            s: HardpointSensitivity(model.corner_linkage(s), like and like.sides.get(s))
+            for s in labels
+        }
         names = {s: h.hardpoints for s, h in self.sides.items()}
         self.moves = {s: model.sensitivity_move(s, one_sided) for s in labels}
         self.hardpoints = list(
@@ -186,31 +192,42 @@ class SubjectSensitivity:
         """At the subject's solved configuration q (default: its design state), holding
         ``targets`` (``Assembly.held_at``; default: each wheel centre's height and the
         rack where q has them)."""
+        return self.at_many([(q, step, targets)], only)[0]
+
+    def at_many(self, states: list[tuple], only=None) -> list[Sensitivity]:
+        """``at`` at each state (q, step, targets), each corner's metric functions run
+        once for all; the drivers' rates only where the columns ``only`` read them."""
+        own = [n for n in self.model.sensitivity_columns if only is None or n in only]
+        steps = [step for _, step, _ in states]
         jets, per_side = {}, {}
         for s, h in self.sides.items():
-            qs = h.corner.q_design if q is None else self.side_q(q, s)
-            jets[s] = h.jets(qs, targets)
             suffix = self.model.suffix(s)
             mine = None if only is None else {_unsuffixed(n, suffix) for n in only}
-            per_side[s] = h._collect(*jets[s], step, mine)
+            side_states = [
+                (h.corner.q_design if q is None else self.side_q(q, s), targets)
+                for q, _, targets in states
+            ]
+            jets[s], per_side[s] = h.evaluated(side_states, steps, mine, rates=bool(own))
         n = len(self.hardpoints)
-        values, units, metrics = {}, {}, {}
-        for s, side in per_side.items():
-            lift = self.lift[s]
-            for name, v in side.values.items():
-                key = name + self.model.suffix(s)
-                values[key] = v if lift is None else (lift @ v.ravel()).reshape(n, 3)
-                units[key], metrics[key] = side.units[name], side.metrics[name]
-        own = [n for n in self.model.sensitivity_columns if only is None or n in only]
         if own:
             with np.errstate(invalid="ignore", divide="ignore"):
                 columns = self._own_columns(jets)
-        for name in own:
-            x, unit_ = columns[name]
-            metrics[name] = float(x.val[0])
-            values[name] = x.der[:, 0].reshape(n, 3) * 1e-3  # per mm
-            units[name] = f"{unit_}/mm"
-        return Sensitivity(step, self.hardpoints, values, units, metrics)
+        out = []
+        for i, step in enumerate(steps):
+            values, units, metrics = {}, {}, {}
+            for s, sides in per_side.items():
+                lift, side = self.lift[s], sides[i]
+                for name, v in side.values.items():
+                    key = name + self.model.suffix(s)
+                    values[key] = v if lift is None else (lift @ v.ravel()).reshape(n, 3)
+                    units[key], metrics[key] = side.units[name], side.metrics[name]
+            for name in own:
+                x, unit_ = columns[name]
+                metrics[name] = float(of_state(x.val, i))
+                values[name] = of_state(x.der, i).reshape(n, 3) * 1e-3  # per mm
+                units[name] = f"{unit_}/mm"
+            out.append(Sensitivity(step, self.hardpoints, values, units, metrics))
+        return out
 
     def _lifted(self, side: str, x, sign: float = 1.0) -> Dual:
         """A side's nested scalar on the subject's directions: outside, the subject's

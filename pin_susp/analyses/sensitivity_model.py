@@ -23,6 +23,13 @@ derivatives, with J̇ from ``computeJointJacobiansTimeVariation``. Points go
 into the metric functions as nested dual numbers (jet.Dual), which return
 the metric, its derivative along the motion, and both their hardpoint
 sensitivities — no finite differences anywhere.
+
+Many states (a sweep's steps, an optimiser's every evaluation) go through the
+metric functions at once, the states stacked along the points' last axis; where
+no column asked for reads the drivers' rates (a study's objective of plain
+metrics) the tangent and its change are left out, and the states' dq/dh are
+solved together. A study's variants, which differ only in their numbers, share
+one model's frames and Pinocchio data.
 """
 
 from __future__ import annotations
@@ -73,24 +80,38 @@ class Sensitivity:
 class HardpointSensitivity:
     """The corner rebuilt with virtual joints; sensitivities at solved states."""
 
-    def __init__(self, corner):
+    def __init__(self, corner, like: HardpointSensitivity | None = None):
+        """``like``: the model of another corner of this one's structure (a study's
+        variant), whose frames and Pinocchio data this one shares — every evaluation
+        sets the data whole — its numbers its own."""
         self.corner = corner
         g = corner.geometry
         self.hardpoints = list(g.hardpoints)
         tree, self.params = _augment(corner.tree)
         # (kinematic: without shapes; a study's later corners of one structure copy the
         # first's model with their own numbers, bit for bit the parsed one: template.py)
-        self.model = variant_model(replace(tree, visuals=[]), _parse, closures=False)[0]
-        self.kin = Kinematics(self.model)
-        m = self.model
-        self.real = np.array(
-            [
-                m.joints[m.getJointId(corner.model.names[j])].idx_v
-                for j in range(1, corner.model.njoints)
-            ]
-        )
-        self.frames = [n for n in corner.point_names if n != "contact_patch_center"]
-        self.points = {n: FramePoint(n, m.getFrameId(n), corner.body_of(n)) for n in self.frames}
+        kinematic = replace(tree, visuals=[])
+        self.model = m = variant_model(kinematic, _parse, closures=False, bulk=False)[0]
+        if like is not None and _same_structure(like, self):
+            self.kin = Kinematics(m, like.kin.data)
+            self.real, self.virt, self.frames = like.real, like.virt, like.frames
+            self.points = dict(like.points)
+            self.rated, self.columns = like.rated, like.columns
+        else:
+            self.kin = Kinematics(m)
+            self.real = np.array(
+                [
+                    m.joints[m.getJointId(corner.model.names[j])].idx_v
+                    for j in range(1, corner.model.njoints)
+                ]
+            )
+            self.virt = np.setdiff1d(np.arange(m.nv), self.real)
+            self.rated = set()  # the sets of columns that read the rates (evaluated)
+            self.columns = {j: m.joints[m.getJointId(j)].idx_v for j in self.params}  # in v
+            self.frames = [n for n in corner.point_names if n != "contact_patch_center"]
+            self.points = {
+                n: FramePoint(n, m.getFrameId(n), corner.body_of(n)) for n in self.frames
+            }
         self.points["contact_patch_center"] = ContactPatchPoint(
             "contact_patch_center",
             self.points["wheel_center"],
@@ -100,6 +121,7 @@ class HardpointSensitivity:
             corner.mechanism.WHEEL_BODY,
         )
         self.B = self._virtual_map()
+        self.B_virt = self.B[self.virt]
         # Design positions move with the hardpoints too (relative targets, wheel travel).
         q0 = pin.neutral(m)
         self.kin.update(q0)
@@ -140,9 +162,9 @@ class HardpointSensitivity:
                 d = derived[point].der
             moves[f] = d
         B = np.zeros((self.model.nv, n_h))
-        m = self.model
+        tilts = {}  # a pivot's, by its end points (each pivot's three tilt joints share them)
         for joint, (kind, owner, a, extra) in self.params.items():
-            v = m.joints[m.getJointId(joint)].idx_v
+            v = self.columns[joint]
             if kind == "point":
                 B[v] = moves[owner][:, a]
             elif kind in ("origin", "origin_back"):
@@ -150,13 +172,11 @@ class HardpointSensitivity:
                 B[v, [col[extra[0], a]]] = sign
             else:  # tilt of a pivot axis running extra[0] → extra[1]
                 sign = 1.0 if kind == "tilt" else -1.0
-                o, e = g.hardpoints[extra[0]], g.hardpoints[extra[1]]
-                w = unit(e - o)
-                project = (E - np.outer(w, w)) / np.linalg.norm(e - o)
-                for h, s in ((extra[1], 1.0), (extra[0], -1.0)):
-                    for b in range(3):
-                        eps = np.cross(w, s * project[:, b])  # ε = ω × δω
-                        B[v, col[h, b]] += sign * eps[a]
+                if extra not in tilts:
+                    tilts[extra] = _tilts(g.hardpoints[extra[0]], g.hardpoints[extra[1]])
+                ends = [(h, b) for h in (extra[1], extra[0]) for b in range(3)]
+                for (h, b), eps in zip(ends, tilts[extra], strict=True):
+                    B[v, col[h, b]] += sign * eps[a]
         return B
 
     def _closures(self) -> list:
@@ -187,13 +207,71 @@ class HardpointSensitivity:
     ) -> Sensitivity:
         """Sensitivities at the solved configuration q (of the corner's model),
         holding ``targets`` (default: wheel-centre height and rack at design)."""
-        return self._collect(*self.jets(q, targets), step, only)
+        return self.at_many([(q, targets)], [step], only)[0]
+
+    def at_many(self, states: list[tuple], steps: list[int], only=None) -> list[Sensitivity]:
+        """``at`` at each state (q, targets), the metric functions run once for all;
+        ``steps``: their step numbers."""
+        return self.evaluated(states, steps, only)[1]
+
+    def evaluated(self, states, steps, only=None, rates: bool = False) -> tuple:
+        """(jets, a Sensitivity per state): at_many's, and the jets (jets_many) they came
+        from, with the drivers' rates if ``rates`` or the columns ``only`` read them —
+        a derivative column, a metric flagged ``rates``, or one found to: unknown (NaN)
+        without them (an instant centre of a mechanism that finds it from the motion)."""
+        key = None if only is None else frozenset(only)
+        rates = rates or key in self.rated or needs_rates(self.corner.geometry, only)
+        jets = self.jets_many(states, rates)
+        out = self._collect(*jets, steps, only)
+        if not rates and any(_unknown(s) for s in out):
+            self.rated.add(key)
+            jets = self.jets_many(states, True)
+            out = self._collect(*jets, steps, only)
+        return jets, out
 
     def jets(self, q: np.ndarray, targets: list[Target] | None = None) -> tuple[dict, dict]:
-        """Every point at q, and its design position, as nested jet.Duals: outside, the
-        hardpoint coordinates (n_h directions, per m); inside, the drivers (per m).
-        Positions (1, 3) m; d/dh (n_h, 1, 1, 3); rates (k, 1, 3); d rates/dh (n_h, k, 1, 3).
-        """
+        """Every point at q, and its design position, as nested jet.Duals (jets_many's,
+        of one state)."""
+        return self.jets_many([(q, targets)])
+
+    def jets_many(self, states: list[tuple], rates: bool = True) -> tuple[dict, dict]:
+        """Every point at each state (q, targets), and its design position, as nested
+        jet.Duals: outside, the hardpoint coordinates (n_h directions, per m); inside,
+        the drivers (per m). For S states: positions (S, 3) m; d/dh (n_h, 1, S, 3);
+        rates (k, S, 3); d rates/dh (n_h, k, S, 3). Without ``rates``, k = 0: no driver
+        (a derivative column cannot be read, a metric of the rates is NaN)."""
+        c = self.corner
+        n, n_h = len(states), self.B.shape[1]
+        at_once = None if rates else self._at_once(states)
+        if rates:
+            each = [self._state(q, targets, rates) for q, targets in states]
+        points = {}
+        for f in self.frames:
+            if at_once is not None:
+                pos, sens = at_once[0][f], at_once[1][f][:, None]
+            else:
+                pos = np.stack([e[0][f] for e in each])
+                sens = np.stack([e[1][f] for e in each], axis=1)[:, None]
+            if rates:
+                rate = np.stack([e[2][f] for e in each], axis=1)
+                mixed = np.stack([e[3][f] for e in each], axis=2)
+            else:
+                rate, mixed = np.empty((0, n, 3)), np.empty((n_h, 0, n, 3))
+            points[f] = Dual(Dual(pos, rate), Dual(sens, mixed))
+        design = {
+            f: Dual(c.design_positions[f][None], self.design_rates[f].T[:, None, None])
+            for f in self.frames
+        }
+        for pts in (points, design):
+            a = unit(pts["axle_outboard"] - pts["axle_inboard"])
+            pts["contact_patch_center"] = contact_patch(
+                pts["wheel_center"], a, c.geometry.wheel.radius
+            )
+        return points, design
+
+    def _state(self, q: np.ndarray, targets, rates: bool) -> tuple:
+        """At one state: each frame's position (3,), d/dh (n_h, 3), and with ``rates``
+        its rates (k, 3) and d rates/dh (n_h, k, 3)."""
         c = self.corner
         if targets is None:
             targets = [Target("wheel_center", "z", 0.0)]
@@ -203,18 +281,11 @@ class HardpointSensitivity:
         qa[self.real] = q  # every joint has one dof: its q index is its v index
         kin.update(qa)
         n_h = self.B.shape[1]
-        virt = np.setdiff1d(np.arange(m.nv), self.real)
+        virt = self.virt
 
         # dq/dh holding the closures and the targets
-        rows, explicit = [], []
-        for cl, ends in zip(self.closures, self.closure_points, strict=True):
-            rows.append(cl.jacobian(kin))
-            e = np.zeros((cl.size, n_h))
-            if isinstance(cl, DistanceClosure):  # its length is drawn from the hardpoints
-                a, b = (c.design_positions[p] for p in ends)
-                da, db = (self.design_rates[p] for p in ends)
-                e[0] = -(unit(b - a) @ (db - da))
-            explicit.append(e)
+        rows = [cl.jacobian(kin) for cl in self.closures]
+        explicit = list(self._closure_explicit())
         for t in targets:
             d = t.unit_direction
             rows.append((d @ self.points[t.point].jacobian(kin))[None])
@@ -223,10 +294,15 @@ class HardpointSensitivity:
                 e[0] = -(d @ self._design_rate(t.point))
             explicit.append(e)
         J = np.vstack(rows)
-        F = J[:, virt] @ self.B[virt] + np.vstack(explicit)
+        F = J[:, virt] @ self.B_virt + np.vstack(explicit)
         dx = np.zeros((m.nv, n_h))
-        dx[virt] = self.B[virt]
+        dx[virt] = self.B_virt
         dx[self.real] = -np.linalg.solve(J[:, self.real], F)
+        pos = {f: self.points[f].position(kin).copy() for f in self.frames}
+        jac = {f: self._jac(f) for f in self.frames}
+        sens = {f: (jac[f] @ dx).T for f in self.frames}  # (n_h, 3)
+        if not rates:
+            return pos, sens, None, None
 
         # the tangent of the motion per driver, and its change with each hardpoint
         drive = list(self.closures) + [PointTarget(self.points["wheel_center"], E[2])]
@@ -236,11 +312,9 @@ class HardpointSensitivity:
         k = len(c.drivers)
         tangent = np.linalg.solve(Jd[:, self.real], c.drive_rhs)  # (nv_real, k): same rows
 
-        pos = {f: self.points[f].position(kin).copy() for f in self.frames}
         anchors = [p for cl in self.closures for p in (cl.a, cl.b) if p.name not in self.points]
-        jac = {p.name: p.jacobian(kin) for p in anchors} | {f: self._jac(f) for f in self.frames}
+        jac |= {p.name: p.jacobian(kin) for p in anchors}
         rate = {f: (jac[f][:, self.real] @ tangent).T for f in self.frames}  # (k, 3)
-        sens = {f: (jac[f] @ dx).T for f in self.frames}  # (n_h, 3)
         mixed = {f: np.zeros((n_h, k, 3)) for f in self.frames}
         for i in range(k):
             ta = np.zeros(m.nv)
@@ -256,24 +330,67 @@ class HardpointSensitivity:
             dt = -np.linalg.solve(Jd[:, self.real], drive_dot @ dx)  # (nv_real, n_h)
             for f in self.frames:
                 mixed[f][:, i] = (jdot[f] @ dx + jac[f][:, self.real] @ dt).T
+        return pos, sens, rate, mixed
 
-        points = {
-            f: Dual(
-                Dual(pos[f][None], rate[f][:, None]),
-                Dual(sens[f][:, None, None], mixed[f][:, :, None]),
-            )
-            for f in self.frames
-        }
-        design = {
-            f: Dual(c.design_positions[f][None], self.design_rates[f].T[:, None, None])
-            for f in self.frames
-        }
-        for pts in (points, design):
-            a = unit(pts["axle_outboard"] - pts["axle_inboard"])
-            pts["contact_patch_center"] = contact_patch(
-                pts["wheel_center"], a, c.geometry.wheel.radius
-            )
-        return points, design
+    def _at_once(self, states: list[tuple]) -> tuple:
+        """Without the rates: ``_state``'s numbers for every state, its rows and frames
+        read from Pinocchio state after state, the linear algebra done for all states at
+        once (the states of each number of rows together): each frame's positions
+        (S, 3) and d/dh (n_h, S, 3)."""
+        m, kin, c = self.model, self.kin, self.corner
+        n, n_h = len(states), self.B.shape[1]
+        P = np.empty((len(self.frames), n, 3))
+        J = np.empty((len(self.frames), n, 3, m.nv))
+        rows, explicit = [], []
+        qa = pin.neutral(m)
+        for s, (q, targets) in enumerate(states):
+            if targets is None:
+                targets = [Target("wheel_center", "z", 0.0)]
+            qa[self.real] = q
+            kin.update(qa)
+            r = [cl.jacobian(kin) for cl in self.closures]
+            e = list(self._closure_explicit())
+            for t in c.held_targets(targets):
+                d = t.unit_direction
+                r.append((d @ self.points[t.point].jacobian(kin))[None])
+                e.append(np.zeros((1, n_h)))
+                if t.mode == "relative":
+                    e[-1][0] = -(d @ self._design_rate(t.point))
+            rows.append(np.vstack(r))
+            explicit.append(np.vstack(e))
+            for i, f in enumerate(self.frames):
+                P[i, s] = self.points[f].position(kin)
+                J[i, s] = self._jac(f)
+        # dq/dh holding the closures and the targets
+        dx = np.zeros((n, m.nv, n_h))
+        dx[:, self.virt] = self.B_virt
+        groups: dict[int, list[int]] = {}
+        for s, r in enumerate(rows):
+            groups.setdefault(len(r), []).append(s)
+        for at in groups.values():
+            Jr = np.stack([rows[s] for s in at])
+            F = Jr[:, :, self.virt] @ self.B_virt + np.stack([explicit[s] for s in at])
+            dx[np.ix_(at, self.real)] = -np.linalg.solve(Jr[:, :, self.real], F)
+        positions, moves = {}, {}
+        for i, f in enumerate(self.frames):
+            positions[f] = P[i]
+            moves[f] = (J[i] @ dx).transpose(2, 0, 1)
+        return positions, moves
+
+    def _closure_explicit(self) -> list[np.ndarray]:
+        """Each closure's explicit change with the hardpoints (cl.size, n_h): a distance
+        closure's length is drawn from its points (worked out once)."""
+        if "_explicit" not in self.__dict__:
+            c, n_h = self.corner, self.B.shape[1]
+            self._explicit = []
+            for cl, ends in zip(self.closures, self.closure_points, strict=True):
+                e = np.zeros((cl.size, n_h))
+                if isinstance(cl, DistanceClosure):
+                    a, b = (c.design_positions[p] for p in ends)
+                    da, db = (self.design_rates[p] for p in ends)
+                    e[0] = -(unit(b - a) @ (db - da))
+                self._explicit.append(e)
+        return self._explicit
 
     def _design_rate(self, point: str) -> np.ndarray:
         if point in self.design_rates:
@@ -306,12 +423,12 @@ class HardpointSensitivity:
         u_dot = (E - np.outer(u, u)) @ ((jb - ja) @ v) / n
         return (u_dot @ (jb - ja) + u @ (db - da))[None]
 
-    def _collect(self, points, design, step, only=None) -> Sensitivity:
-        """``only``: the columns wanted (a study's), else every one."""
+    def _collect(self, points, design, steps: list[int], only=None) -> list[Sensitivity]:
+        """A Sensitivity per state of the jets (``steps``: their step numbers); ``only``:
+        the columns wanted (a study's), else every one."""
         g = self.corner.geometry
         ps = PointSet(points, design, g)
         n = len(self.hardpoints)
-        values, units, metrics = {}, {}, {}
         wanted = derivative_columns(g)
         if only is not None:
             wanted = [d for d in wanted if d.name in only]
@@ -322,21 +439,72 @@ class HardpointSensitivity:
                 for m in METRICS
                 if m.applies(g) and (only is None or m.name in needed)
             }
-        for m in METRICS:
-            if m.name not in evaluated or only is not None and m.name not in only:
-                continue
-            v = evaluated[m.name]
-            metrics[m.name] = float(v.val.val[0])
-            values[m.name] = v.der.val[:, 0, 0].reshape(n, 3) * 1e-3
-            units[m.name] = f"{m.unit}/mm"
+        shown = [m for m in METRICS if m.name in evaluated and (only is None or m.name in only)]
         drivers = self.corner.drivers
-        for d in wanted:
-            v = evaluated[d.metric.name]
-            i = drivers.index(d.driver)
-            metrics[d.name] = float(v.val.der[i, 0]) * 1e-3
-            values[d.name] = v.der.der[:, i, 0].reshape(n, 3) * 1e-6
-            units[d.name] = f"{d.unit}/mm"
-        return Sensitivity(step, self.hardpoints, values, units, metrics)
+        out = []
+        for s, step in enumerate(steps):
+            values, units, metrics = {}, {}, {}
+            for m in shown:
+                v = evaluated[m.name]
+                metrics[m.name] = float(of_state(v.val.val, s))
+                values[m.name] = of_state(v.der.val[:, 0], s).reshape(n, 3) * 1e-3
+                units[m.name] = f"{m.unit}/mm"
+            for d in wanted:
+                v = evaluated[d.metric.name]
+                i = drivers.index(d.driver)
+                metrics[d.name] = float(of_state(v.val.der[i], s)) * 1e-3
+                values[d.name] = of_state(v.der.der[:, i], s).reshape(n, 3) * 1e-6
+                units[d.name] = f"{d.unit}/mm"
+            out.append(Sensitivity(step, self.hardpoints, values, units, metrics))
+        return out
+
+
+def needs_rates(g, only=None) -> bool:
+    """Whether the columns ``only`` (None: every one) read the drivers' rates: a
+    derivative column, or a metric of the rates (``Metric.rates``)."""
+    if only is None:
+        return True
+    return any(d.name in only for d in derivative_columns(g)) or any(
+        m.rates for m in METRICS if m.name in only
+    )
+
+
+def _unknown(s: Sensitivity) -> bool:
+    return any(np.isnan(v).any() for v in s.values.values()) or any(
+        np.isnan(v) for v in s.metrics.values()
+    )
+
+
+def of_state(x: np.ndarray, s: int) -> np.ndarray:
+    """State s's entries of x (the states on its last axis; a column of the design
+    alone, one entry)."""
+    return x[..., s if x.shape[-1] > 1 else 0]
+
+
+def _tilts(o: np.ndarray, e: np.ndarray) -> list[np.ndarray]:
+    """A pivot axis o → e: its tilt ε = ω × δω per unit move of e's coordinates (x, y,
+    z), then of o's."""
+    w = unit(e - o)
+    project = (E - np.outer(w, w)) / np.linalg.norm(e - o)
+    return [np.cross(w, s * project[:, b]) for s in (1.0, -1.0) for b in range(3)]
+
+
+def _same_structure(a: HardpointSensitivity, b: HardpointSensitivity) -> bool:
+    """Whether two sensitivity models are of one structure, their Pinocchio data then
+    interchangeable: the same joints, of the same kinds, and as many frames (named by
+    the points and links: the tree's structure), and each joint along an axis of its
+    own (a pivot's) along the same axis — the data keeps it, from the model it was
+    made for."""
+    ma, mb = a.model, b.model
+    if a.hardpoints != b.hardpoints or ma.nframes != mb.nframes or list(ma.names) != list(mb.names):
+        return False
+    for x, y in zip(ma.joints, mb.joints, strict=True):
+        kind = x.shortname()
+        if kind != y.shortname():
+            return False
+        if kind.endswith("Unaligned") and not np.array_equal(x.extract().axis, y.extract().axis):
+            return False
+    return True
 
 
 def _parse(tree: Tree) -> tuple:

@@ -11,11 +11,12 @@ WORLD = pin.LOCAL_WORLD_ALIGNED
 class Kinematics:
     """Pinocchio model + data; ``update(q)`` computes every frame and Jacobian."""
 
-    def __init__(self, model: pin.Model):
+    def __init__(self, model: pin.Model, data: pin.Data | None = None):
+        """``data``: the Data of a model of the same joints (a study's variant), reused."""
         self.model = model
         # (not model.createData(): that returns its Data by value, a copy as long again
         # as the build, which for a sensitivity model's 80 joints costs 10 ms)
-        self.data = pin.Data(model)
+        self.data = pin.Data(model) if data is None else data
 
     def update(self, q: np.ndarray) -> None:
         self.q = q

@@ -150,12 +150,12 @@ class _Template:
         return model
 
 
-def variant_model(tree, parse, closures: bool = True):
+def variant_model(tree, parse, closures: bool = True, bulk: bool = True):
     """(model, closure specs, its bulk.Tree or None) of a variant's tree: a copy of the
     model of the first tree of its structure with its own numbers, and its bulk tree
     likewise (``parse(tree)`` → (model, specs) builds one from the URDF text, for the
     first of each structure and for any tree this module cannot place); ``closures``:
-    the specs read (else None)."""
+    the specs read (else None); ``bulk``: the bulk tree made (else None)."""
     if tree.floating is not None:
         return (*parse(tree), None)
     steps = joint_steps(tree)
@@ -171,4 +171,4 @@ def variant_model(tree, parse, closures: bool = True):
         return (*parse(tree), None)
     model = template.place(tree, steps)
     specs = closure_specs(tree, _origins(tree, steps)) if closures else None
-    return model, specs, template.tree_like(model)
+    return model, specs, template.tree_like(model) if bulk else None

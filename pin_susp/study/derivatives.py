@@ -15,17 +15,18 @@ if TYPE_CHECKING:
     from .spec import Study
 
 
-def objective_jacobian(v: Variant, sweep) -> np.ndarray:
+def objective_jacobian(v: Variant, sweep, reuse: dict | None = None) -> np.ndarray:
     """d r / d variables from the exact hardpoint sensitivities at every step and at
     design (a relative term's reference moves too); a curve's target moves with its
-    x column. A step without a number (see term_miss) has a zero row."""
+    x column. A step without a number (see term_miss) has a zero row. ``reuse``: a
+    dict the caller keeps between the variants of one job (see sensitivities)."""
     job = v.job
     k = len(job.variables)
     n = sweep.steps
     if v.results is None:
         return np.zeros((len(job.terms) * n, k))
     wanted = {t.metric for t in job.terms} | {t.curve_x for t in job.terms if t.curve_x}
-    at_design, steps = sensitivities(v.subject, sweep, v.results, wanted)
+    at_design, steps = sensitivities(v.subject, sweep, v.results, wanted, reuse)
     columns = _columns(at_design.hardpoints, job.variables)
     blocks = []
     for t, w in zip(job.terms, shares(job.terms, n), strict=True):
@@ -57,22 +58,31 @@ def _pick(s, name: str, columns) -> np.ndarray:
     return np.nan_to_num(s.values[name][columns])
 
 
-def sensitivities(subject, sweep, results, only=None) -> tuple:
+def sensitivities(subject, sweep, results, only=None, reuse: dict | None = None) -> tuple:
     """The exact hardpoint sensitivities at design and at each converged step, holding
     there what the subject holds (``Assembly.held_at``): (Sensitivity, {step:
     Sensitivity}), one-sided names (``left_…``) on labelled corners; no steps where the
     sweep holds other than they hold (``Assembly.sensitivities_hold``: an axle's roll or
-    heave sweep); ``only``: the columns wanted (the objective's, the summary's)."""
+    heave sweep); ``only``: the columns wanted (the objective's, the summary's).
+    ``reuse``: a dict kept by the caller, holding the last subject's sensitivity model,
+    whose frames and Pinocchio data the next one of its structure shares (an
+    optimiser's evaluations: the variants differ only in their numbers)."""
     from ..analyses.sensitivity import SubjectSensitivity
 
-    model = SubjectSensitivity(subject, one_sided=True)
-    at_design, steps = model.at(only=only), {}
+    like = None if reuse is None else reuse.get("model")
+    model = SubjectSensitivity(subject, one_sided=True, like=like)
+    if reuse is not None:
+        reuse["model"] = model
+    states = [(None, 0, None)]  # the design state, then the steps: all in one pass
     if subject.sensitivities_hold(sweep):  # else the steps' would hold other quantities
-        for i in range(len(results)):
-            if results["solver_converged"][i]:
-                held = subject.held_at(sweep, i)
-                steps[i] = model.at(results.meta["q"][i], step=i, targets=held, only=only)
-    return at_design, steps
+        converged = results["solver_converged"]
+        states += [
+            (results.meta["q"][i], i, subject.held_at(sweep, i))
+            for i in range(len(results))
+            if converged[i]
+        ]
+    at_design, *steps = model.at_many(states, only)
+    return at_design, {s.step: s for s in steps}
 
 
 def linear_prediction(study: Study, variants) -> dict[str, np.ndarray] | None:

@@ -42,15 +42,19 @@ def run_start(job: Job, index: int, ids: np.ndarray, table: np.ndarray, steps: b
 
     sweep = load_sweep(job.sweep)
     low, high = job.bounds
-    cache = {}
+    x0 = np.clip(table[0], low, high)
+    # the start's variant and the last one asked for (least_squares asks for the
+    # residuals and then the Jacobian at one x; the row reads the start's again)
+    cache, first = {}, x0.tobytes()
+    reuse = {}  # the sensitivity model, shared by the variants (derivatives.sensitivities)
 
-    # (each evaluation marched as a sweep: the optimum to the last digit as before —
-    # its time is the sensitivities')
+    # (each evaluation marched as a sweep: the optimum to the last digit as before)
 
     def solved(x: np.ndarray) -> Variant:
         key = x.tobytes()
         if key not in cache:
-            cache.clear()
+            for old in [k for k in cache if k != first]:
+                del cache[old]
             cache[key] = Variant(job, x, sweep, every_column=steps)
         return cache[key]
 
@@ -58,9 +62,8 @@ def run_start(job: Job, index: int, ids: np.ndarray, table: np.ndarray, steps: b
         return solved(x).residuals()
 
     def jac(x):
-        return objective_jacobian(solved(x), sweep)
+        return objective_jacobian(solved(x), sweep, reuse)
 
-    x0 = np.clip(table[0], low, high)
     fit = least_squares(
         fun,
         x0,
