@@ -68,12 +68,16 @@ def run_study(
     try:
         if scheduler is None or scheduler == "none":
             return _run(study, outdir, None, steps, resume, progress, None, warn)
+        table = forked = None
+        if scheduler == "local":  # the workers' imports while this process builds the table
+            forked = cluster.start_forkserver()
+            table = variant_table(study)
         # a scheduler that answers, before any file
-        with cluster.dask_client(scheduler, workers) as client:
+        with cluster.dask_client(scheduler, workers, forked) as client:
             dashboard = cluster.dashboard(client, local=scheduler == "local")
             if announce is not None and dashboard:
                 announce(f"Dask dashboard: {dashboard}")
-            return _run(study, outdir, client, steps, resume, progress, dashboard, warn)
+            return _run(study, outdir, client, steps, resume, progress, dashboard, warn, table)
     except BaseException as exc:
         kept = _left(outdir, fresh, resume)
         if isinstance(exc, NoRoom):
@@ -106,8 +110,10 @@ def _left(outdir: Path, fresh: bool, resume: bool) -> int:
     return 0
 
 
-def _run(study, outdir, client, steps, resume, progress, dashboard, warn=None) -> Outcome:
-    table = variant_table(study)
+def _run(
+    study, outdir, client, steps, resume, progress, dashboard, warn=None, table=None
+) -> Outcome:
+    table = variant_table(study) if table is None else table
     parts = folder.prepare(study, outdir, steps, resume)
     cut = batches(study)
     if resume:  # a part cut short or damaged since (a disk error, an editor): solved again
@@ -125,9 +131,11 @@ def _run(study, outdir, client, steps, resume, progress, dashboard, warn=None) -
     if progress is not None and done:
         progress(done, len(cut))
 
+    written = {}  # batch → its variants as written (assembled without reading them back)
+
     def finished(result: dict) -> None:
         nonlocal done
-        folder.write_part(parts, result)
+        written[result["index"]] = folder.write_part(parts, result)
         done += 1
         if progress is not None:
             progress(done, len(cut))
@@ -137,7 +145,7 @@ def _run(study, outdir, client, steps, resume, progress, dashboard, warn=None) -
             finished(task(job, i, cut[i], table[cut[i]], steps))
     elif todo:
         cluster.on_dask(client, task, job, cut, table, todo, steps, finished)
-    table = folder.assemble(study, outdir, parts, len(cut), steps)
+    table = folder.assemble(study, outdir, parts, len(cut), steps, written)
     variants = table.to_pandas()
     outcome = Outcome(study, outdir, variants, len(todo), len(cut), dashboard=dashboard)
     outcome.linear = linear_prediction(study, variants) if study.kind == "monte_carlo" else None
