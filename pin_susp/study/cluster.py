@@ -27,19 +27,37 @@ PRELOAD = (
     "pyarrow",
 )
 FORKSERVER = {"distributed.worker.multiprocessing-method": "forkserver"}
+# The environment its libraries load in: as Dask's for a worker it spawns (its
+# distributed.nanny.pre-spawn-environ), one thread each (OpenBLAS reads it at import:
+# set later, a forked worker's numpy would use every core)
+ENVIRON = {
+    "MALLOC_TRIM_THRESHOLD_": "65536",
+    "OMP_NUM_THREADS": "1",
+    "MKL_NUM_THREADS": "1",
+    "OPENBLAS_NUM_THREADS": "1",
+}
 
 
 def start_forkserver() -> bool:
     """Start the server that the local cluster's workers are forked from (with PRELOAD
-    imported): at once, so that it imports while this process works on. False where
-    there is no forkserver (the workers are spawned)."""
+    imported, in ENVIRON): at once, so that it imports while this process works on.
+    False where there is no forkserver (the workers are spawned)."""
     import multiprocessing
     from multiprocessing import forkserver
 
     if "forkserver" not in multiprocessing.get_all_start_methods():
         return False
     multiprocessing.get_context("forkserver").set_forkserver_preload(list(PRELOAD))
-    forkserver.ensure_running()  # (a server already running is kept: its imports are done)
+    kept = {name: os.environ.get(name) for name in ENVIRON}
+    os.environ.update(ENVIRON)
+    try:
+        forkserver.ensure_running()  # (one already running is kept: its imports are done)
+    finally:
+        for name, value in kept.items():
+            if value is None:
+                os.environ.pop(name, None)
+            else:
+                os.environ[name] = value
     return True
 
 
