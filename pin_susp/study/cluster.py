@@ -123,7 +123,8 @@ class dask_client:
             threads_per_worker=1,  # the solve is single-threaded Python: a process a core
             processes=True,
             host="127.0.0.1",
-            dashboard_address="127.0.0.1:0",  # its HTTP server runs even without bokeh
+            # its pages need bokeh: without it, no dashboard is started (nor printed)
+            dashboard_address="127.0.0.1:0" if _has_dashboard() else None,
             silence_logs=logging.ERROR,
         )
         self.client = client_class(self.cluster)
