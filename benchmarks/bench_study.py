@@ -17,6 +17,11 @@ way in turn in this process, so that the ratios compare like with like:
 - the 10 000-variant tolerance study of examples/study_tolerances.yaml end to end
   on 2 workers, as `pin-susp study` runs it (--full only).
 
+Each run's fixed costs are printed by name (``Outcome.seconds``: the variants' table,
+the first-order prediction, the cluster's start and close, the part files, the
+assembly, the summary, study.png, variants.parquet), with the time to the first batch
+done and from the last one to the end.
+
 Targets (issue 30): ≥ 1 500 variants/s end to end on 2 workers (the 10 000-variant
 Monte Carlo and the 1 000-variant DOE), ≥ 800 variants/s serially; the optimisation
 ≥ 5× faster than before (OPTIMISE_BEFORE).
@@ -99,7 +104,7 @@ def timed(study, folder: Path, name: str, scheduler, workers=None) -> dict:
 
     marks = []
     started = time.perf_counter()
-    run_study(
+    outcome = run_study(
         study,
         folder / name,
         scheduler=scheduler,
@@ -111,7 +116,16 @@ def timed(study, folder: Path, name: str, scheduler, workers=None) -> dict:
     per_batch = n / len(batches(study))
     (first_done, first), (last_done, last) = marks[0], marks[-1]
     running = (last_done - first_done) * per_batch / (last - first) if last > first else n / total
-    return {"seconds": total, "end_to_end": n / total, "running": running, "variants": n}
+    phases = dict(outcome.seconds)
+    phases["(to the first batch done)"] = first - started
+    phases["(after the last batch done)"] = started + total - last
+    return {
+        "seconds": total,
+        "end_to_end": n / total,
+        "running": running,
+        "variants": n,
+        "phases": phases,
+    }
 
 
 def run(variants: int, full: bool) -> dict:
@@ -169,6 +183,7 @@ def show(report: dict) -> None:
             f"{report['ten_thousand']['seconds']:.1f} s"
         )
     print(f"  2 workers over 1 (running): {report['two_over_one']:.2f}x")
+    show_phases(report)
     seconds = report["optimise_seconds"]
     gain = OPTIMISE_BEFORE / seconds
     print(
@@ -176,6 +191,35 @@ def show(report: dict) -> None:
         f"{gain:.1f}x faster than before issue 30 ({OPTIMISE_BEFORE} s; target >= "
         f"{TARGETS['optimise']:.0f}x: {'met' if gain >= TARGETS['optimise'] else 'NOT met'})"
     )
+
+
+def show_phases(report: dict) -> None:
+    """Where each run's time went, phase by phase (seconds): the batches, and the fixed
+    costs around them."""
+    runs = {**report["ways"], **{f"DOE 1000, {k}": w for k, w in report["doe"].items()}}
+    if "ten_thousand" in report:
+        runs["tolerances 10 000, 2 workers"] = report["ten_thousand"]
+    short = {
+        "serial": "serial",
+        "local, 1 worker": "1 worker",
+        "local, 2 workers": "2 workers",
+        "DOE 1000, serial": "DOE ser.",
+        "DOE 1000, local, 2 workers": "DOE 2 w.",
+        "tolerances 10 000, 2 workers": "10k 2 w.",
+    }
+    # in the order of the run with the most phases (a cluster's: its start and close too)
+    fullest = sorted(runs.values(), key=lambda w: -len(w["phases"]))
+    names = list(dict.fromkeys(k for w in fullest for k in w["phases"]))
+    print("  where the time went (s):")
+    print(f"    {'':28s}" + "".join(f"{short.get(r, r)[:9]:>10s}" for r in runs))
+    for name in [*names, "end to end"]:
+        cells = [
+            w["seconds"] if name == "end to end" else w["phases"].get(name) for w in runs.values()
+        ]
+        print(
+            f"    {name:28s}"
+            + "".join(f"{c:10.3f}" if c is not None else f"{'':10s}" for c in cells)
+        )
 
 
 def main() -> None:

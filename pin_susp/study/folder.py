@@ -119,19 +119,21 @@ def finished_batches(outdir: str | Path) -> int | None:
     return len(list((outdir / PARTS).glob("variants-*.parquet")))
 
 
-def write_part(parts: Path, result: dict) -> None:
+def write_part(parts: Path, result: dict):
     """A batch's part files, each written whole; the variants' part last: its
-    presence marks the batch done (a steps part without it goes)."""
+    presence marks the batch done (a steps part without it goes). The batch's
+    variants (an Arrow table), for ``assemble``."""
     i = result["index"]
     parts.mkdir(exist_ok=True)
-    order = [("steps", result["steps"]), ("variants", result["variants"])]
+    variants = from_ipc(result["variants"])
     try:
-        for what, data in order:
-            if data is not None:
-                write_parquet(from_ipc(data), parts / f"{what}-{i:06d}.parquet")
+        if result["steps"] is not None:
+            write_parquet(from_ipc(result["steps"]), parts / f"steps-{i:06d}.parquet")
+        write_parquet(variants, parts / f"variants-{i:06d}.parquet")
     except BaseException:
         (parts / f"steps-{i:06d}.parquet").unlink(missing_ok=True)
         raise
+    return variants
 
 
 def damaged(parts: Path, i: int, ids: np.ndarray, steps: bool) -> str | None:
@@ -177,9 +179,10 @@ def write_parquet(table, path: Path) -> None:
         pq.write_table(table, f)
 
 
-def assemble(study: Study, outdir: Path, parts: Path, n: int, steps: bool):
+def assemble(study: Study, outdir: Path, parts: Path, n: int, steps: bool, have=None):
     """The variants' table (by variant_id) from the parts, and steps.parquet (a
-    dataset: a folder of part files) moved into place."""
+    dataset: a folder of part files) moved into place. ``have``: batch → its variants
+    as written in this run (not read back)."""
     import pyarrow as pa
     import pyarrow.parquet as pq
 
@@ -189,9 +192,12 @@ def assemble(study: Study, outdir: Path, parts: Path, n: int, steps: bool):
             f"{parts}: the part files of {len(missing)} batches went missing while the study "
             "ran (removed by another program?): --resume solves them again"
         )
-    tables = []
+    tables, have = [], have or {}
     for i in range(n):
         path = parts / f"variants-{i:06d}.parquet"
+        if i in have:
+            tables.append(have[i])
+            continue
         try:
             tables.append(pq.read_table(path))
         except (pa.ArrowException, OSError, ValueError) as exc:  # damaged while the run ran

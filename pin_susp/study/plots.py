@@ -32,6 +32,7 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
+from matplotlib.ticker import MaxNLocator
 
 from ..columns.metrics import METRIC_BY_NAME, Derivative
 from ..errors import PinSuspError
@@ -113,11 +114,21 @@ def _with_unit(text: str, unit: str) -> str:
 
 
 def _grid(fig: Figure, rows: int, cols: int) -> list:
+    """The panels; on each axis a few round ticks (AutoLocator's steps, fewer of them:
+    the ticks, their labels and grid lines were most of the cost of the figure)."""
     axes = fig.subplots(rows, cols, squeeze=False).ravel()
     for ax in axes:
         ax.grid(True, alpha=0.3)
         ax.tick_params(labelsize=8)
+        for axis, bins in ((ax.xaxis, 6), (ax.yaxis, 5)):
+            axis.set_major_locator(MaxNLocator(nbins=bins, steps=[1, 2, 2.5, 5, 10]))
     return list(axes)
+
+
+def _title(ax, text: str) -> None:
+    """A panel's title, high enough above it for the y axis's multiplier (1e7), if any
+    (placed, not moved at each save to clear the tick labels: a sixth of the cost)."""
+    ax.set_title(text, fontsize=10, y=1.0, pad=13.0)
 
 
 def _finite(x) -> np.ndarray:
@@ -173,18 +184,68 @@ def _figure(
     extra_height: float = 0.9,
     height: float = PANEL_H,
 ) -> Figure:
-    """A constrained-layout figure for a grid of panels, at least MIN_WIDTH wide, with
-    the heading wrapped to its width."""
+    """A figure for a grid of panels, at least MIN_WIDTH wide, with the heading wrapped
+    to its width; no layout engine: ``_place`` puts everything in its place, once."""
     inches = max(width * cols, MIN_WIDTH)
-    fig = Figure(figsize=(inches, height * rows + extra_height), layout="constrained")
+    fig = Figure(figsize=(inches, height * rows + extra_height))
     lines = [textwrap.fill(line, int(inches * 10)) for line in heading.splitlines()]
-    fig.suptitle("\n".join(lines), fontsize=12)
+    fig.suptitle("\n".join(lines), fontsize=12, va="top", gid="heading")
     return fig
 
 
+# The layout, in inches, set once rather than found at every save by a layout engine
+# (a constrained layout was half of the cost of drawing the figure): the panels'
+# texts have the same sizes in every study, only their numbers change.
+LEFT = 0.8  # left of a panel: its y tick labels and label
+RIGHT = 0.15  # right of a panel
+TITLE = 0.38  # above a panel: its title
+BELOW = 0.55  # under a panel: its x tick labels and label
+EDGE = 0.1  # the figure's edge to the heading, and to the footnote
+HEAD_LINE = 0.21  # a line of the heading (12 pt)
+LEGEND_ROW = 0.22  # a row of the figure's legend (9 pt), and LEGEND_PAD around it
+LEGEND_PAD = 0.12
+LEGEND_COLUMNS = 4  # the figure's legend: its keys in rows of (at most) this many
+FOOT_LINE = 0.15  # a line of the footnote (8 pt)
+MIN_PANEL = 1.5  # the least a panel's axes may span either way
+
+
+def _place(fig: Figure, rows: int, cols: int, right: float = RIGHT) -> None:
+    """Place the parts of a figure: the heading at the top, the figure's legend and then
+    the footnote at the bottom, and the grid of panels between, each with room for
+    its title and axis labels (and ``right`` inches right of it: a panel's legend)."""
+    w, h = fig.get_size_inches()
+    heading = [t for t in fig.texts if t.get_gid() == "heading"]
+    footnote = [t for t in fig.texts if t.get_gid() == "footnote"]
+    head = EDGE + HEAD_LINE * (fig.get_suptitle().count("\n") + 1)
+    foot = EDGE + FOOT_LINE * (footnote[0].get_text().count("\n") + 1) if footnote else EDGE
+    legend = 0.0
+    for lg in fig.legends:
+        legend = LEGEND_PAD + LEGEND_ROW * -(-len(lg.get_texts()) // LEGEND_COLUMNS)
+    # (a long heading, footnote or legend: the figure grows rather than its panels shrink)
+    w = max(w, cols * (LEFT + right + MIN_PANEL))
+    h = max(h, head + legend + foot + rows * (TITLE + BELOW + MIN_PANEL))
+    fig.set_size_inches(w, h)
+    panel_w = w / cols - LEFT - right
+    panel_h = (h - head - legend - foot) / rows - TITLE - BELOW
+    fig.subplots_adjust(
+        left=LEFT / w,
+        right=1.0 - right / w,
+        top=1.0 - (head + TITLE) / h,
+        bottom=(foot + legend + BELOW) / h,
+        wspace=(LEFT + right) / panel_w,
+        hspace=(TITLE + BELOW) / panel_h,
+    )
+    for text in heading:
+        text.set_y(1.0 - EDGE / h)
+    for lg in fig.legends:
+        lg.set_bbox_to_anchor((0.5, (foot + 0.5 * LEGEND_PAD) / h), fig.transFigure)
+    for text in footnote:
+        text.set_y(0.5 * EDGE / h)
+
+
 def _footnote(fig: Figure, text: str) -> None:
-    """A note under the panels (room made for it by the layout)."""
-    fig.supxlabel(text, x=0.01, ha="left", fontsize=8, gid="footnote")
+    """A note under the panels (room made for it by ``_place``)."""
+    fig.supxlabel(text, x=0.01, ha="left", va="bottom", fontsize=8, gid="footnote")
 
 
 def _note(ax, text: str, where: str = "upper right") -> None:
@@ -209,7 +270,8 @@ def _note(ax, text: str, where: str = "upper right") -> None:
 
 def _histograms(study, variants, linear, heading: str) -> Figure:
     rows = _summary_columns(study, variants)
-    fig = _figure(len(rows), max(len(r) for r in rows), heading, extra_height=1.2)
+    cols = max(len(r) for r in rows)
+    fig = _figure(len(rows), cols, heading, extra_height=1.2)
     axes, columns = _layout(fig, rows)
     gaussian = study.distribution == "normal"
     for ax, column in zip(axes, columns, strict=True):
@@ -224,9 +286,10 @@ def _histograms(study, variants, linear, heading: str) -> Figure:
     }
     keys = {name: h for name, h in keys.items() if name in drawn}
     if keys:
-        fig.legend(keys.values(), keys.keys(), loc="outside lower center", ncol=3, fontsize=9)
+        fig.legend(keys.values(), keys.keys(), loc="lower center", ncol=LEGEND_COLUMNS, fontsize=9)
     if linear is None:
         _footnote(fig, "no first-order prediction (an axle, or the design did not solve)")
+    _place(fig, len(rows), cols)
     return fig
 
 
@@ -249,7 +312,7 @@ def _flat(x: np.ndarray, scale: float) -> bool:
 
 def _histogram(ax, column: str, values, predicted, gaussian: bool) -> None:
     title, xlabel, unit = _column_texts(column)
-    ax.set_title(title, fontsize=10)
+    _title(ax, title)
     ax.set_xlabel(xlabel, fontsize=8)
     ax.set_ylabel(_with_unit("density", f"1/{unit}" if unit else ""), fontsize=8)
     sampled = _finite(values)
@@ -268,6 +331,7 @@ def _histogram(ax, column: str, values, predicted, gaussian: bool) -> None:
         sampled,
         bins=edges,
         density=True,
+        histtype="stepfilled",  # one patch, not a bar per bin
         color=SAMPLED,
         alpha=0.55,
         label="sampled (solved)",
@@ -347,11 +411,22 @@ def _main_effects(study, variants, heading: str) -> Figure:
         fig.legend(
             [handles[n] for n in order],
             order,
-            loc="outside lower center",
-            ncol=min(len(order), 4) or 1,
+            loc="lower center",
+            ncol=min(len(order), LEGEND_COLUMNS) or 1,
             fontsize=9,
         )
+    # many variables: each panel's own legend, right of it
+    _place(fig, len(rows), cols, RIGHT + (0.0 if shared else _widest_legend(fig, axes) + 0.1))
     return fig
+
+
+def _widest_legend(fig: Figure, axes) -> float:
+    """The widest of the panels' own legends, in inches (measured: the names vary)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    renderer = FigureCanvasAgg(fig).get_renderer()
+    legends = [ax.get_legend() for ax in axes if ax.get_legend() is not None]
+    return max((lg.get_window_extent(renderer).width / fig.dpi for lg in legends), default=0.0)
 
 
 def effect_sizes(effects: dict[str, tuple]) -> dict[str, float]:
@@ -372,7 +447,7 @@ def _effects_panel(ax, column: str, effects: dict, count: int, colours: dict | N
     drawn = [k for k in sizes if np.isfinite(sizes[k])]
     if colours is None:
         drawn = drawn[:TOP]
-    ax.set_title(title, fontsize=10)
+    _title(ax, title)
     ax.set_ylabel(_with_unit("mean", unit), fontsize=8)
     ax.set_xlabel("variable, from design [mm]", fontsize=8)
     for k, name in enumerate(drawn):
@@ -425,6 +500,7 @@ def _curves(study, variants, curves: list[dict], heading: str) -> Figure:
     if not curves:
         _note(axes[0], "no objective term to draw", "upper left")
     _footnote(fig, _best_text(study, variants, int(fig.get_figwidth() * 13)))
+    _place(fig, rows, cols)
     return fig
 
 
@@ -460,7 +536,7 @@ def _curve_panel(ax, entry: dict) -> None:
     label, unit = describe(metric)
     x_name = entry.get("x", "step_index")
     x_label, x_unit = describe(x_name)
-    ax.set_title(label + (": change from design state" if relative else ""), fontsize=10)
+    _title(ax, label + (": change from design state" if relative else ""))
     ax.set_ylabel(_with_unit(("Δ " if relative else "") + metric, unit), fontsize=8)
     ax.set_xlabel(_with_unit(x_label, x_unit), fontsize=8)
     notes, targets = [], []

@@ -6,6 +6,7 @@ that stops leaves for ``resume``.
 from __future__ import annotations
 
 import contextlib
+import time
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -35,6 +36,7 @@ class Outcome:
     figure: Path | None = None  # study.png (None when no variant converged)
     dashboard: str | None = None
     linear: dict | None = None  # Monte Carlo: the first-order prediction per column
+    seconds: dict = field(default_factory=dict)  # phase → seconds it took (Clock)
 
 
 def run_study(
@@ -60,20 +62,34 @@ def run_study(
     (a new run's study.json and part folder removed). A write that runs out of room
     raises NoRoom saying which (docs/studies.md).
     """
+    clock = Clock()
     if not isinstance(study, Study):
         study = load_study(study)
+        clock.lap("study read")
     outdir = Path(outdir)
     folder.check_outdir(study, outdir, steps, resume)  # before any connection or file
     fresh = not outdir.exists()
     try:
         if scheduler is None or scheduler == "none":
-            return _run(study, outdir, None, steps, resume, progress, None, warn)
+            return _run(study, outdir, None, steps, resume, progress, None, warn, clock)
+        early = {}
+        forked = scheduler == "local" and cluster.start_forkserver()
+        if scheduler == "local":  # what needs no worker, while the workers' server imports
+            early["table"] = variant_table(study)
+            clock.lap("variants' table")
+            if study.kind == "monte_carlo":
+                early["linear"] = _prediction(study, early["table"])
+                clock.lap("first-order prediction")
         # a scheduler that answers, before any file
-        with cluster.dask_client(scheduler, workers) as client:
+        with cluster.dask_client(scheduler, workers, forked) as client:
+            clock.lap("cluster start")
             dashboard = cluster.dashboard(client, local=scheduler == "local")
             if announce is not None and dashboard:
                 announce(f"Dask dashboard: {dashboard}")
-            return _run(study, outdir, client, steps, resume, progress, dashboard, warn)
+            args = (steps, resume, progress, dashboard, warn, clock)
+            outcome = _run(study, outdir, client, *args, **early)
+        clock.lap("cluster close")
+        return outcome
     except BaseException as exc:
         kept = _left(outdir, fresh, resume)
         if isinstance(exc, NoRoom):
@@ -106,8 +122,41 @@ def _left(outdir: Path, fresh: bool, resume: bool) -> int:
     return 0
 
 
-def _run(study, outdir, client, steps, resume, progress, dashboard, warn=None) -> Outcome:
-    table = variant_table(study)
+class Clock:
+    """The seconds of each phase of a run (``Outcome.seconds``), in the order first met:
+    ``lap(phase)`` ends the phase that ran since the last lap."""
+
+    def __init__(self):
+        self.seconds, self.mark = {}, time.perf_counter()
+
+    def lap(self, phase: str) -> None:
+        now = time.perf_counter()
+        self.seconds[phase] = self.seconds.get(phase, 0.0) + now - self.mark
+        self.mark = now
+
+
+def _prediction(study: Study, table: np.ndarray) -> dict | None:
+    """Monte Carlo's first-order prediction from the variants' table, as from the
+    assembled variants (their variables in the study's convention: the same numbers)."""
+    import pyarrow as pa
+
+    from ..io.conventions import Output
+
+    names = pa.table({name: table[:, j] for j, name in enumerate(study.names)})
+    variables = folder.in_convention(names, Output(study.convention)).to_pandas()
+    return linear_prediction(study, variables)
+
+
+NOT_YET = object()  # (the first-order prediction is None for an axle's)
+
+
+def _run(
+    study, outdir, client, steps, resume, progress, dashboard, warn, clock, **early
+) -> Outcome:
+    table = early.get("table")
+    if table is None:
+        table = variant_table(study)
+        clock.lap("variants' table")
     parts = folder.prepare(study, outdir, steps, resume)
     cut = batches(study)
     if resume:  # a part cut short or damaged since (a disk error, an editor): solved again
@@ -120,14 +169,19 @@ def _run(study, outdir, client, steps, resume, progress, dashboard, warn=None) -
                 warnings.warn(message, stacklevel=2) if warn is None else warn(message)
     todo = [i for i in range(len(cut)) if not (parts / f"variants-{i:06d}.parquet").exists()]
     job = study.job()
+    clock.lap("folder")
     task = tasks.run_start if study.kind == "optimise" else tasks.run_batch
     done = len(cut) - len(todo)
     if progress is not None and done:
         progress(done, len(cut))
 
+    written = {}  # batch → its variants as written (assembled without reading them back)
+
     def finished(result: dict) -> None:
         nonlocal done
-        folder.write_part(parts, result)
+        clock.lap("batches")
+        written[result["index"]] = folder.write_part(parts, result)
+        clock.lap("part files")
         done += 1
         if progress is not None:
             progress(done, len(cut))
@@ -137,10 +191,17 @@ def _run(study, outdir, client, steps, resume, progress, dashboard, warn=None) -
             finished(task(job, i, cut[i], table[cut[i]], steps))
     elif todo:
         cluster.on_dask(client, task, job, cut, table, todo, steps, finished)
-    table = folder.assemble(study, outdir, parts, len(cut), steps)
+    clock.lap("batches")
+    table = folder.assemble(study, outdir, parts, len(cut), steps, written)
     variants = table.to_pandas()
     outcome = Outcome(study, outdir, variants, len(todo), len(cut), dashboard=dashboard)
-    outcome.linear = linear_prediction(study, variants) if study.kind == "monte_carlo" else None
+    outcome.seconds = clock.seconds
+    clock.lap("assembled")
+    if study.kind == "monte_carlo":
+        outcome.linear = early.get("linear", NOT_YET)
+        if outcome.linear is NOT_YET:
+            outcome.linear = linear_prediction(study, variants)
+            clock.lap("first-order prediction")
     if outcome.linear:  # beside each sampled column, its first-order prediction
         import pyarrow as pa
 
@@ -160,6 +221,7 @@ def _run(study, outdir, client, steps, resume, progress, dashboard, warn=None) -
         outcome.best = outdir / "best.yaml"
         curves = curves_of(study, best)
     outcome.lines = summary_lines(study, variants, outcome.linear, curves)
+    clock.lap("summary")
     from ..io.atomic import all_or_none
 
     with all_or_none():  # best.yaml, study.png, variants.parquet: together, or none of them
@@ -171,8 +233,10 @@ def _run(study, outdir, client, steps, resume, progress, dashboard, warn=None) -
 
             outcome.figure = outdir / "study.png"
             save_figure(study_figure(study, variants, outcome.linear, curves), outcome.figure)
+            clock.lap("study.png")
         folder.write_parquet(table, outdir / "variants.parquet")  # last: it marks the run finished
     folder.drop_parts(parts)
+    clock.lap("variants.parquet")
     return outcome
 
 

@@ -358,10 +358,11 @@ def _terms(raw, design: _Design, r: Reader) -> list[Term]:
 
 def batches(study: Study) -> list[np.ndarray]:
     """The variants' ids cut into batches (fixed by the study alone, so that a
-    resumed run cuts them the same)."""
+    resumed run cuts them the same): by default 16 (each a task, its part file: fewer,
+    larger batches cost less to send, write and solve together), of 200 at most."""
     n = study.samples
     if study.kind == "optimise":
         size = 1
     else:
-        size = study.batch_size or max(1, min(200, math.ceil(n / 64)))
+        size = study.batch_size or max(1, min(200, math.ceil(n / 16)))
     return [np.arange(i, min(i + size, n)) for i in range(0, n, size)]
