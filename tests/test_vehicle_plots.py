@@ -15,11 +15,11 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 import yaml
-from conftest import EXAMPLES, sweep_csv
+from conftest import EXAMPLES, main_saving, sweep_csv
 
 import pin_susp
 from pin_susp.cli import main
-from pin_susp.plots import ResultsFile, report_figure, save_figure
+from pin_susp.plots import ResultsFile, report_figure
 
 CARS = ("fs", "saloon")
 SWEEPS = ("heave", "pitch", "roll", "warp", "steer", "combined")
@@ -59,25 +59,11 @@ def runs(tmp_path_factory):
     return Runs(tmp_path_factory.mktemp("vehicle_plots"))
 
 
-def saving(argv: list[str]) -> tuple[int, list]:
-    """`pin-susp ARGV`'s exit code and the figures it saved, each as it was saved (the
-    picture's own figure: read, not drawn again)."""
-    saved = []
-
-    def keep(fig, out):
-        saved.append(fig)
-        save_figure(fig, out)
-
-    with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(pin_susp.plots, "save_figure", keep)
-        return main(argv), saved
-
-
 def sweep_plot(car: str, sweep: str, folder):
     """`pin-susp sweep --plot` of an example car through an example sweep: its CSV, its
     picture and the figure the picture was saved from."""
     path, png = folder / f"{car}_{sweep}.csv", folder / f"{car}_{sweep}.png"
-    code, (fig,) = saving([*sweep_argv(car, sweep, path), "--plot", str(png)])
+    code, (fig,) = main_saving([*sweep_argv(car, sweep, path), "--plot", str(png)])
     assert code == 0, (car, sweep)
     return path, png, fig
 
@@ -292,7 +278,7 @@ def test_failed_steps_leave_gaps(tmp_path, runs):
     sweep.write_text(yaml.safe_dump(data))
     out, png = tmp_path / "far.csv", tmp_path / "far.png"
     argv = ["sweep", str(EXAMPLES / "vehicle_fs.yaml"), str(sweep), "-o", str(out)]
-    code, (fig,) = saving([*argv, "--plot", str(png), "-q"])
+    code, (fig,) = main_saving([*argv, "--plot", str(png), "-q"])
     assert code == 1
     assert matplotlib.image.imread(png).ndim == 3
     columns = read(out)
@@ -310,7 +296,7 @@ def test_failed_steps_leave_gaps(tmp_path, runs):
     lines[k + 1 + 10] = ",".join(cells[:1] + ["False"] + [""] * (len(cells) - 2))
     gap = tmp_path / "gap.csv"
     gap.write_text("\n".join(lines) + "\n")
-    code, (fig,) = saving(["plot", str(gap), "-o", str(tmp_path / "gap.png")])
+    code, (fig,) = main_saving(["plot", str(gap), "-o", str(tmp_path / "gap.png")])
     assert code == 0
     (line, *_) = lines_of(fig)["Camber to ground"]
     x, y = np.asarray(line.get_xdata(), float), np.asarray(line.get_ydata(), float)
