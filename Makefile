@@ -20,9 +20,13 @@ $(STAMP): pyproject.toml
 demo: $(STAMP)
 	$(BIN)/pin-susp demo -o $(DEMO_DIR)
 
-# pytest exits 5 when it collects no test: that is a failure here too.
+# The suite on TEST_WORKERS processes (pytest-xdist; `make test TEST_WORKERS=0` runs it in
+# one). worksteal: each worker takes a contiguous half of the tests (a module's shared
+# fixtures computed once, mostly) and one that runs dry takes half of what the other has
+# left. pytest exits 5 when it collects no test: that is a failure here too.
+TEST_WORKERS ?= 2
 test: $(STAMP)
-	@$(BIN)/python -m pytest -q; status=$$?; \
+	@$(BIN)/python -m pytest -q -n $(TEST_WORKERS) --dist worksteal; status=$$?; \
 	if [ $$status -eq 5 ]; then echo "make test: pytest collected no tests" >&2; fi; \
 	exit $$status
 

@@ -56,6 +56,23 @@ def sweep_csv(tmp_path: Path, geometry: str, sweep: str, name: str = "results.cs
     return out
 
 
+def main_saving(argv: list[str]) -> tuple[int, list]:
+    """`pin-susp ARGV` in process: its exit code and the figures it saved, each as it was
+    saved (a picture's own figure, to read its panels off without drawing it again)."""
+    import pin_susp.plots
+    from pin_susp.cli import main
+
+    saved, save = [], pin_susp.plots.save_figure
+
+    def keep(fig, path):
+        saved.append(fig)
+        save(fig, path)
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(pin_susp.plots, "save_figure", keep)
+        return main(argv), saved
+
+
 # Runs pin_susp.cli.main(argv) as the console script would, then writes the names of
 # every imported module (a command's own output stays on stdout).
 RUN_CLI = """

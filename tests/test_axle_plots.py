@@ -4,7 +4,8 @@
 The CSVs are read here with the csv module, not with pin_susp's reader; the roll
 centre is checked against the crossing of the two contact-patch → FVIC lines solved
 here with numpy from the CSV's own point and FVIC columns, and at design against the
-mirror symmetry of the axle (on the centreline).
+mirror symmetry of the axle (on the centreline). A picture's panels are read off the
+figure the command saved it from.
 """
 
 import csv
@@ -13,7 +14,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 import yaml
-from conftest import EXAMPLES, example, sweep_csv
+from conftest import EXAMPLES, example, main_saving, sweep_csv
 
 from pin_susp.cli import main
 from pin_susp.errors import InputError
@@ -75,7 +76,9 @@ SWEEPS = {  # name: (steps, what it moves); roll at a ride height, a steer, a he
 
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory):
-    """The converging axle's file, and each sweep's CSV and report (sweep --plot)."""
+    """The converging axle's file, and each sweep's CSV and report (sweep --plot); the
+    figure each report was saved from by ("report", sweep) (read by the tests, never
+    changed)."""
     folder = tmp_path_factory.mktemp("axle_plots")
     geometry = folder / "axle.yaml"
     geometry.write_text(yaml.safe_dump(converging()))
@@ -84,9 +87,10 @@ def runs(tmp_path_factory):
         sweep = folder / f"{name}.yaml"
         sweep.write_text(text)
         csv_path, png = folder / f"{name}.csv", folder / f"{name}.png"
-        code = main(["sweep", str(geometry), str(sweep), "-o", str(csv_path), "--plot", str(png)])
+        argv = ["sweep", str(geometry), str(sweep), "-o", str(csv_path), "--plot", str(png)]
+        code, (fig,) = main_saving(argv)
         assert code == 0 and png.stat().st_size > 10_000
-        out[name] = str(csv_path)
+        out[name], out["report", name] = str(csv_path), fig
     return out
 
 
@@ -124,7 +128,7 @@ def same(a, b) -> None:
 )
 def test_each_panel_draws_its_csv_columns_against_what_the_sweep_moved(runs, sweep, x):
     columns = read(runs[sweep])
-    fig = report_figure([ResultsFile(runs[sweep])])
+    fig = runs["report", sweep]
     panels = lines_of(fig)
     expected = {
         TITLES[names]: names
@@ -150,11 +154,11 @@ def test_each_panel_draws_its_csv_columns_against_what_the_sweep_moved(runs, swe
 def test_ackermann_is_drawn_against_the_mean_steer_angle_when_the_sweep_steers(runs):
     columns = read(runs["steer"])
     assert np.isfinite(columns["ackermann"]).sum() >= 6  # blank only near straight ahead
-    (line,) = lines_of(report_figure([ResultsFile(runs["steer"])]))[ACKERMANN_TITLE]
+    (line,) = lines_of(runs["report", "steer"])[ACKERMANN_TITLE]
     same(line.get_xdata(), 0.5 * (columns["steer_angle_left"] + columns["steer_angle_right"]))
     same(line.get_ydata(), columns["ackermann"])
     # no steer, no Ackermann panel
-    assert ACKERMANN_TITLE not in lines_of(report_figure([ResultsFile(runs["roll"])]))
+    assert ACKERMANN_TITLE not in lines_of(runs["report", "roll"])
 
 
 def without(path, out, drop=(), blank=()) -> str:
@@ -170,7 +174,7 @@ def without(path, out, drop=(), blank=()) -> str:
 
 
 def test_absent_or_blank_columns_leave_their_panel_out(runs, tmp_path):
-    full = lines_of(report_figure([ResultsFile(runs["roll"])]))
+    full = lines_of(runs["report", "roll"])
     gone = ("Anti-roll bar twist (left − right arm)", "Heave link length", "Roll centre height")
     assert set(gone) <= set(full)
     path = without(

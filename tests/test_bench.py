@@ -21,6 +21,7 @@ def test_benchmark_quick_mode_runs_with_few_iterations_and_tiny_residuals(tmp_pa
         capture_output=True,
         text=True,
         timeout=600,
+        env=os.environ | {"TMPDIR": str(tmp_path)},  # its command-line runs' files in tmp_path
     )
     assert proc.returncode == 0, proc.stderr
     assert "baselines" in proc.stdout and "x (target" in proc.stdout

@@ -4,7 +4,8 @@ engineer reads off it, for both example cars and every example sweep.
 The CSVs are read here with the csv module, not with pin_susp's reader; the x axis is
 checked against the sweep file's own targets (what it moved, over what range), and each
 panel's lines against the CSV's columns, a line per corner (the front solid, the rear
-dashed, the left and the right a colour each) or per axle (the front solid).
+dashed, the left and the right a colour each) or per axle (the front solid). A picture's
+panels are read off the figure the command saved it from.
 """
 
 import csv
@@ -14,7 +15,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 import yaml
-from conftest import EXAMPLES, sweep_csv
+from conftest import EXAMPLES, main_saving, sweep_csv
 
 import pin_susp
 from pin_susp.cli import main
@@ -31,19 +32,40 @@ def _close_figures():
     plt.close("all")
 
 
+def sweep_argv(car: str, sweep: str, out) -> list[str]:
+    """`pin-susp sweep` of an example car through an example sweep, quietly, to ``out``."""
+    argv = ["sweep", str(EXAMPLES / f"vehicle_{car}.yaml")]
+    return [*argv, str(EXAMPLES / f"vehicle_{sweep}.yaml"), "-o", str(out), "-q"]
+
+
+class Runs(dict):
+    """(car, sweep) → its CSV, swept when a test first asks for it (a test that needs two
+    of them does not wait for all twelve; each test's report is drawn where it is read)."""
+
+    def __init__(self, folder):
+        super().__init__()
+        self.folder = folder
+
+    def __missing__(self, key):
+        path = self.folder / "{}_{}.csv".format(*key)
+        assert main(sweep_argv(*key, path)) == 0, key
+        self[key] = path
+        return path
+
+
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory):
-    """Each example car's CSV and report (sweep --plot) of each example sweep."""
-    folder = tmp_path_factory.mktemp("vehicle_plots")
-    out = {}
-    for car in CARS:
-        for sweep in SWEEPS:
-            csv_path, png = folder / f"{car}_{sweep}.csv", folder / f"{car}_{sweep}.png"
-            argv = ["sweep", str(EXAMPLES / f"vehicle_{car}.yaml")]
-            argv += [str(EXAMPLES / f"vehicle_{sweep}.yaml"), "-o", str(csv_path)]
-            assert main([*argv, "--plot", str(png), "-q"]) == 0, (car, sweep)
-            out[car, sweep] = csv_path
-    return out
+    """Each example car's CSV of each example sweep."""
+    return Runs(tmp_path_factory.mktemp("vehicle_plots"))
+
+
+def sweep_plot(car: str, sweep: str, folder):
+    """`pin-susp sweep --plot` of an example car through an example sweep: its CSV, its
+    picture and the figure the picture was saved from."""
+    path, png = folder / f"{car}_{sweep}.csv", folder / f"{car}_{sweep}.png"
+    code, (fig,) = main_saving([*sweep_argv(car, sweep, path), "--plot", str(png)])
+    assert code == 0, (car, sweep)
+    return path, png, fig
 
 
 def read(path) -> dict[str, np.ndarray]:
@@ -137,12 +159,11 @@ def expected_panels(columns: dict) -> dict[str, tuple[tuple[str, str, str], ...]
 
 @pytest.mark.parametrize("car", CARS)
 @pytest.mark.parametrize("sweep", SWEEPS)
-def test_each_panel_draws_its_csv_columns_against_what_the_sweep_moved(runs, car, sweep):
-    path = runs[car, sweep]
-    image = matplotlib.image.imread(path.with_suffix(".png"))  # sweep --plot's picture
+def test_each_panel_draws_its_csv_columns_against_what_the_sweep_moved(car, sweep, tmp_path):
+    path, png, fig = sweep_plot(car, sweep, tmp_path)  # the figure of sweep --plot's picture
+    image = matplotlib.image.imread(png)
     assert image.shape[0] > 1000 and image.shape[1] > 1500 and np.ptp(image) > 0.5
     columns = read(path)
-    fig = report_figure([ResultsFile(path)])
     assert fig._suptitle.get_text() == f"pin_susp vehicle kinematics: {car}_{sweep}"
     panels = lines_of(fig)
     targets = moved_targets(sweep)
@@ -257,12 +278,13 @@ def test_failed_steps_leave_gaps(tmp_path, runs):
     sweep.write_text(yaml.safe_dump(data))
     out, png = tmp_path / "far.csv", tmp_path / "far.png"
     argv = ["sweep", str(EXAMPLES / "vehicle_fs.yaml"), str(sweep), "-o", str(out)]
-    assert main([*argv, "--plot", str(png), "-q"]) == 1
+    code, (fig,) = main_saving([*argv, "--plot", str(png), "-q"])
+    assert code == 1
     assert matplotlib.image.imread(png).ndim == 3
     columns = read(out)
     failed = columns["solver_converged"] == 0.0
     assert 0 < failed.sum() < 9
-    panels = lines_of(report_figure([ResultsFile(out)]))
+    panels = lines_of(fig)
     for title in ("Camber to ground", "Roll centre height", "Pitch centre height"):
         for line in panels[title]:
             y = np.asarray(line.get_ydata(), dtype=float)
@@ -274,8 +296,9 @@ def test_failed_steps_leave_gaps(tmp_path, runs):
     lines[k + 1 + 10] = ",".join(cells[:1] + ["False"] + [""] * (len(cells) - 2))
     gap = tmp_path / "gap.csv"
     gap.write_text("\n".join(lines) + "\n")
-    assert main(["plot", str(gap), "-o", str(tmp_path / "gap.png")]) == 0
-    (line, *_) = lines_of(report_figure([ResultsFile(gap)]))["Camber to ground"]
+    code, (fig,) = main_saving(["plot", str(gap), "-o", str(tmp_path / "gap.png")])
+    assert code == 0
+    (line, *_) = lines_of(fig)["Camber to ground"]
     x, y = np.asarray(line.get_xdata(), float), np.asarray(line.get_ydata(), float)
     assert np.isnan(x[10]) and np.isnan(y[10])
     assert np.all(np.isfinite(np.delete(y, 10))) and line.get_marker() in ("None", None, "")

