@@ -26,7 +26,7 @@ Targets (issue 30): ≥ 1 500 variants/s end to end on 2 workers (the 10 000-var
 Monte Carlo and the 1 000-variant DOE), ≥ 800 variants/s serially; the optimisation
 ≥ 5× faster than before (OPTIMISE_BEFORE).
 
-    python benchmarks/bench_study.py [--variants N] [--full] [--json OUT.json]
+    python benchmarks/bench_study.py [--variants N] [--doe N] [--full] [--json OUT.json]
 """
 
 from __future__ import annotations
@@ -128,17 +128,18 @@ def timed(study, folder: Path, name: str, scheduler, workers=None) -> dict:
     }
 
 
-def run(variants: int, full: bool) -> dict:
+def run(variants: int, full: bool, doe_variants: int = 1000) -> dict:
     from pin_susp.study import load_study
 
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
         study = load_study(study_file(folder, variants))
         report = {"cores": os.cpu_count(), "variants": variants, "ways": {}}
+        report["doe_variants"] = doe_variants
         report["ways"]["serial"] = timed(study, folder, "serial", None)
         report["ways"]["local, 1 worker"] = timed(study, folder, "one", "local", 1)
         report["ways"]["local, 2 workers"] = timed(study, folder, "two", "local", 2)
-        doe = load_study(doe_file(folder, 1000))
+        doe = load_study(doe_file(folder, doe_variants))
         report["doe"] = {
             "serial": timed(doe, folder, "doe_serial", None),
             "local, 2 workers": timed(doe, folder, "doe_two", "local", 2),
@@ -175,7 +176,7 @@ def show(report: dict) -> None:
         line(name, w, target.get(name))
     for name, w in report["doe"].items():
         target = TARGETS["serial"] if name == "serial" else TARGETS["two workers"]
-        line(f"DOE 1000, {name}", w, target)
+        line(f"DOE {report['doe_variants']}, {name}", w, target)
     if "ten_thousand" in report:
         line("tolerances 10 000, 2 workers", report["ten_thousand"], TARGETS["two workers"])
         print(
@@ -196,15 +197,16 @@ def show(report: dict) -> None:
 def show_phases(report: dict) -> None:
     """Where each run's time went, phase by phase (seconds): the batches, and the fixed
     costs around them."""
-    runs = {**report["ways"], **{f"DOE 1000, {k}": w for k, w in report["doe"].items()}}
+    doe = f"DOE {report['doe_variants']}"
+    runs = {**report["ways"], **{f"{doe}, {k}": w for k, w in report["doe"].items()}}
     if "ten_thousand" in report:
         runs["tolerances 10 000, 2 workers"] = report["ten_thousand"]
     short = {
         "serial": "serial",
         "local, 1 worker": "1 worker",
         "local, 2 workers": "2 workers",
-        "DOE 1000, serial": "DOE ser.",
-        "DOE 1000, local, 2 workers": "DOE 2 w.",
+        f"{doe}, serial": "DOE ser.",
+        f"{doe}, local, 2 workers": "DOE 2 w.",
         "tolerances 10 000, 2 workers": "10k 2 w.",
     }
     # in the order of the run with the most phases (a cluster's: its start and close too)
@@ -225,10 +227,11 @@ def show_phases(report: dict) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--variants", type=int, default=2000, help="variants per way")
+    parser.add_argument("--doe", type=int, default=1000, help="the DOE's variants")
     parser.add_argument("--full", action="store_true", help="also the 10 000-variant study")
     parser.add_argument("--json", metavar="OUT.json", help="also write the figures as JSON")
     args = parser.parse_args()
-    report = run(args.variants, args.full)
+    report = run(args.variants, args.full, args.doe)
     show(report)
     if args.json:
         Path(args.json).write_text(json.dumps(report, indent=2))

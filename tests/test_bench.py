@@ -65,6 +65,7 @@ def test_study_benchmark_runs_a_small_slice(tmp_path):
     out = tmp_path / "study.json"
     proc = subprocess.run(
         [sys.executable, str(ROOT / "benchmarks" / "bench_study.py"), "--variants", "64"]
+        + ["--doe", "64"]
         + ["--json", str(out)],
         capture_output=True,
         text=True,
@@ -77,7 +78,7 @@ def test_study_benchmark_runs_a_small_slice(tmp_path):
     assert "2 workers over 1" in proc.stdout
     report = json.loads(out.read_text())
     assert set(report["ways"]) == {"serial", "local, 1 worker", "local, 2 workers"}
-    for way in report["ways"].values():
+    for way in [*report["ways"].values(), *report["doe"].values()]:
         assert way["variants"] == 64 and way["running"] > 0
 
 
