@@ -599,6 +599,33 @@ def test_resume_finishes_a_run_cut_short_whatever_the_path_spelling(tmp_path, mo
     assert finished_batches(tmp_path / "o") is None  # finished: nothing left to resume
 
 
+def test_a_run_cut_into_other_batches_is_not_resumed_and_says_why(tmp_path, capsys):
+    """A run cut short by an earlier version (its manifest: 64 batches where this one
+    cuts the study into 2) is refused by --resume in one line naming both counts, and
+    the directory is left as it was."""
+    import json
+
+    from pin_susp.study import MANIFEST
+
+    path = write_study(tmp_path, LHS)  # 6 variants in 2 batches
+
+    def interrupt(done, total):
+        if done == 1:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        run_study(load_study(path), tmp_path / "o", scheduler=None, progress=interrupt)
+    manifest = tmp_path / "o" / MANIFEST
+    data = json.loads(manifest.read_text()) | {"batches": 64}
+    manifest.write_text(json.dumps(data))
+    before = sorted(p.name for p in (tmp_path / "o").rglob("*"))
+    code, _, err = run_cli(["study", path, "-o", tmp_path / "o", "--resume"], capsys)
+    assert code == 2 and err.count("\n") == 1, err
+    assert "cut into 64 batches, where this pin_susp cuts it into 2" in err
+    assert "cannot be resumed" in err
+    assert sorted(p.name for p in (tmp_path / "o").rglob("*")) == before
+
+
 def test_a_curve_target_extends_its_end_segments():
     from pin_susp.study import Term
 

@@ -83,6 +83,12 @@ def check_outdir(study: Study, outdir: Path, steps: bool, resume: bool) -> dict:
                 f"{outdir}: holds a run of this study made {how} --steps: run it {how} "
                 "--steps, or give a new or empty directory"
             )
+        if differs == ["batches"]:  # (16 batches since issue 30; 64 before)
+            raise PinSuspError(
+                f"{outdir}: holds a run of this study cut into {theirs.get('batches')} batches, "
+                f"where this pin_susp cuts it into {mine['batches']} (an earlier version's): "
+                "it cannot be resumed; give a new or empty directory"
+            )
         if differs:
             what = theirs.get("study", "another study")
             raise PinSuspError(
