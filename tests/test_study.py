@@ -578,17 +578,22 @@ def test_an_axle_objective_jacobian_is_exact_and_roll_sweeps_are_refused(tmp_pat
     assert code == 2 and "optimise: on an axle" in err
 
 
-def test_resume_finishes_a_run_cut_short_whatever_the_path_spelling(tmp_path, monkeypatch):
-    from pin_susp.study import finished_batches
-
-    path = write_study(tmp_path, LHS)  # 6 variants in 2 batches
+def cut_short(path, outdir) -> None:
+    """The study run into ``outdir`` and interrupted after its first batch."""
 
     def interrupt(done, total):
         if done == 1:
             raise KeyboardInterrupt
 
     with pytest.raises(KeyboardInterrupt):
-        run_study(load_study(path), tmp_path / "o", scheduler=None, progress=interrupt)
+        run_study(load_study(path), outdir, scheduler=None, progress=interrupt)
+
+
+def test_resume_finishes_a_run_cut_short_whatever_the_path_spelling(tmp_path, monkeypatch):
+    from pin_susp.study import finished_batches
+
+    path = write_study(tmp_path, LHS)  # 6 variants in 2 batches
+    cut_short(path, tmp_path / "o")
     assert finished_batches(tmp_path / "o") == 1
     assert not (tmp_path / "o" / "variants.parquet").exists()
     monkeypatch.chdir(tmp_path)  # the same file, typed relative to another folder
@@ -608,13 +613,7 @@ def test_a_run_cut_into_other_batches_is_not_resumed_and_says_why(tmp_path, caps
     from pin_susp.study import MANIFEST
 
     path = write_study(tmp_path, LHS)  # 6 variants in 2 batches
-
-    def interrupt(done, total):
-        if done == 1:
-            raise KeyboardInterrupt
-
-    with pytest.raises(KeyboardInterrupt):
-        run_study(load_study(path), tmp_path / "o", scheduler=None, progress=interrupt)
+    cut_short(path, tmp_path / "o")
     manifest = tmp_path / "o" / MANIFEST
     data = json.loads(manifest.read_text()) | {"batches": 64}
     manifest.write_text(json.dumps(data))
