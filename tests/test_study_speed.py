@@ -265,3 +265,28 @@ def test_failed_variants_are_flagged_as_when_marched(tmp_path, monkeypatch):
     a, b = fast[numbers].to_numpy(float), marched[numbers].to_numpy(float)
     assert np.array_equal(np.isnan(a), np.isnan(b))
     assert np.allclose(a, b, atol=1e-9, rtol=0.0, equal_nan=True)
+
+
+@pytest.mark.parametrize("column", ["spring_force", "wheel_rate", "solver_converged"])
+def test_a_summary_the_metric_functions_do_not_give_is_built_instead(tmp_path, monkeypatch, column):
+    """A summary column that is no metric function's (a rated spring's force and rate,
+    a solver's column): no variant measured together, every one built and swept, and
+    the rows its direct sweep gives."""
+    body = {
+        "variables": {"all_hardpoints": {"tolerance": 0.5}},
+        "kind": "monte_carlo",
+        "monte_carlo": {"samples": 3, "seed": 2},
+        "summary": ["camber", column],
+    }
+    study = load_study(write_study(tmp_path, body, "pushrod_rocker.yaml"))
+    together = counted(monkeypatch)
+    variants = run_study(study, tmp_path / "out", scheduler=None).variants
+    assert sum(k for _, k, how in together if how == "measured") == 0
+    assert variants["converged"].all()
+    row = variants.iloc[1]
+    steps, static = direct(study, row[study.names].to_numpy())
+    for m in ("camber", column):
+        values = steps[m].astype(float)
+        assert row[f"{m}_min"] == pytest.approx(values.min(), rel=1e-9, abs=1e-9), m
+        assert row[f"{m}_max"] == pytest.approx(values.max(), rel=1e-9, abs=1e-9), m
+        assert row[f"{m}_static"] == pytest.approx(float(static[m][0]), rel=1e-9, abs=1e-9)

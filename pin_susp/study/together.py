@@ -223,8 +223,11 @@ class Together:
     # ---------------------------------------------------------------- measuring
 
     def measure(self, table: np.ndarray) -> list:
-        """Per variant of the batch (its variables' rows) a Measured, or None."""
+        """Per variant of the batch (its variables' rows) a Measured, or None (every one
+        where the summary reads a column the metric functions do not give)."""
         out = [None] * len(table)
+        if not self.ok:
+            return out
         trees, which = [], []
         for i, deltas in enumerate(table):
             tree = self._tree(deltas)
@@ -328,6 +331,9 @@ class Together:
             if T is None:
                 return [None] * n
             columns = self._columns(tree, placed, T, E, J, every, design)
+        if any(m not in columns for m in self.job.summary):
+            self.ok = False  # (a spring's rates, a solver's column: built, every variant)
+            return [None] * n
         out = []
         for v in range(n):
             if not good[v]:
