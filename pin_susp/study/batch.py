@@ -1,5 +1,6 @@
-"""A batch of a study's variants solved together (docs/studies.md, Speed): every
-variant built, then every step of every variant whose subject solves so
+"""A batch of a study's variants solved together (docs/studies.md, Speed): a corner's
+variants measured together from their trees' numbers where they can be (together.py);
+every other variant built, then every step of every variant whose subject solves so
 (``solves_stacked``: a corner's) in one set of batched Newton iterations from the
 design variant's solutions (solve/stacked.py); each variant's results then follow from
 its own steps, and a variant whose steps did not all converge there is marched on its
@@ -30,29 +31,26 @@ def solve_batch(job: Job, table: np.ndarray, sweep, guess, every_column: bool) -
     return measured
 
 
-_TOGETHER: dict = {}  # id(job) → (job, its Together or None): the job's tasks' process's
+_TOGETHER: dict = {}
 
 
 def _together_of(job: Job, sweep, guess):
     """The job's Together (its design corner's structure, read once per process), or
     None where its variants cannot be measured so."""
     from .together import Together
-    from .variants import design_of
+    from .variants import design_of, per_job
 
-    kept = _TOGETHER.get(id(job))
-    if kept is None or kept[0] is not job:
-        design = design_of(job, sweep)
-        together = None
-        if design.subject is not None and design.subject.solves_stacked:
-            try:
-                together = Together(job, design.subject, sweep, guess)
-            except (PinSuspError, ArithmeticError, ValueError, np.linalg.LinAlgError):
-                together = None
-            together = together if together is not None and together.ok else None
-        if len(_TOGETHER) >= 4:
-            _TOGETHER.clear()
-        kept = _TOGETHER[id(job)] = (job, together)
-    return kept[1]
+    def make():
+        design = design_of(job, sweep).subject
+        if design is None or not design.solves_stacked:
+            return None
+        try:
+            together = Together(job, design, sweep, guess)
+        except (PinSuspError, ArithmeticError, ValueError, np.linalg.LinAlgError):
+            return None
+        return together if together.ok else None
+
+    return per_job(_TOGETHER, job, make)
 
 
 def _built(job: Job, table: np.ndarray, sweep, guess, every_column: bool) -> list:

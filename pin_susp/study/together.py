@@ -43,7 +43,7 @@ from ..solve.bulk import rows_of, solve_all
 from ..solve.linkage import twist
 from ..solve.stacked import Stack, StackedTree
 from ..solve.template import signature
-from .variants import variant_data
+from .variants import summary_figures, variant_data
 
 
 class Measured:
@@ -142,6 +142,11 @@ class Together:
                 for index, (row, _, _) in enumerate(rows.items)
                 if isinstance(vars(row).get("length"), float)
             ]
+        # the summary's columns must be the metric functions' (not a rated spring's,
+        # nor a solver's): seen on the design's own state
+        given = design.metric_columns(design.label_motion([design.q_design]), self.needs)
+        if any(m not in given for m in job.summary):
+            return
         self.ok = self._same(design, self.rows, self.drive) and self._probe()
 
     # ---------------------------------------------------------------- numbers
@@ -223,11 +228,8 @@ class Together:
     # ---------------------------------------------------------------- measuring
 
     def measure(self, table: np.ndarray) -> list:
-        """Per variant of the batch (its variables' rows) a Measured, or None (every one
-        where the summary reads a column the metric functions do not give)."""
+        """Per variant of the batch (its variables' rows) a Measured, or None."""
         out = [None] * len(table)
-        if not self.ok:
-            return out
         trees, which = [], []
         for i, deltas in enumerate(table):
             tree = self._tree(deltas)
@@ -331,9 +333,6 @@ class Together:
             if T is None:
                 return [None] * n
             columns = self._columns(tree, placed, T, E, J, every, design)
-        if any(m not in columns for m in self.job.summary):
-            self.ok = False  # (a spring's rates, a solver's column: built, every variant)
-            return [None] * n
         out = []
         for v in range(n):
             if not good[v]:
@@ -407,9 +406,5 @@ def _summary(summary: list, columns: dict) -> dict:
     then its steps, every one converged)."""
     row = {}
     for m in summary:
-        values = columns[m][1:]
-        finite = values[np.isfinite(values)]
-        row[f"{m}_static"] = float(columns[m][0])
-        row[f"{m}_min"] = float(finite.min()) if finite.size else math.nan
-        row[f"{m}_max"] = float(finite.max()) if finite.size else math.nan
+        row |= summary_figures(m, float(columns[m][0]), columns[m][1:])
     return row

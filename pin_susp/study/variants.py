@@ -178,10 +178,7 @@ class Variant:
             else:
                 static = float(self.static[m][0])
                 values = np.where(self.results["solver_converged"], self.results[m], np.nan)
-            finite = values[np.isfinite(values)]
-            row[f"{m}_static"] = static
-            row[f"{m}_min"] = float(finite.min()) if finite.size else math.nan
-            row[f"{m}_max"] = float(finite.max()) if finite.size else math.nan
+            row |= summary_figures(m, static, values)
         return row
 
     def residuals(self) -> np.ndarray:
@@ -192,16 +189,32 @@ class Variant:
         return objective_residuals(self.job.terms, self.results, self.static)
 
 
-_DESIGNS: dict = {}  # id(job) → (job, its design Variant), this process's
+def summary_figures(m: str, static: float, values: np.ndarray) -> dict:
+    """A summary column's figures: its value at design, its least and greatest over
+    the steps (``values``: NaN where a step did not converge or the column is blank)."""
+    finite = values[np.isfinite(values)]
+    return {
+        f"{m}_static": static,
+        f"{m}_min": float(finite.min()) if finite.size else math.nan,
+        f"{m}_max": float(finite.max()) if finite.size else math.nan,
+    }
+
+
+def per_job(cache: dict, job: Job, make):
+    """``make()`` for a job, made once per process that runs the job's tasks (``cache``:
+    id(job) → (job, what was made); a few jobs kept)."""
+    kept = cache.get(id(job))
+    if kept is None or kept[0] is not job:
+        if len(cache) >= 4:
+            cache.clear()
+        kept = cache[id(job)] = (job, make())
+    return kept[1]
+
+
+_DESIGNS: dict = {}
 
 
 def design_of(job: Job, sweep) -> Variant:
     """The job's design variant (every variable 0), solved through the sweep: built
     once per process that runs the job's tasks."""
-    kept = _DESIGNS.get(id(job))
-    if kept is None or kept[0] is not job:
-        if len(_DESIGNS) >= 4:
-            _DESIGNS.clear()
-        design = Variant(job, np.zeros(len(job.variables)), sweep, every_column=False)
-        kept = _DESIGNS[id(job)] = (job, design)
-    return kept[1]
+    return per_job(_DESIGNS, job, lambda: Variant(job, np.zeros(len(job.variables)), sweep, False))
