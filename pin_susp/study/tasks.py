@@ -88,11 +88,8 @@ def run_start(job: Job, index: int, ids: np.ndarray, table: np.ndarray, steps: b
 def guess_of(job: Job, sweep) -> np.ndarray | None:
     """The design variant's configuration at every step (None if some step failed):
     every variant's steps solved at once from it (Variant's ``guess``); worked out once
-    per process that runs the job's tasks (kept on the job)."""
-    key = "_guess"
-    if key not in job.__dict__:
-        job.__dict__[key] = design_of(job, sweep).solved
-    return job.__dict__[key]
+    per process that runs the job's tasks (variants.design_of)."""
+    return design_of(job, sweep).solved
 
 
 def _row(job: Job, vid: int, deltas, v: Variant) -> dict:
