@@ -352,8 +352,5 @@ def _along(t) -> str:
 
 def sweep_clearance(model, sweep, results, bodies=()) -> ClearanceRun:
     """The clearance of a subject's solved sweep (``results``: its run_sweep)."""
-    qs = [
-        q if ok else None
-        for q, ok in zip(results.meta["q"], results["solver_converged"], strict=True)
-    ]
+    qs = results.solved_configurations
     return ClearanceRun(Clearance(model, bodies), qs, sweep)

@@ -328,6 +328,13 @@ class Results:
     def failed_steps(self) -> np.ndarray:
         return np.flatnonzero(~self.columns["solver_converged"])
 
+    @property
+    def solved_configurations(self) -> list:
+        """Each step's configuration q, None where the step did not converge (no
+        trustworthy pose: what the replays, the clearance and the envelope skip)."""
+        converged = self.columns["solver_converged"]
+        return [q if ok else None for q, ok in zip(self.meta["q"], converged, strict=True)]
+
     def to_pandas(self):
         """The columns as a pandas DataFrame, one row per step, in the CSV's order and
         with its values; the units (mm, deg, ...) in ``.attrs["units"]``; an undefined

@@ -47,10 +47,7 @@ def clearance_replay(model, results, measured, bodies, fps: float = 10.0) -> str
 
     from ..analyses.clearance_shapes import Poses
 
-    qs = [
-        q if ok else None
-        for q, ok in zip(results.meta["q"], results["solver_converged"], strict=True)
-    ]
+    qs = results.solved_configurations
     quiet = io.StringIO()
     with contextlib.redirect_stdout(quiet):  # meshcat announces its server on stdout
         scene = Scene(model)

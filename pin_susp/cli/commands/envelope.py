@@ -36,10 +36,7 @@ def run(args) -> int:
     sweep = load_sweep(args.sweep)
     subject.check_sweep(sweep)
     results = subject.run_sweep(sweep, progress=progress_bar(sweep.steps, args.quiet))
-    qs = [
-        q if ok else None
-        for q, ok in zip(results.meta["q"], results["solver_converged"], strict=True)
-    ]
+    qs = results.solved_configurations
     if not any(q is not None for q in qs):
         report_failures(results, "are left out")
         raise PinSuspError(f"{args.sweep}: no step converged: no envelope written")

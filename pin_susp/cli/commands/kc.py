@@ -116,10 +116,7 @@ def _replay(subject, kc, table, results, case: str, cases_path) -> tuple[str, in
     from ...viz.kc_colours import kc_replay
     from ...viz.scene import Scene
 
-    qs = [
-        q if ok else None
-        for q, ok in zip(results.meta["q"], results["solver_converged"], strict=True)
-    ]
+    qs = results.solved_configurations
     with contextlib.redirect_stdout(io.StringIO()):  # meshcat announces its server
         scene = Scene(subject)
     try:

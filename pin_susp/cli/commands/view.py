@@ -75,10 +75,7 @@ def run(args) -> int:
         results = model.run_sweep(sweep, progress=progress)
         warn_transmission(results)  # each corner's rocker and spring, as sweep warns
     if results is not None:
-        qs = [
-            q if ok else None
-            for q, ok in zip(results.meta["q"], results["solver_converged"], strict=True)
-        ]
+        qs = results.solved_configurations
     quiet = io.StringIO()
     with contextlib.redirect_stdout(quiet):  # meshcat announces its server on stdout
         scene = Scene(model)
