@@ -273,12 +273,12 @@ def test_unsupported_image_name(tmp_path, name, message):
 def test_image_endings_are_matplotlibs_and_case_insensitive(tmp_path):
     from matplotlib.backend_bases import FigureCanvasBase
 
+    from pin_susp.viz.drawing import drawing_figure
+
     for ext in ("png", "PNG", "Pdf", "svg", "jpeg"):
         check_image_path(f"out.{ext}")
     assert "png" in FigureCanvasBase.get_supported_filetypes()
-    drawing = pin_susp.viz.drawing.drawing_figure(
-        pin_susp.Corner(EXAMPLES / "double_wishbone.yaml")
-    )
+    drawing = drawing_figure(pin_susp.Corner(EXAMPLES / "double_wishbone.yaml"))
     save_figure(drawing, tmp_path / "d.PNG")
     assert (tmp_path / "d.PNG").read_bytes()[:4] == b"\x89PNG"
 
