@@ -38,8 +38,10 @@ def write_study(
 
 def counted(monkeypatch) -> list:
     """(variants offered, variants solved, how) of each batch solved together: "measured"
-    from their trees' numbers (together.py), or "built" and then solved together (batch.py:
-    the rest of a batch, offered after the measured)."""
+    from their trees' numbers (together.py), each variant's geometry the design's with
+    its own hardpoints (geometry.with_points; "measured, geometry read whole" where its
+    data was parsed whole), or "built" and then solved together (batch.py: the rest of
+    a batch, offered after the measured)."""
     out = []
     together, measure = batch._together, Together.measure
 
@@ -50,7 +52,8 @@ def counted(monkeypatch) -> list:
 
     def measuring(self, table):
         measured = measure(self, table)
-        out.append((len(table), sum(m is not None for m in measured), "measured"))
+        how = "measured" if self.points is not None else "measured, geometry read whole"
+        out.append((len(table), sum(m is not None for m in measured), how))
         return measured
 
     monkeypatch.setattr(batch, "_together", counting)
@@ -259,6 +262,38 @@ def test_failed_variants_are_flagged_as_when_marched(tmp_path, monkeypatch):
     monkeypatch.setattr(tasks, "guess_of", lambda job, sweep: None)
     marched = run_study(study, tmp_path / "marched", scheduler=None).variants
     assert (~fast["converged"]).sum() >= 2 and (fast["steps_failed"] < 21).all()
+    for c in ("variant_id", "converged", "steps_failed", "error"):
+        assert (fast[c] == marched[c]).all(), c
+    numbers = [c for c in fast.columns if c.endswith(("_static", "_min", "_max"))]
+    a, b = fast[numbers].to_numpy(float), marched[numbers].to_numpy(float)
+    assert np.array_equal(np.isnan(a), np.isnan(b))
+    assert np.allclose(a, b, atol=1e-9, rtol=0.0, equal_nan=True)
+
+
+def test_variants_their_geometry_refuses_are_refused_as_when_built(tmp_path, monkeypatch):
+    """A DOE whose box puts some variants' points where a file's would be refused (the
+    trackrod's outer end across the centreline or on the steering axis, the lower ball
+    joint on the arm's pivot axis): measured together, each variant's hardpoints checked
+    as a file's are, the rows — converged, error, summaries — those of every variant
+    built and marched on its own."""
+    body = {
+        "variables": [
+            {"point": "trackrod_outboard", "axis": "y", "range": [-1000, 0]},
+            {"point": "lower_wishbone_outboard", "axis": "y", "range": [-500, 0]},
+        ],
+        "kind": "doe",
+        "doe": {"method": "full_factorial", "levels": 6},
+        "summary": ["camber", "roadwheel_angle"],
+    }
+    study = load_study(write_study(tmp_path, body, "double_wishbone.yaml"))
+    together = counted(monkeypatch)
+    fast = run_study(study, tmp_path / "fast", scheduler=None).variants
+    assert sum(k for _, k, how in together if how == "measured") > 0
+    monkeypatch.undo()
+    monkeypatch.setattr(tasks, "guess_of", lambda job, sweep: None)
+    marched = run_study(study, tmp_path / "marched", scheduler=None).variants
+    refused = marched["error"].str.contains("hardpoints.")
+    assert refused.sum() >= 3 and marched["converged"][~refused].sum() >= 3
     for c in ("variant_id", "converged", "steps_failed", "error"):
         assert (fast[c] == marched[c]).all(), c
     numbers = [c for c in fast.columns if c.endswith(("_static", "_min", "_max"))]

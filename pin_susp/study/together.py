@@ -34,15 +34,16 @@ import numpy as np
 from ..columns.metrics import metric_columns
 from ..constraints.branch import MEASURES_MANY, LoopBranch
 from ..errors import PinSuspError
-from ..io.yamlio import Reader
+from ..io.yamlio import MAX_LENGTH_MM, Reader
 from ..maths.jet import Dual, cross
-from ..model.geometry import parse_geometry, unit
+from ..model.geometry import parse_geometry, unit, with_points
 from ..model.tree import joint_steps
 from ..model.wheel import contact_patch
 from ..solve.bulk import rows_of, solve_all
 from ..solve.linkage import twist
 from ..solve.stacked import Stack, StackedTree
 from ..solve.template import signature
+from .data import AXES
 from .variants import summary_figures, variant_data
 
 
@@ -83,6 +84,7 @@ class Together:
 
     def __init__(self, job, design, sweep, guess: np.ndarray):
         self.ok = False
+        self.points = None  # the design's hardpoints (mm) where a variant's are its own (_own)
         self.job, self.design, self.sweep, self.guess = job, design, sweep, guess
         self.needs = set(job.needs)
         g = design.geometry
@@ -148,6 +150,8 @@ class Together:
         if any(m not in given for m in job.summary):
             return
         self.ok = self._same(design, self.rows, self.drive) and self._probe()
+        if self.ok:
+            self.points = self._own_points()
 
     # ---------------------------------------------------------------- numbers
 
@@ -256,13 +260,59 @@ class Together:
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                data = variant_data(self.job.geometry, self.job.variables, deltas)
-                g = parse_geometry(data, Reader("<dict>"), None)
-                if g.needs_setup:
-                    return None
-                return g.mechanism.tree(g)
+                g = self._geometry(deltas)
+                return None if g is None else g.mechanism.tree(g)
         except (PinSuspError, ArithmeticError, ValueError, np.linalg.LinAlgError):
             return None
+
+    def _geometry(self, deltas):
+        """A variant's Geometry: the design's with its own hardpoints, checked as a file's
+        are (geometry.with_points), where its variables are the file's own points
+        (``points``); else its geometry data read whole. None where it needs a setup
+        solve."""
+        if self.points is not None:
+            points = self.points | {name: self.points[name].copy() for name in self.varied}
+            for (name, i), d in zip(self.slots, deltas, strict=True):
+                if d != 0.0:  # (as variant_data: the file's number plus the delta)
+                    points[name][i] += float(d)
+                    if not abs(points[name][i]) <= MAX_LENGTH_MM:
+                        return None  # (its own build says why)
+            return with_points(self.design.geometry, points, Reader("<dict>"))
+        data = variant_data(self.job.geometry, self.job.variables, deltas)
+        g = parse_geometry(data, Reader("<dict>"), None)
+        return None if g.needs_setup else g
+
+    def _own_points(self) -> dict | None:
+        """The design's hardpoints (mm) as its canonical data gives them, where every
+        variable is a coordinate of one of them that the file gives as is (so that a
+        variant's hardpoints are these with its deltas: variant_data's numbers; another
+        unit or form of the file's differs here or in the probe) and the probe variant's
+        tree numbers come out the same either way; else None."""
+        g, r = self.design.geometry, Reader("<dict>")
+        canonical, given = g.data.get("hardpoints", {}), self.job.geometry.get("hardpoints", {})
+        if not isinstance(given, dict):
+            return None
+        points = {name: r.point(canonical[name], name) for name in g.hardpoints}
+        for v in self.job.variables:
+            if v.side or v.point not in points or v.point not in given:
+                return None
+            if not np.array_equal(r.point(given[v.point], v.point), points[v.point]):
+                return None
+        self.slots = [(v.point, AXES.index(v.axis)) for v in self.job.variables]
+        self.varied, self.points = {v.point for v in self.job.variables}, points
+        deltas = np.full(len(self.job.variables), 1e-3)
+        fast = self._numbers_of(deltas)
+        self.points = None
+        whole = self._numbers_of(deltas)
+        if fast is None or whole is None:
+            return None
+        if not all(np.array_equal(a, b) for a, b in zip(fast, whole, strict=True)):
+            return None
+        return points
+
+    def _numbers_of(self, deltas):
+        tree = self._tree(deltas)
+        return None if tree is None else self.numbers(tree)
 
     def _branches(self, E: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Which variants tell each loop's branches apart at design by the design's own
