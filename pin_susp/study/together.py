@@ -261,7 +261,7 @@ class Together:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 g = self._geometry(deltas)
-                return None if g is None else g.mechanism.tree(g)
+                return None if g is None else g.mechanism.tree(g, shapes=False)
         except (PinSuspError, ArithmeticError, ValueError, np.linalg.LinAlgError):
             return None
 

@@ -18,7 +18,8 @@ Each module has:
 - ``prepare(p, o, r)``: check the points (one clear error each), then ``settle``;
 - ``settle(p)``: hardpoints that others place (the MacPherson clamp on its
   strut line); runs on jet.Duals too;
-- ``tree(g)``: bodies, joints, points, closures, visuals (a tree.Tree), and
+- ``tree(g, shapes=True)``: bodies, joints, points, closures, visuals (none
+  without ``shapes``: a study's variant, never drawn) (a tree.Tree), and
   what robotics tools read beside them (``robot(g)`` below);
 - ``kingpin(ps)``: (lower, upper) points of the steering axis, or None;
 - ``instant_planes(ps)``: two planes (normal, point) whose line is the instant

@@ -164,8 +164,9 @@ def off_axis(p, point: str, a: str, b: str, r, problem: str) -> None:
         r.fail(f"hardpoints.{point}", problem)
 
 
-def tree(g) -> Tree:
-    """Bodies, joints, points and closures of one corner at its design state."""
+def tree(g, shapes: bool = True) -> Tree:
+    """Bodies, joints, points and closures of one corner at its design state (its
+    drawn shapes too with ``shapes``)."""
     p = g.design_points()
     inner, outer = g.steering_points
 
@@ -259,7 +260,7 @@ def tree(g) -> Tree:
         bodies=bodies,
         points=points,
         closures=closures,
-        visuals=_visuals(g, p, body_of),
+        visuals=_visuals(g, p, body_of) if shapes else [],
         materials=MATERIALS,
         **robot(g),
     )

@@ -122,7 +122,7 @@ def settle(p: dict) -> dict:
     }
 
 
-def tree(g) -> Tree:
+def tree(g, shapes: bool = True) -> Tree:
     p = g.design_points()
     inner, outer = g.steering_points
     axis = unit(p[TOP] - p[LBJ])
@@ -186,7 +186,7 @@ def tree(g) -> Tree:
         bodies=bodies,
         points=points,
         closures=closures,
-        visuals=visuals(g, p, body_of, rods, {"lower_wishbone": "wishbone"}),
+        visuals=visuals(g, p, body_of, rods, {"lower_wishbone": "wishbone"}) if shapes else [],
         materials=MATERIALS,
         **robot(g),
     )

@@ -129,7 +129,7 @@ def _plucker(p, members) -> np.ndarray:
     return np.array(rows)
 
 
-def tree(g) -> Tree:
+def tree(g, shapes: bool = True) -> Tree:
     p = g.design_points()
     inner, outer = g.steering_points
     t_in, t_out = ends(TREE_LINK)
@@ -196,7 +196,7 @@ def tree(g) -> Tree:
         bodies=bodies,
         points=points,
         closures=closures,
-        visuals=visuals(g, p, body_of, rods, {TREE_LINK: "wishbone"}),
+        visuals=visuals(g, p, body_of, rods, {TREE_LINK: "wishbone"}) if shapes else [],
         materials=MATERIALS,
         **robot(g),
     )

@@ -74,7 +74,7 @@ def prepare(p: dict[str, np.ndarray], o, r) -> None:
         off_axis(p, point, *PIVOT, r, f"lies on the arm's pivot axis ({PIVOT[0]}→{PIVOT[1]})")
 
 
-def tree(g) -> Tree:
+def tree(g, shapes: bool = True) -> Tree:
     p = g.design_points()
     bodies = [Body("chassis"), Body("trailing_arm", "chassis", pivot("arm_pivot", *PIVOT, p))]
     body_of = dict.fromkeys(PIVOT, "chassis") | dict.fromkeys(AXLE_POINTS, "trailing_arm")
@@ -102,7 +102,7 @@ def tree(g) -> Tree:
         bodies=bodies,
         points=points,
         closures=[],
-        visuals=visuals(g, p, body_of, rods, {"trailing_arm": "wishbone"}),
+        visuals=visuals(g, p, body_of, rods, {"trailing_arm": "wishbone"}) if shapes else [],
         materials=MATERIALS,
         **robot(g),
     )
