@@ -74,6 +74,17 @@ def direct(study, deltas) -> tuple:
         )
 
 
+def same_rows(fast, marched) -> None:
+    """Two runs' variants: the same converged, steps failed and error, each summary to
+    1e-9 (blank where the other's is)."""
+    for c in ("variant_id", "converged", "steps_failed", "error"):
+        assert (fast[c] == marched[c]).all(), c
+    numbers = [c for c in fast.columns if c.endswith(("_static", "_min", "_max"))]
+    a, b = fast[numbers].to_numpy(float), marched[numbers].to_numpy(float)
+    assert np.array_equal(np.isnan(a), np.isnan(b))
+    assert np.allclose(a, b, atol=1e-9, rtol=0.0, equal_nan=True)
+
+
 def tolerances(tmp_path, geometry: str, tolerance: float, samples: int, sweep: Path = BUMP):
     body = {
         "variables": {"all_hardpoints": {"tolerance": tolerance}},
@@ -262,12 +273,7 @@ def test_failed_variants_are_flagged_as_when_marched(tmp_path, monkeypatch):
     monkeypatch.setattr(tasks, "guess_of", lambda job, sweep: None)
     marched = run_study(study, tmp_path / "marched", scheduler=None).variants
     assert (~fast["converged"]).sum() >= 2 and (fast["steps_failed"] < 21).all()
-    for c in ("variant_id", "converged", "steps_failed", "error"):
-        assert (fast[c] == marched[c]).all(), c
-    numbers = [c for c in fast.columns if c.endswith(("_static", "_min", "_max"))]
-    a, b = fast[numbers].to_numpy(float), marched[numbers].to_numpy(float)
-    assert np.array_equal(np.isnan(a), np.isnan(b))
-    assert np.allclose(a, b, atol=1e-9, rtol=0.0, equal_nan=True)
+    same_rows(fast, marched)
 
 
 def test_variants_their_geometry_refuses_are_refused_as_when_built(tmp_path, monkeypatch):
@@ -294,12 +300,7 @@ def test_variants_their_geometry_refuses_are_refused_as_when_built(tmp_path, mon
     marched = run_study(study, tmp_path / "marched", scheduler=None).variants
     refused = marched["error"].str.contains("hardpoints.")
     assert refused.sum() >= 3 and marched["converged"][~refused].sum() >= 3
-    for c in ("variant_id", "converged", "steps_failed", "error"):
-        assert (fast[c] == marched[c]).all(), c
-    numbers = [c for c in fast.columns if c.endswith(("_static", "_min", "_max"))]
-    a, b = fast[numbers].to_numpy(float), marched[numbers].to_numpy(float)
-    assert np.array_equal(np.isnan(a), np.isnan(b))
-    assert np.allclose(a, b, atol=1e-9, rtol=0.0, equal_nan=True)
+    same_rows(fast, marched)
 
 
 @pytest.mark.parametrize("column", ["spring_force", "wheel_rate", "solver_converged"])
