@@ -4,10 +4,11 @@ The file format is documented in ``docs/geometry.md`` (it is the one of
 open-kinematics 0.4). Lengths arrive in mm and leave this module in metres;
 nothing after it converts units.
 
-Why one module of ~700 lines: the reader checks each key as the Geometry's field
-it fills, and the derived points (wheel, contact patch, the kingpin's ends) are
-computed as the file is read; the checks, the dataclass and the formulas change
-together when the file format does.
+The reader checks each key as the Geometry's field it fills, and the derived points
+(wheel, contact patch, the kingpin's ends) are computed as the file is read; the
+checks, the dataclass and the formulas change together when the file format does.
+The checks that the hardpoints' positions decide are hardpoint_checks.py's (a study's
+variant is checked by them alone).
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from ..errors import PlausibilityWarning
 from ..io.yamlio import MAX_LENGTH_MM, Reader, load_yaml
 from ..maths.vectors import COINCIDENT, direction, unit
 from . import packaging
+from .hardpoint_checks import check_points
 from .packaging import Driveshaft, Limits
 from .units import INCH as INCH
 from .units import MM as MM
@@ -382,7 +384,7 @@ def parse_geometry(data: dict, r: Reader, sha: str | None) -> Geometry:
             r.fail(f"hardpoints.{key}", "missing point")
         hardpoints[key] = r.point(hp_map[key], f"hardpoints.{key}") * MM
 
-    _check_points(hardpoints, options, r)
+    check_points(hardpoints, options, r)
     compliance.read_compliance(data["compliance"], r, names) if "compliance" in data else None
     driveshaft = packaging.read_driveshaft(config, hardpoints, side, r)
     adjusters = _setup_block(config.get("setup", {}), actuation, mech.steering_points(options), r)
@@ -436,55 +438,6 @@ def parse_geometry(data: dict, r: Reader, sha: str | None) -> Geometry:
         sha256=sha,
         data=data,
     )
-
-
-def _check_points(hardpoints: dict, o: Options, r: Reader) -> None:
-    """parse_geometry's checks of a corner's hardpoints (m) that their positions decide
-    (the mechanism's ``prepare`` may settle some of them in place)."""
-    from . import mechanisms
-
-    mech, side = mechanisms.get(o.type), o.side
-    sign = 1.0 if side == "left" else -1.0
-    # Chassis pickups may cross the centreline (cross-car dampers, rockers, bars);
-    # what rides with the wheel must be on the wheel's side.
-    for key in mech.wheel_side_points(o):
-        p = hardpoints[key]
-        if sign * p[1] < 0.0:
-            want = "y >= 0" if side == "left" else "y <= 0"
-            r.fail(
-                f"hardpoints.{key}",
-                f"y = {p[1] / MM:g} mm on a {side} corner (the points that ride with the "
-                f"wheel have {want}; check 'side' or the sign of y)",
-            )
-    if np.linalg.norm(hardpoints["axle_outboard"] - hardpoints["axle_inboard"]) < COINCIDENT:
-        r.fail(
-            "hardpoints.axle_outboard",
-            "coincides with axle_inboard: the spin axis needs two distinct points",
-        )
-    spin = unit(hardpoints["axle_outboard"] - hardpoints["axle_inboard"])
-    if sign * spin[1] <= 0.0:
-        r.fail(
-            "hardpoints.axle_outboard",
-            "the spin axis axle_inboard→axle_outboard points inboard or straight up/down: "
-            f"axle_outboard must be outboard (toward {'+' if sign > 0 else '-'}y) of axle_inboard",
-        )
-    mech.prepare(hardpoints, o, r)
-
-
-def with_points(g: Geometry, points_mm: dict[str, np.ndarray], r: Reader) -> Geometry:
-    """``g`` with other hardpoints: ``points_mm`` each of its hardpoints (mm, as its file
-    gives them once in canonical form, before the mechanism settles any), checked as
-    parse_geometry checks them (through ``r``); the rest of ``g`` unchanged (a study's
-    variant, docs/studies.md Speed). ``g.data`` stays the design's."""
-    from dataclasses import replace
-
-    hardpoints = {name: points_mm[name] * MM for name in g.hardpoints}
-    o = Options(g.type, g.side, g.steering, g.actuation, g.actuation_mount, g.spring)
-    _check_points(hardpoints, o, r)
-    config = g.data["config"]
-    driveshaft = packaging.read_driveshaft(config, hardpoints, g.side, r)
-    limits = packaging.read_limits(config, hardpoints, r)
-    return replace(g, hardpoints=hardpoints, driveshaft=driveshaft, limits=limits)
 
 
 # beyond these a value is a unit slip, not a part: kg/m³ (osmium is 22 590), kg

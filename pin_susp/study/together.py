@@ -36,7 +36,8 @@ from ..constraints.branch import MEASURES_MANY, LoopBranch
 from ..errors import PinSuspError
 from ..io.yamlio import MAX_LENGTH_MM, Reader
 from ..maths.jet import Dual, cross
-from ..model.geometry import parse_geometry, unit, with_points
+from ..model.geometry import parse_geometry, unit
+from ..model.hardpoint_checks import with_points
 from ..model.tree import joint_steps
 from ..model.wheel import contact_patch
 from ..solve.bulk import rows_of, solve_all
