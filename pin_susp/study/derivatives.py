@@ -90,7 +90,8 @@ def linear_prediction(study: Study, variants) -> dict[str, np.ndarray] | None:
     sensitivities at design and at every step (no re-solve): name → values per
     variant, for ``<metric>_static``, ``_min`` and ``_max`` — the steps' only where the
     sweep holds what the sensitivities hold (``Assembly.sensitivities_hold``: an axle's
-    roll or heave sweep, the static column alone)."""
+    roll or heave sweep, the static column alone); None for a vehicle (its design
+    state is its body's on the road, held otherwise than its sensitivities are)."""
     from ..model.sweep import load_sweep
 
     job = study.job()
@@ -98,6 +99,8 @@ def linear_prediction(study: Study, variants) -> dict[str, np.ndarray] | None:
     design = Variant(job, np.zeros(len(study.variables)), sweep, every_column=True)
     if design.results is None or not design.converged:
         return None
+    if design.subject.on_road:  # a vehicle's design state holds its body on the road, not
+        return None  # each wheel centre's height in the chassis: no prediction of it
     at_design, steps = sensitivities(design.subject, sweep, design.results, set(study.summary))
     columns = _columns(at_design.hardpoints, study.variables)
     d = variants[study.names].to_numpy(dtype=float)

@@ -212,6 +212,8 @@ def assemble(study: Study, outdir: Path, parts: Path, n: int, steps: bool, have=
             ) from None
     variants = pa.concat_tables(tables, promote_options="permissive").sort_by("variant_id")
     units = {v.name: "mm" for v in study.variables}
+    for m, unit in study.column_units.items():
+        units |= {f"{m}_{figure}": unit for figure in ("static", "min", "max") if unit}
     meta = {
         "units": json.dumps(units),
         "pin_susp": __version__,

@@ -84,14 +84,19 @@ def _heading(study, variants) -> str:
 # ------------------------------------------------------------------- names
 
 
+CORNERS = {"_left": "left", "_right": "right", "_fl": "front left", "_fr": "front right"}
+CORNERS |= {"_rl": "rear left", "_rr": "rear right"}
+
+
 def describe(column: str) -> tuple[str, str]:
     """A column's label and unit: from the metric registry (derivatives: the metric's
-    unit per mm), a point's coordinate in mm, an axle's ``_left``/``_right`` as its
-    corner's column; else the name and no unit."""
+    unit per mm), a point's coordinate in mm, an axle's ``_left``/``_right`` and a
+    vehicle's ``_fl`` ... ``_rr`` as its corner's column; else the name and no unit."""
     name, side = column, ""
-    for s in ("_left", "_right"):
+    for s, corner in CORNERS.items():
         if column.endswith(s):
-            name, side = column.removesuffix(s), f" ({s[1:]})"
+            name, side = column.removesuffix(s), f" ({corner})"
+            break
     if name in METRIC_BY_NAME:
         m = METRIC_BY_NAME[name]
         return m.label + side, m.unit
@@ -152,10 +157,12 @@ def _summary_columns(study, variants) -> list[list[str]]:
     return rows
 
 
-def _column_texts(column: str) -> tuple[str, str, str]:
-    """Title (column [unit]), axis label (label, what the column is [unit]), unit."""
+def _column_texts(column: str, units: dict) -> tuple[str, str, str]:
+    """Title (column [unit]), axis label (label, what the column is [unit]), unit: the
+    study's own (``units``: Study.column_units) where it has one."""
     metric, _, stat = column.rpartition("_")
     label, unit = describe(metric)
+    unit = units.get(metric, unit)
     what = dict(STATS).get(stat, stat)
     return _with_unit(column, unit), _with_unit(f"{label}, {what}", unit), unit
 
@@ -276,7 +283,7 @@ def _histograms(study, variants, linear, heading: str) -> Figure:
     gaussian = study.distribution == "normal"
     for ax, column in zip(axes, columns, strict=True):
         predicted = None if linear is None else linear.get(column)
-        _histogram(ax, column, variants[column], predicted, gaussian)
+        _histogram(ax, column, variants[column], predicted, gaussian, study.column_units)
     # the legend's keys as drawn in a histogram (a panel of one value draws lines)
     drawn = {name for ax in axes for name in ax.get_legend_handles_labels()[1]}
     keys = {
@@ -310,8 +317,8 @@ def _flat(x: np.ndarray, scale: float) -> bool:
     return not float(np.ptp(x)) > 1e-9 * max(1.0, scale)
 
 
-def _histogram(ax, column: str, values, predicted, gaussian: bool) -> None:
-    title, xlabel, unit = _column_texts(column)
+def _histogram(ax, column: str, values, predicted, gaussian: bool, units: dict) -> None:
+    title, xlabel, unit = _column_texts(column, units)
     _title(ax, title)
     ax.set_xlabel(xlabel, fontsize=8)
     ax.set_ylabel(_with_unit("density", f"1/{unit}" if unit else ""), fontsize=8)
@@ -401,7 +408,8 @@ def _main_effects(study, variants, heading: str) -> Figure:
     axes, columns = _layout(fig, rows)
     colours = {name: f"C{k}" for k, name in enumerate(names)} if shared else None
     for ax, column in zip(axes, columns, strict=True):
-        _effects_panel(ax, column, main_effects(study, variants, column), len(names), colours)
+        effects = main_effects(study, variants, column)
+        _effects_panel(ax, column, effects, len(names), colours, study.column_units)
     if shared:
         handles = {}
         for ax in axes:
@@ -439,10 +447,12 @@ def effect_sizes(effects: dict[str, tuple]) -> dict[str, float]:
     return dict(sorted(out.items(), key=lambda kv: -kv[1] if np.isfinite(kv[1]) else np.inf))
 
 
-def _effects_panel(ax, column: str, effects: dict, count: int, colours: dict | None) -> None:
+def _effects_panel(
+    ax, column: str, effects: dict, count: int, colours: dict | None, units: dict
+) -> None:
     """The main effects on one column: a line per variable (``colours``: a colour each,
     the figure's legend) or, of many, the TOP largest (ranked colours, a legend here)."""
-    title, _, unit = _column_texts(column)
+    title, _, unit = _column_texts(column, units)
     sizes = effect_sizes(effects)
     drawn = [k for k in sizes if np.isfinite(sizes[k])]
     if colours is None:

@@ -68,6 +68,9 @@ class Study:
     max_evaluations: int = 60
     geometry_sha256: str | None = None  # of the files as read
     sweep_sha256: str | None = None
+    # each summary column's unit, as the design's sweep gives it ("deg/deg": per degree
+    # of roll); variants.parquet's units and study.png's labels
+    column_units: dict[str, str] = field(default_factory=dict)
 
     @property
     def names(self) -> list[str]:
@@ -180,6 +183,13 @@ def _load_study(source: str | Path) -> Study:
         study.seed = _seed(b, "optimise", r)
         study.max_evaluations = _count(b.get("evaluations", 60), "optimise.evaluations", r)
         study.terms = _terms(b["objective"], design, r)
+        if design.subject.on_road:
+            r.fail(
+                "optimise",
+                "a vehicle's sweep holds its body on the road, and the optimiser's exact "
+                "Jacobian holds each wheel centre's height in the chassis: optimise one of "
+                "its axle files (kind doe or monte_carlo take the vehicle)",
+            )
         if not design.subject.sensitivities_hold(design.sweep):
             r.fail(
                 "optimise",
@@ -192,6 +202,7 @@ def _load_study(source: str | Path) -> Study:
     for i, m in enumerate(summary):
         design.check_column(r.text(m, f"summary[{i}]"), f"summary[{i}]", r)
     study.summary = list(dict.fromkeys(summary))
+    study.column_units = {m: design.results.units.get(m, "") for m in study.summary}
     if "conventions" in data:  # one name: the convention of variants.parquet, steps.parquet
         from ..io.conventions import CONVENTIONS
 
@@ -242,6 +253,7 @@ class _Design:
         # the labels a variable's side names (none on a corner)
         self.points = {label or None: list(g.hardpoints) for label, g in subject.corners.items()}
         self.sides = tuple(label for label in subject.labels if label)
+        self.noun = "a vehicle" if subject.on_road else "an axle"  # (with sides)
         self.columns = [c for c in self.results.columns if c != "step_index"]
 
     def factor(self, column: str) -> float:
@@ -292,10 +304,17 @@ def _variables(data: dict, design: _Design, r: Reader) -> list[Variable]:
         side = None
         if design.sides:
             if "side" not in v:
-                r.fail(f"{key}.side", "missing key: on an axle each variable names its side")
+                r.fail(
+                    f"{key}.side",
+                    f"missing key: on {design.noun} each variable names its corner "
+                    f"({', '.join(design.sides)})",
+                )
             side = r.choice(v["side"], f"{key}.side", design.sides)
         elif "side" in v:
-            r.fail(f"{key}.side", "a corner has one side: side is for an axle's variables")
+            r.fail(
+                f"{key}.side",
+                "a corner has one side: side is for an axle's or a vehicle's variables",
+            )
         point = r.text(v["point"], f"{key}.point")
         names = design.points[side]
         if point not in names:

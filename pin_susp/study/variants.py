@@ -62,12 +62,12 @@ def variant_data(base: dict, variables: list[Variable], deltas, axle=None) -> di
     """The geometry file's data with each variable's delta (mm) added to its point (its
     corner's by the variable's side: every corner's points its own, an axle's mirrored
     right side written out; subject.kind_of). ``axle``: unused, the kind is the data's."""
-    data = kind_of(base).variant_data(base)
+    kind = kind_of(base)
+    data = kind.variant_data(base)
     for v, d in zip(variables, deltas, strict=True):
         if d == 0.0:
             continue
-        table = data["hardpoints"][v.side] if v.side else data["hardpoints"]
-        p = table[v.point]
+        p = kind.hardpoints(data, v.side)[v.point]
         i = AXES.index(v.axis)
         if isinstance(p, dict):
             p[v.axis] = float(p[v.axis]) + float(d)

@@ -76,7 +76,7 @@ class AxleModel(AxleAssembly):
 
     labels = SIDES
     # every command but export, which writes one corner's points (docs/interop.md); a
-    # vehicle takes these but study (Vehicle.commands)
+    # vehicle takes these too (Vehicle.commands)
     commands = (
         "sweep",
         "attitude",

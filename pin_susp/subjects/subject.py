@@ -125,6 +125,11 @@ class SubjectKind:
 
         return canonical_corner(data, Reader(source))
 
+    def hardpoints(self, data: dict, label: str | None) -> dict:
+        """The hardpoints of the corner ``label`` names in ``variant_data``'s copy (None:
+        a corner's one)."""
+        return data["hardpoints"][label] if label else data["hardpoints"]
+
 
 class _CornerKind(SubjectKind):
     def variant_data(self, data: dict) -> dict:
@@ -166,6 +171,46 @@ class _AxleKind(SubjectKind):
         return out
 
 
+class _VehicleKind(SubjectKind):
+    """A vehicle's (docs/vehicle.md): its data with both axles inline, each in mm with its
+    right side written out; a corner's label (fl, fr, rl, rr) names its axle and side."""
+
+    def build(self, data: dict, source: str, variant: bool = False) -> Assembly:
+        from .vehicle import Vehicle
+        from .vehicle_file import load_vehicle
+
+        return Vehicle(load_vehicle(data))
+
+    def in_mm(self, data: dict, source: str) -> dict:
+        """The vehicle file's data in mm and N with each axle inline, as its axle file
+        gives it in mm (its own units) and canonical form, its right side written out;
+        the file read first as every command reads it (its errors name its files)."""
+        from ..io.yamlio import Reader, load_yaml
+        from ..model.units import vehicle_in_mm
+        from .vehicle_file import load_vehicle
+
+        load_vehicle(source)
+        r = Reader(source)
+        data = vehicle_in_mm(copy.deepcopy(data), r)
+        for end in ("front", "rear"):
+            given = data[end]
+            path = str(Path(source).parent / given) if isinstance(given, str) else source
+            axle = load_yaml(path)[0] if isinstance(given, str) else given
+            data[end] = _AxleKind().variant_data(_AxleKind().in_mm(axle, path))
+        return data
+
+    def variant_data(self, data: dict) -> dict:
+        return copy.deepcopy(data)
+
+    def hardpoints(self, data: dict, label: str | None) -> dict:
+        from .vehicle_file import AXLES
+
+        end = next(e for e, labels in AXLES.items() if label in labels)
+        return data[end]["hardpoints"]["left" if label == AXLES[end][0] else "right"]
+
+
 def kind_of(data: dict) -> SubjectKind:
     """The kind of subject a geometry file's data, as read, holds (its ``scope``)."""
+    if isinstance(data, dict) and data.get("scope") == "vehicle":
+        return _VehicleKind()
     return _AxleKind() if is_axle_data(data) else _CornerKind()

@@ -111,8 +111,7 @@ class Vehicle(VehicleExport, VehicleViews, VehicleTangents, VehicleAssembly):
 
     labels = LABELS
     noun = "vehicle"
-    # an axle's commands but a study's (docs/vehicle.md: the rest not yet)
-    commands = tuple(c for c in AxleModel.commands if c != "study")
+    commands = AxleModel.commands  # an axle's (docs/vehicle.md)
     reports = True
     on_road = True
     summary_columns = tuple(
