@@ -80,6 +80,11 @@ def run_study(
             if study.kind == "monte_carlo":
                 early["linear"] = _prediction(study, early["table"])
                 clock.lap("first-order prediction")
+            if forked:  # study.png's imports (matplotlib), on this core while the server's
+                from ..plots import save_figure  # noqa: F401  (on the other) go on
+                from .plots import study_figure  # noqa: F401
+
+                clock.lap("study.png's imports")
         # a scheduler that answers, before any file
         with cluster.dask_client(scheduler, workers, forked) as client:
             clock.lap("cluster start")

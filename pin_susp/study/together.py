@@ -37,14 +37,16 @@ from ..errors import PinSuspError
 from ..io.yamlio import MAX_LENGTH_MM, Reader
 from ..maths.jet import Dual, cross
 from ..model.geometry import parse_geometry, unit
-from ..model.hardpoint_checks import with_points
+from ..model.hardpoint_checks import checked, checked_points, with_points
 from ..model.tree import joint_steps
+from ..model.units import MM
 from ..model.wheel import contact_patch
 from ..solve.bulk import rows_of, solve_all
 from ..solve.linkage import twist
 from ..solve.stacked import Stack, StackedTree
 from ..solve.template import signature
 from .data import AXES
+from .tree_numbers import TreeNumbers, design_points_many
 from .variants import summary_figures, variant_data
 
 
@@ -151,8 +153,10 @@ class Together:
         if any(m not in given for m in job.summary):
             return
         self.ok = self._same(design, self.rows, self.drive) and self._probe()
+        self.recipe = None  # where each tree number comes from (tree_numbers.py)
         if self.ok:
             self.points = self._own_points()
+            self.recipe = self._recipe() if self.points is not None else None
 
     # ---------------------------------------------------------------- numbers
 
@@ -235,16 +239,10 @@ class Together:
     def measure(self, table: np.ndarray) -> list:
         """Per variant of the batch (its variables' rows) a Measured, or None."""
         out = [None] * len(table)
-        trees, which = [], []
-        for i, deltas in enumerate(table):
-            tree = self._tree(deltas)
-            got = None if tree is None else self.numbers(tree)
-            if got is not None:
-                trees.append(got)
-                which.append(i)
+        got, which = self._numbers_many(table)
         if not which:
             return out
-        E, J, A = (np.array([t[k] for t in trees]) for k in range(3))
+        E, J, A = got
         keep, signs = self._branches(E)
         if not keep.any():
             return out
@@ -254,6 +252,91 @@ class Together:
         for w, row in zip(which, rows, strict=True):
             out[w] = None if row is None else Measured(row)
         return out
+
+    def _numbers_many(self, table: np.ndarray) -> tuple:
+        """(E, J, A) of the batch's variants that are not refused, and their indices:
+        gathered from their design points (``recipe``), else read from each one's tree."""
+        if self.recipe is not None:
+            return self._gathered(table)
+        which, got = [], []
+        for i, deltas in enumerate(table):
+            x = self._numbers_of(deltas)
+            if x is not None:
+                which.append(i)
+                got.append(x)
+        if not which:
+            return None, which
+        return tuple(np.array([t[k] for t in got]) for k in range(3)), which
+
+    def _gathered(self, table: np.ndarray) -> tuple:
+        """_numbers_many's by the recipe: every variant's hardpoints (mm) at once — the
+        design's plus its deltas, variant_data's numbers — then each one's checked as a
+        file's are (hardpoint_checks), the numbers gathered from the design points of
+        those not refused."""
+        names = list(self.points)
+        base = np.array([self.points[n] for n in names])  # (names, 3) mm
+        column = [names.index(n) for n, _ in self.slots], [i for _, i in self.slots]
+        H = np.repeat(base[None], len(table), axis=0)
+        moved = H[:, column[0], column[1]] + table
+        H[:, column[0], column[1]] = np.where(table != 0.0, moved, H[:, column[0], column[1]])
+        inside = (np.abs(moved) <= MAX_LENGTH_MM).all(axis=1)  # (beyond: its build says why)
+        H *= MM
+        g, r = self.design.geometry, Reader("<dict>")
+        which, got = [], []
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            for v in np.flatnonzero(inside):
+                hardpoints = dict(zip(names, H[v], strict=True))
+                try:
+                    checked(hardpoints, g, r)
+                except (PinSuspError, ArithmeticError, ValueError, np.linalg.LinAlgError):
+                    continue
+                which.append(int(v))
+                got.append([hardpoints[n] for n in names])
+        if not which:
+            return None, which
+        settled = np.array(got)
+        P = design_points_many(g, {n: settled[:, j] for j, n in enumerate(names)})
+        return self.recipe(P), which
+
+    def _recipe(self) -> TreeNumbers | None:
+        """Where each of the trees' numbers comes from, read off the design's and two
+        probe variants' (their deltas small and all different), and checked on them."""
+        rng = np.random.default_rng(0)
+        samples = [np.zeros(len(self.job.variables))]
+        samples += [rng.uniform(-1e-2, 1e-2, len(self.job.variables)) for _ in range(2)]
+        points, numbers = [], []
+        for deltas in samples:
+            hardpoints, got = self._hardpoints(deltas), self._numbers_of(deltas)
+            if hardpoints is None or got is None:
+                return None
+            points.append(design_points_many(self.design.geometry, hardpoints))
+            numbers.append(got)
+        return TreeNumbers.found(points, numbers)
+
+    def _hardpoints(self, deltas) -> dict | None:
+        """A variant's hardpoints (m), checked as a file's are (hardpoint_checks), or None
+        where they are refused (its own build then says why)."""
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                points = self._points_mm(deltas)
+                if points is None:
+                    return None
+                return checked_points(self.design.geometry, points, Reader("<dict>"))[0]
+        except (PinSuspError, ArithmeticError, ValueError, np.linalg.LinAlgError):
+            return None
+
+    def _points_mm(self, deltas) -> dict | None:
+        """The design's hardpoints (mm, ``points``) with a variant's deltas: variant_data's
+        numbers (the file's number plus the delta); None beyond the file limit."""
+        points = self.points | {name: self.points[name].copy() for name in self.varied}
+        for (name, i), d in zip(self.slots, deltas, strict=True):
+            if d != 0.0:
+                points[name][i] += float(d)
+                if not abs(points[name][i]) <= MAX_LENGTH_MM:
+                    return None  # (its own build says why)
+        return points
 
     def _tree(self, deltas):
         """A variant's tree, or None where its geometry is refused or needs a setup
@@ -272,13 +355,12 @@ class Together:
         (``points``); else its geometry data read whole. None where it needs a setup
         solve."""
         if self.points is not None:
-            points = self.points | {name: self.points[name].copy() for name in self.varied}
-            for (name, i), d in zip(self.slots, deltas, strict=True):
-                if d != 0.0:  # (as variant_data: the file's number plus the delta)
-                    points[name][i] += float(d)
-                    if not abs(points[name][i]) <= MAX_LENGTH_MM:
-                        return None  # (its own build says why)
-            return with_points(self.design.geometry, points, Reader("<dict>"))
+            points = self._points_mm(deltas)
+            return (
+                None
+                if points is None
+                else with_points(self.design.geometry, points, Reader("<dict>"))
+            )
         data = variant_data(self.job.geometry, self.job.variables, deltas)
         g = parse_geometry(data, Reader("<dict>"), None)
         return None if g.needs_setup else g
