@@ -18,7 +18,15 @@ from pin_susp import Corner, load_sweep
 from pin_susp.model.sweep import Sweep
 from pin_susp.model.urdf import read_closures, tree_to_urdf
 from pin_susp.solve.bulk import Tree, tree_of
-from pin_susp.study import batch, load_study, run_study, tasks, variant_data, variant_table
+from pin_susp.study import (
+    batch,
+    batches,
+    load_study,
+    run_study,
+    tasks,
+    variant_data,
+    variant_table,
+)
 from pin_susp.study.together import Together
 from pin_susp.study.variants import build
 
@@ -326,3 +334,20 @@ def test_a_summary_the_metric_functions_do_not_give_is_built_instead(tmp_path, m
         assert row[f"{m}_min"] == pytest.approx(values.min(), rel=1e-9, abs=1e-9), m
         assert row[f"{m}_max"] == pytest.approx(values.max(), rel=1e-9, abs=1e-9), m
         assert row[f"{m}_static"] == pytest.approx(float(static[m][0]), rel=1e-9, abs=1e-9)
+
+
+def test_a_batch_raises_the_allocators_thresholds_once(tmp_path, monkeypatch):
+    """Every batch's process sets glibc's mmap and trim thresholds (solve/allocator.py)
+    before its solve; where glibc is the C library, mallopt takes both."""
+    import platform
+
+    from pin_susp.solve import allocator
+
+    calls = []
+    monkeypatch.setattr(allocator, "tune", lambda: calls.append(1) or True)
+    study = tolerances(tmp_path, "double_wishbone.yaml", 0.5, 2)
+    run_study(study, tmp_path / "out", scheduler=None)
+    assert len(calls) == len(batches(study))
+    monkeypatch.undo()
+    glibc = platform.libc_ver()[0] == "glibc"
+    assert allocator.tune() is glibc and allocator.tune() is glibc

@@ -19,6 +19,9 @@ def run_batch(job: Job, index: int, ids: np.ndarray, table: np.ndarray, steps: b
 
     Returns plain data (Arrow IPC bytes) so that any scheduler can carry it."""
     from ..model.sweep import load_sweep
+    from ..solve.allocator import tune
+
+    tune()  # (the batch's arrays: solve/allocator.py)
 
     sweep = load_sweep(job.sweep)
     rows, frames = [], []
@@ -39,6 +42,9 @@ def run_start(job: Job, index: int, ids: np.ndarray, table: np.ndarray, steps: b
     from scipy.optimize import least_squares
 
     from ..model.sweep import load_sweep
+    from ..solve.allocator import tune
+
+    tune()  # (solve/allocator.py)
 
     sweep = load_sweep(job.sweep)
     low, high = job.bounds
