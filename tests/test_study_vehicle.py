@@ -173,6 +173,10 @@ def test_a_vehicle_monte_carlo_has_no_first_order_prediction(tmp_path):
     assert outcome.linear is None
     assert outcome.variants["converged"].all()
     assert np.ptp(outcome.variants["camber_fr_static"]) > 0.01  # deg: the spin axis tilted
+    from pin_susp.study.plots import study_figure
+
+    notes = [t.get_text() for t in study_figure(study, outcome.variants).texts]
+    assert any("a vehicle's design state holds its body on the road" in t for t in notes)
 
 
 def test_the_summary_columns_units_are_the_sweeps(tmp_path):
@@ -205,3 +209,34 @@ def test_the_summary_columns_units_are_the_sweeps(tmp_path):
     assert not any("deg/mm" in t for t in titles + labels)
     label, unit = describe("camber_rr")
     assert label.endswith("(rear right)") and unit == "deg"
+
+
+def test_a_run_made_before_an_axle_file_was_edited_is_not_resumed(tmp_path, capsys):
+    """The vehicle file names its axle files: a run is another study's once one of them
+    is edited (its variants would mix two cars), said in one line."""
+    import shutil
+
+    examples = tmp_path / "examples"
+    shutil.copytree(EXAMPLES / "vehicle", examples / "vehicle")
+    shutil.copy(EXAMPLES / "vehicle_fs.yaml", examples)
+    shutil.copy(EXAMPLES / "vehicle_heave.yaml", examples)
+    study = examples / "study.yaml"
+    body = {
+        "version": 1,
+        "geometry": "vehicle_fs.yaml",
+        "sweep": "vehicle_heave.yaml",
+        "variables": [{"side": "rl", "point": "toe_link_inboard", "axis": "z", "range": [-1, 1]}],
+        "kind": "doe",
+        "doe": {"method": "full_factorial", "levels": 2},
+        "summary": ["roadwheel_angle_rl"],
+    }
+    study.write_text(yaml.safe_dump(body, sort_keys=False))
+    out = tmp_path / "out"
+    assert main(["study", str(study), "-o", str(out), "--scheduler", "none", "-q"]) == 0
+    rear = examples / "vehicle" / "fs_rear.yaml"
+    rear.write_text(rear.read_text().replace("z: 275}", "z: 285}", 1))
+    capsys.readouterr()
+    code = main(["study", str(study), "-o", str(out), "--scheduler", "none", "--resume"])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1, err
+    assert "fs_rear.yaml was edited" in err

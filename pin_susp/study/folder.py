@@ -23,7 +23,7 @@ from .variants import variant_data
 def _fingerprint(study: Study, steps: bool) -> dict:
     """What makes a run this study's: the files' hashes, the variants, --steps (the
     study's path is kept for information: the same file may be typed differently)."""
-    return {
+    out = {
         "pin_susp": __version__,
         "study": study.source,
         "study_sha256": study.sha256,
@@ -34,6 +34,9 @@ def _fingerprint(study: Study, steps: bool) -> dict:
         "batches": len(batches(study)),
         "steps": steps,
     }
+    if study.referenced_sha256:  # a vehicle's axle files: edited, another geometry
+        out["referenced_sha256"] = study.referenced_sha256
+    return out
 
 
 INFORMATION = ("pin_susp", "study")  # manifest entries that do not decide sameness
@@ -88,6 +91,12 @@ def check_outdir(study: Study, outdir: Path, steps: bool, resume: bool) -> dict:
                 f"{outdir}: holds a run of this study cut into {theirs.get('batches')} batches, "
                 f"where this pin_susp cuts it into {mine['batches']} (an earlier version's): "
                 "it cannot be resumed; give a new or empty directory"
+            )
+        if differs == ["referenced_sha256"]:
+            edited = [f for f, sha in mine[differs[0]].items() if theirs[differs[0]].get(f) != sha]
+            raise PinSuspError(
+                f"{outdir}: holds a run of this study made before {', '.join(edited)} was "
+                "edited (the geometry reads it): give a new or empty directory"
             )
         if differs:
             what = theirs.get("study", "another study")

@@ -295,7 +295,10 @@ def _histograms(study, variants, linear, heading: str) -> Figure:
     if keys:
         fig.legend(keys.values(), keys.keys(), loc="lower center", ncol=LEGEND_COLUMNS, fontsize=9)
     if linear is None:
-        _footnote(fig, "no first-order prediction (an axle, or the design did not solve)")
+        why = "the design did not solve"
+        if study.geometry_data.get("scope") == "vehicle":
+            why = "a vehicle's design state holds its body on the road"
+        _footnote(fig, f"no first-order prediction ({why})")
     _place(fig, len(rows), cols)
     return fig
 
@@ -475,8 +478,10 @@ def _effects_panel(
     if not drawn:
         _note(ax, "no value: no variant converged here", "upper left")
         return
-    ax.ticklabel_format(axis="y", useOffset=False)
     levels = np.concatenate([_finite(effects[name][1]) for name in drawn])
+    if levels.size and np.ptp(levels) > 1e-4 * np.abs(levels).max():
+        ax.ticklabel_format(axis="y", useOffset=False)  # (a spread far finer: an offset,
+    # not tick labels of nine digits that the panel cannot hold)
     if _flat(levels, float(np.abs(levels).max())):
         level = levels[0]
         _note(ax, f"the same at every variant: {level:.6g} {unit}".rstrip())

@@ -12,7 +12,7 @@ import numpy as np
 
 from ..io.yamlio import Reader, load_yaml, read_once
 from ..model.units import read_units
-from ..subjects.subject import kind_of
+from ..subjects.subject import kind_of, referenced_files
 from .data import AXES, Job, Term, Variable
 from .variants import at_design, build
 
@@ -68,6 +68,8 @@ class Study:
     max_evaluations: int = 60
     geometry_sha256: str | None = None  # of the files as read
     sweep_sha256: str | None = None
+    # the files the geometry reads (a vehicle's axle files): path → sha256 as read
+    referenced_sha256: dict[str, str] = field(default_factory=dict)
     # each summary column's unit, as the design's sweep gives it ("deg/deg": per degree
     # of roll); variants.parquet's units and study.png's labels
     column_units: dict[str, str] = field(default_factory=dict)
@@ -135,6 +137,9 @@ def _load_study(source: str | Path) -> Study:
         seed=0,
         geometry_sha256=geometry_sha,
         sweep_sha256=sweep_sha,
+        referenced_sha256={
+            str(path): load_yaml(path)[2] for path in referenced_files(geometry_path)
+        },
     )
     if kind not in data:
         r.fail(kind, f"missing key (kind: {kind} needs its block)")
