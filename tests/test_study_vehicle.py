@@ -240,3 +240,29 @@ def test_a_run_made_before_an_axle_file_was_edited_is_not_resumed(tmp_path, caps
     err = capsys.readouterr().err
     assert code == 2 and err.count("\n") == 1, err
     assert "fs_rear.yaml was edited" in err
+
+
+def test_a_study_without_summary_summarises_each_corners_camber_and_toe(tmp_path, capsys):
+    """No ``summary``: a corner's camber and toe, on a vehicle each corner's (not an
+    error naming a key the file does not have); a geometry whose clearance block
+    `pin-susp sweep` refuses is refused by the study too, before any variant."""
+    body = {
+        "variables": [{"side": "fl", "point": "trackrod_inboard", "axis": "z", "range": [-1, 1]}],
+        "kind": "doe",
+        "doe": {"method": "full_factorial", "levels": 2},
+    }
+    study = load_study(vehicle_study(tmp_path, body, "vehicle_heave.yaml"))
+    corners = ("fl", "fr", "rl", "rr")
+    assert study.summary == [f"{m}_{c}" for m in ("camber", "roadwheel_angle") for c in corners]
+    corner = yaml.safe_load((EXAMPLES / "double_wishbone.yaml").read_text())
+    corner["clearance"] = {"bodies": 5}
+    geometry = tmp_path / "corner.yaml"
+    geometry.write_text(yaml.safe_dump(corner))
+    path = tmp_path / "corner_study.yaml"
+    data = {"version": 1, "geometry": str(geometry), "sweep": str(EXAMPLES / "bump.yaml")}
+    data |= {k: v for k, v in body.items() if k != "variables"}
+    data["variables"] = [{"point": "trackrod_inboard", "axis": "z", "range": [-1, 1]}]
+    path.write_text(yaml.safe_dump(data))
+    code = main(["study", str(path), "-o", str(tmp_path / "out"), "--scheduler", "none"])
+    err = capsys.readouterr().err
+    assert code == 2 and f"{geometry}: clearance.bodies: " in err and err.count("\n") == 1

@@ -201,7 +201,8 @@ def _load_study(source: str | Path) -> Study:
                 "on an axle the optimiser's exact Jacobian holds each wheel centre's height "
                 "and the rack: give a sweep of those targets (roll and heave sweeps: kind doe)",
             )
-    summary = data.get("summary", ["camber", "roadwheel_angle"])
+    # (default: camber and toe, each corner's on an axle or a vehicle)
+    summary = data.get("summary", design.default_summary(("camber", "roadwheel_angle")))
     if not isinstance(summary, list) or not summary:
         r.fail("summary", "expected a list of column names (e.g. [camber, roadwheel_angle])")
     for i, m in enumerate(summary):
@@ -248,6 +249,9 @@ class _Design:
 
     def __init__(self, geometry: dict, geometry_path: str, sweep_path: str):
         # errors name the files, as `pin-susp sweep` would
+        from ..model.clearance_bodies import check_clearance
+
+        check_clearance(geometry_path)  # its clearance bodies, as every command checks them
         self.subject = subject = build(geometry, geometry_path)
         from ..model.sweep import load_sweep
 
@@ -260,6 +264,16 @@ class _Design:
         self.sides = tuple(label for label in subject.labels if label)
         self.noun = "a vehicle" if subject.on_road else "an axle"  # (with sides)
         self.columns = [c for c in self.results.columns if c != "step_index"]
+
+    def default_summary(self, metrics: tuple[str, ...]) -> list[str]:
+        """The metrics' columns: a corner's own, else each of its corners' (``_left``,
+        ``_fl``, ...)."""
+        return [
+            column
+            for m in metrics
+            for column in ([m] if m in self.columns else [f"{m}_{s}" for s in self.sides])
+            if column in self.columns
+        ]
 
     def factor(self, column: str) -> float:
         """What one unit of the study's number on ``column`` is in the column's own unit
