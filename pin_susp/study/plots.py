@@ -296,7 +296,7 @@ def _histograms(study, variants, linear, heading: str) -> Figure:
         fig.legend(keys.values(), keys.keys(), loc="lower center", ncol=LEGEND_COLUMNS, fontsize=9)
     if linear is None:
         why = "the design did not solve"
-        if study.geometry_data.get("scope") == "vehicle":
+        if study.on_road:
             why = "a vehicle's design state holds its body on the road"
         _footnote(fig, f"no first-order prediction ({why})")
     _place(fig, len(rows), cols)

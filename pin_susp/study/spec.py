@@ -68,6 +68,7 @@ class Study:
     max_evaluations: int = 60
     geometry_sha256: str | None = None  # of the files as read
     sweep_sha256: str | None = None
+    on_road: bool = False  # its subject's body stands on the road (a vehicle's: Assembly)
     # the files the geometry reads (a vehicle's axle files): path → sha256 as read
     referenced_sha256: dict[str, str] = field(default_factory=dict)
     # each summary column's unit, as the design's sweep gives it ("deg/deg": per degree
@@ -209,6 +210,7 @@ def _load_study(source: str | Path) -> Study:
         design.check_column(r.text(m, f"summary[{i}]"), f"summary[{i}]", r)
     study.summary = list(dict.fromkeys(summary))
     study.column_units = {m: design.results.units.get(m, "") for m in study.summary}
+    study.on_road = design.subject.on_road
     if "conventions" in data:  # one name: the convention of variants.parquet, steps.parquet
         from ..io.conventions import CONVENTIONS
 
