@@ -65,7 +65,7 @@ def test_study_benchmark_runs_a_small_slice(tmp_path):
     out = tmp_path / "study.json"
     proc = subprocess.run(
         [sys.executable, str(ROOT / "benchmarks" / "bench_study.py"), "--variants", "64"]
-        + ["--doe", "64"]
+        + ["--doe", "64", "--optimise-runs", "1"]
         + ["--json", str(out)],
         capture_output=True,
         text=True,
