@@ -4,8 +4,10 @@ of their trees alone (docs/studies.md, Speed).
 Every variant of one corner has the design's tree with other numbers: its joints at
 other origins along other axes, its points and closure anchors elsewhere, its
 distance closures of other lengths (solve/template.py). Those numbers are read here
-straight from each variant's tree — no model, solver or URDF built per variant — and
-the batch is then one set of configurations (every variant's design state and every
+straight from each variant's tree — no model, solver or URDF built per variant — or,
+where each is one of its design points, a unit vector between two or a constant,
+gathered for the batch at once from its variants' design points (tree_numbers.py),
+their hardpoints checked as a file's are (model/hardpoint_checks.py); the batch is then one set of configurations (every variant's design state and every
 step of its sweep) on the design model's tree with each configuration's own numbers
 (solve/stacked.py):
 
@@ -88,6 +90,7 @@ class Together:
     def __init__(self, job, design, sweep, guess: np.ndarray):
         self.ok = False
         self.points = None  # the design's hardpoints (mm) where a variant's are its own (_own)
+        self.recipe = None  # where each tree number comes from (tree_numbers.py)
         self.job, self.design, self.sweep, self.guess = job, design, sweep, guess
         self.needs = set(job.needs)
         g = design.geometry
@@ -153,7 +156,6 @@ class Together:
         if any(m not in given for m in job.summary):
             return
         self.ok = self._same(design, self.rows, self.drive) and self._probe()
-        self.recipe = None  # where each tree number comes from (tree_numbers.py)
         if self.ok:
             self.points = self._own_points()
             self.recipe = self._recipe() if self.points is not None else None
@@ -351,16 +353,14 @@ class Together:
 
     def _geometry(self, deltas):
         """A variant's Geometry: the design's with its own hardpoints, checked as a file's
-        are (geometry.with_points), where its variables are the file's own points
+        are (hardpoint_checks.with_points), where its variables are the file's own points
         (``points``); else its geometry data read whole. None where it needs a setup
         solve."""
         if self.points is not None:
             points = self._points_mm(deltas)
-            return (
-                None
-                if points is None
-                else with_points(self.design.geometry, points, Reader("<dict>"))
-            )
+            if points is None:
+                return None
+            return with_points(self.design.geometry, points, Reader("<dict>"))
         data = variant_data(self.job.geometry, self.job.variables, deltas)
         g = parse_geometry(data, Reader("<dict>"), None)
         return None if g.needs_setup else g
