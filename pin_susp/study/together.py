@@ -7,8 +7,9 @@ distance closures of other lengths (solve/template.py). Those numbers are read h
 straight from each variant's tree — no model, solver or URDF built per variant — or,
 where each is one of its design points, a unit vector between two or a constant,
 gathered for the batch at once from its variants' design points (tree_numbers.py),
-their hardpoints checked as a file's are (model/hardpoint_checks.py); the batch is then one set of configurations (every variant's design state and every
-step of its sweep) on the design model's tree with each configuration's own numbers
+their hardpoints checked as a file's are (model/hardpoint_checks.py). The batch is
+then one set of configurations (every variant's design state and every step of its
+sweep) on the design model's tree with each configuration's own numbers
 (solve/stacked.py):
 
 - the sweep's steps by Newton iterations together from the design variant's
