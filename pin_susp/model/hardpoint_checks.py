@@ -46,27 +46,23 @@ def check_points(hardpoints: dict, o, r) -> None:
     mech.prepare(hardpoints, o, r)
 
 
-def checked_points(g, points_mm: dict[str, np.ndarray], r) -> tuple:
-    """``points_mm`` — each of ``g``'s hardpoints (mm, as its file gives them once in
-    canonical form, before the mechanism settles any) — checked as parse_geometry checks
-    them (through ``r``): the hardpoints (m, settled), the driveshaft and the travel
-    limits they give with the rest of ``g``."""
-    return checked({name: points_mm[name] * MM for name in g.hardpoints}, g, r)
-
-
 def checked(hardpoints: dict, g, r) -> tuple:
-    """checked_points' of hardpoints in m (``hardpoints``: the mechanism may settle some
-    of its entries)."""
+    """``hardpoints`` (m) — each of ``g``'s — checked as parse_geometry checks them
+    (through ``r``; the mechanism may settle some of its entries): the driveshaft and
+    the travel limits they give with the rest of ``g``."""
     check_points(hardpoints, g, r)
     config = g.data["config"]
     driveshaft = packaging.read_driveshaft(config, hardpoints, g.side, r)
-    return hardpoints, driveshaft, packaging.read_limits(config, hardpoints, r)
+    return driveshaft, packaging.read_limits(config, hardpoints, r)
 
 
 def with_points(g, points_mm: dict[str, np.ndarray], r):
-    """``g`` with other hardpoints, checked (checked_points); the rest of ``g``
-    unchanged (a study's variant, docs/studies.md Speed). ``g.data`` stays the design's."""
+    """``g`` with other hardpoints, checked (``checked``): ``points_mm`` each of its
+    hardpoints (mm, as its file gives them once in canonical form, before the mechanism
+    settles any); the rest of ``g`` unchanged (a study's variant, docs/studies.md
+    Speed). ``g.data`` stays the design's."""
     from dataclasses import replace
 
-    hardpoints, driveshaft, limits = checked_points(g, points_mm, r)
+    hardpoints = {name: points_mm[name] * MM for name in g.hardpoints}
+    driveshaft, limits = checked(hardpoints, g, r)
     return replace(g, hardpoints=hardpoints, driveshaft=driveshaft, limits=limits)

@@ -40,7 +40,7 @@ from ..errors import PinSuspError
 from ..io.yamlio import MAX_LENGTH_MM, Reader
 from ..maths.jet import Dual, cross
 from ..model.geometry import parse_geometry, unit
-from ..model.hardpoint_checks import checked, checked_points, with_points
+from ..model.hardpoint_checks import checked, with_points
 from ..model.tree import joint_steps
 from ..model.units import MM
 from ..model.wheel import contact_patch
@@ -92,10 +92,11 @@ class Together:
         self.ok = False
         self.points = None  # the design's hardpoints (mm) where a variant's are its own (_own)
         self.recipe = None  # where each tree number comes from (tree_numbers.py)
+        self.slots = [(v.point, AXES.index(v.axis)) for v in job.variables]  # (name, axis)
         self.job, self.design, self.sweep, self.guess = job, design, sweep, guess
         self.needs = set(job.needs)
         g = design.geometry
-        if self._tree(np.zeros(len(job.variables))) is None:
+        if self._tree(np.zeros(len(job.variables)), None) is None:
             return  # (its setup solved per variant, or no tree of its own)
         if "motion_ratio" in self.needs and g.spring == "torsion_bar":
             return  # (a setup solve per variant; a bar's sense read per variant)
@@ -260,10 +261,11 @@ class Together:
         """(E, J, A) of the batch's variants that are not refused, and their indices:
         gathered from their design points (``recipe``), else read from each one's tree."""
         if self.recipe is not None:
-            return self._gathered(table)
+            settled, which = self._checked_many(table)
+            return (None if not which else self.recipe(self._design_points(settled))), which
         which, got = [], []
         for i, deltas in enumerate(table):
-            x = self._numbers_of(deltas)
+            x = self._numbers_of(deltas, self.points)
             if x is not None:
                 which.append(i)
                 got.append(x)
@@ -271,18 +273,24 @@ class Together:
             return None, which
         return tuple(np.array([t[k] for t in got]) for k in range(3)), which
 
-    def _gathered(self, table: np.ndarray) -> tuple:
-        """_numbers_many's by the recipe: every variant's hardpoints (mm) at once — the
-        design's plus its deltas, variant_data's numbers — then each one's checked as a
-        file's are (hardpoint_checks), the numbers gathered from the design points of
-        those not refused."""
+    def _with_deltas(self, table: np.ndarray, points: dict) -> tuple:
+        """Variants' hardpoints (mm, (n, names, 3) in ``points``' order): the design's
+        ``points`` plus each one's deltas — variant_data's numbers (the file's number
+        plus a delta that is not 0) — and whether each is within the file limit (else
+        its own build says why)."""
+        rows = [list(points).index(n) for n, _ in self.slots]
+        axes = [i for _, i in self.slots]
+        H = np.repeat(np.array(list(points.values()))[None], len(table), axis=0)
+        moved = H[:, rows, axes] + table
+        H[:, rows, axes] = np.where(table != 0.0, moved, H[:, rows, axes])
+        return H, (np.abs(moved) <= MAX_LENGTH_MM).all(axis=1)
+
+    def _checked_many(self, table: np.ndarray) -> tuple:
+        """The variants' hardpoints (m, (k, names, 3), as the mechanism settles them) of
+        those that are not refused, each checked as a file's are (hardpoint_checks),
+        and their indices."""
         names = list(self.points)
-        base = np.array([self.points[n] for n in names])  # (names, 3) mm
-        column = [names.index(n) for n, _ in self.slots], [i for _, i in self.slots]
-        H = np.repeat(base[None], len(table), axis=0)
-        moved = H[:, column[0], column[1]] + table
-        H[:, column[0], column[1]] = np.where(table != 0.0, moved, H[:, column[0], column[1]])
-        inside = (np.abs(moved) <= MAX_LENGTH_MM).all(axis=1)  # (beyond: its build says why)
+        H, inside = self._with_deltas(table, self.points)
         H *= MM
         g, r = self.design.geometry, Reader("<dict>")
         which, got = [], []
@@ -296,75 +304,51 @@ class Together:
                     continue
                 which.append(int(v))
                 got.append([hardpoints[n] for n in names])
-        if not which:
-            return None, which
-        settled = np.array(got)
-        P = design_points_many(g, {n: settled[:, j] for j, n in enumerate(names)})
-        return self.recipe(P), which
+        return np.array(got), which
+
+    def _design_points(self, settled: np.ndarray) -> dict:
+        """name → (k, 3) of every design point of k variants, their hardpoints settled."""
+        by_name = dict(zip(self.points, settled.swapaxes(0, 1), strict=True))
+        return design_points_many(self.design.geometry, by_name)
 
     def _recipe(self) -> TreeNumbers | None:
         """Where each of the trees' numbers comes from, read off the design's and two
         probe variants' (their deltas small and all different), and checked on them."""
         rng = np.random.default_rng(0)
-        samples = [np.zeros(len(self.job.variables))]
-        samples += [rng.uniform(-1e-2, 1e-2, len(self.job.variables)) for _ in range(2)]
-        points, numbers = [], []
-        for deltas in samples:
-            hardpoints, got = self._hardpoints(deltas), self._numbers_of(deltas)
-            if hardpoints is None or got is None:
-                return None
-            points.append(design_points_many(self.design.geometry, hardpoints))
-            numbers.append(got)
-        return TreeNumbers.found(points, numbers)
-
-    def _hardpoints(self, deltas) -> dict | None:
-        """A variant's hardpoints (m), checked as a file's are (hardpoint_checks), or None
-        where they are refused (its own build then says why)."""
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                points = self._points_mm(deltas)
-                if points is None:
-                    return None
-                return checked_points(self.design.geometry, points, Reader("<dict>"))[0]
-        except (PinSuspError, ArithmeticError, ValueError, np.linalg.LinAlgError):
+        samples = np.vstack(
+            [np.zeros(len(self.job.variables))]
+            + [rng.uniform(-1e-2, 1e-2, len(self.job.variables)) for _ in range(2)]
+        )
+        settled, which = self._checked_many(samples)
+        numbers = [self._numbers_of(deltas, self.points) for deltas in samples]
+        if len(which) != len(samples) or any(n is None for n in numbers):
             return None
+        return TreeNumbers.found(self._design_points(settled), numbers)
 
-    def _points_mm(self, deltas) -> dict | None:
-        """The design's hardpoints (mm, ``points``) with a variant's deltas: variant_data's
-        numbers (the file's number plus the delta); None beyond the file limit."""
-        points = self.points | {name: self.points[name].copy() for name in self.varied}
-        for (name, i), d in zip(self.slots, deltas, strict=True):
-            if d != 0.0:
-                points[name][i] += float(d)
-                if not abs(points[name][i]) <= MAX_LENGTH_MM:
-                    return None  # (its own build says why)
-        return points
-
-    def _tree(self, deltas):
+    def _tree(self, deltas, points):
         """A variant's tree, or None where its geometry is refused or needs a setup
         solve (its own build then says why, or solves it)."""
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                g = self._geometry(deltas)
+                g = self._geometry(deltas, points)
                 return None if g is None else g.mechanism.tree(g, shapes=False)
         except (PinSuspError, ArithmeticError, ValueError, np.linalg.LinAlgError):
             return None
 
-    def _geometry(self, deltas):
+    def _geometry(self, deltas, points):
         """A variant's Geometry: the design's with its own hardpoints, checked as a file's
-        are (hardpoint_checks.with_points), where its variables are the file's own points
-        (``points``); else its geometry data read whole. None where it needs a setup
-        solve."""
-        if self.points is not None:
-            points = self._points_mm(deltas)
-            if points is None:
-                return None
-            return with_points(self.design.geometry, points, Reader("<dict>"))
-        data = variant_data(self.job.geometry, self.job.variables, deltas)
-        g = parse_geometry(data, Reader("<dict>"), None)
-        return None if g.needs_setup else g
+        are (hardpoint_checks.with_points), from the design's ``points`` (mm); without
+        them its geometry data read whole. None where it needs a setup solve."""
+        if points is None:
+            data = variant_data(self.job.geometry, self.job.variables, deltas)
+            g = parse_geometry(data, Reader("<dict>"), None)
+            return None if g.needs_setup else g
+        H, inside = self._with_deltas(np.asarray(deltas)[None], points)
+        if not inside[0]:
+            return None
+        own = dict(zip(points, H[0], strict=True))
+        return with_points(self.design.geometry, own, Reader("<dict>"))
 
     def _own_points(self) -> dict | None:
         """The design's hardpoints (mm) as its canonical data gives them, where every
@@ -382,20 +366,17 @@ class Together:
                 return None
             if not np.array_equal(r.point(given[v.point], v.point), points[v.point]):
                 return None
-        self.slots = [(v.point, AXES.index(v.axis)) for v in self.job.variables]
-        self.varied, self.points = {v.point for v in self.job.variables}, points
         deltas = np.full(len(self.job.variables), 1e-3)
-        fast = self._numbers_of(deltas)
-        self.points = None
-        whole = self._numbers_of(deltas)
-        if fast is None or whole is None:
+        own, whole = self._numbers_of(deltas, points), self._numbers_of(deltas, None)
+        if own is None or whole is None:
             return None
-        if not all(np.array_equal(a, b) for a, b in zip(fast, whole, strict=True)):
+        if not all(np.array_equal(a, b) for a, b in zip(own, whole, strict=True)):
             return None
         return points
 
-    def _numbers_of(self, deltas):
-        tree = self._tree(deltas)
+    def _numbers_of(self, deltas, points):
+        """A variant's (E, J, A) read from its tree (``points``: as _geometry's)."""
+        tree = self._tree(deltas, points)
         return None if tree is None else self.numbers(tree)
 
     def _branches(self, E: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -47,12 +47,11 @@ class TreeNumbers:
         self.frames, self.origins, self.axes = frames, origins, axes
 
     @classmethod
-    def found(cls, points: list[dict], numbers: list[tuple]) -> TreeNumbers | None:
-        """From samples (the design, the probes): ``points`` each one's design points
-        (name → (3,)), ``numbers`` each one's (E, J, A) read from its tree; None where
+    def found(cls, P: dict, numbers: list[tuple]) -> TreeNumbers | None:
+        """From samples (the design, the probes): ``P`` their design points (name →
+        (samples, 3)), ``numbers`` each one's (E, J, A) read from its tree; None where
         some number is none of those."""
-        names = list(points[0])
-        P = {n: np.array([p[n] for p in points]) for n in names}  # (samples, 3)
+        names = list(P)
         E, J, A = (np.array([x[k] for x in numbers]) for k in range(3))
 
         def same(x, y) -> bool:
