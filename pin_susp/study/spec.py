@@ -264,7 +264,7 @@ class _Design:
         # the labels a variable's side names (none on a corner)
         self.points = {label or None: list(g.hardpoints) for label, g in subject.corners.items()}
         self.sides = tuple(label for label in subject.labels if label)
-        self.noun = "a vehicle" if subject.on_road else "an axle"  # (with sides)
+        self.noun = f"{subject.article} {subject.noun}"  # (one with sides: an axle, a vehicle)
         self.columns = [c for c in self.results.columns if c != "step_index"]
 
     def default_summary(self, metrics: tuple[str, ...]) -> list[str]:
