@@ -152,7 +152,7 @@ def _prediction(study: Study, table: np.ndarray) -> dict | None:
     return linear_prediction(study, variables)
 
 
-NOT_YET = object()  # (the first-order prediction is None for an axle's)
+NOT_YET = object()  # (the first-order prediction may be None: a vehicle's, an unsolved design)
 
 
 def _run(

@@ -187,20 +187,16 @@ class _VehicleKind(SubjectKind):
         the file read first as every command reads it (its errors name its files)."""
         from ..io.yamlio import Reader, load_yaml
         from ..model.units import vehicle_in_mm
-        from .vehicle_file import load_vehicle
+        from .vehicle_file import AXLES, load_vehicle
 
         load_vehicle(source)
-        r = Reader(source)
-        data = vehicle_in_mm(copy.deepcopy(data), r)
-        for end in ("front", "rear"):
+        data = vehicle_in_mm(copy.deepcopy(data), Reader(source))
+        for end in AXLES:
             given = data[end]
             path = str(Path(source).parent / given) if isinstance(given, str) else source
             axle = load_yaml(path)[0] if isinstance(given, str) else given
             data[end] = _AxleKind().variant_data(_AxleKind().in_mm(axle, path))
         return data
-
-    def variant_data(self, data: dict) -> dict:
-        return copy.deepcopy(data)
 
     def hardpoints(self, data: dict, label: str | None) -> dict:
         from .vehicle_file import AXLES
