@@ -87,11 +87,5 @@ class TreeNumbers:
 
         E = np.stack([point(x) for x in self.frames], axis=1)
         J = np.stack([point(x) for x in self.origins], axis=1)
-        A = np.stack(
-            [
-                _axis(P, *x) if isinstance(x, tuple) else np.broadcast_to(x, (n, 3))
-                for x in self.axes
-            ],
-            axis=1,
-        )
+        A = np.stack([_axis(P, *x) if isinstance(x, tuple) else point(x) for x in self.axes], 1)
         return E, J, A
