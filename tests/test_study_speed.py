@@ -93,6 +93,16 @@ def same_rows(fast, marched) -> None:
     assert np.allclose(a, b, atol=1e-9, rtol=0.0, equal_nan=True)
 
 
+def fast_and_marched(study, tmp_path, monkeypatch) -> tuple:
+    """A study's variants run as a study runs them (each batch's solves counted:
+    ``counted``) and with every variant marched from the start (no guess)."""
+    together = counted(monkeypatch)
+    fast = run_study(study, tmp_path / "fast", scheduler=None).variants
+    monkeypatch.undo()
+    monkeypatch.setattr(tasks, "guess_of", lambda job, sweep: None)
+    return fast, run_study(study, tmp_path / "marched", scheduler=None).variants, together
+
+
 def tolerances(tmp_path, geometry: str, tolerance: float, samples: int, sweep: Path = BUMP):
     body = {
         "variables": {"all_hardpoints": {"tolerance": tolerance}},
@@ -273,13 +283,9 @@ def test_failed_variants_are_flagged_as_when_marched(tmp_path, monkeypatch):
         "summary": ["camber", "roadwheel_angle"],
     }
     study = load_study(write_study(tmp_path, body, "double_wishbone.yaml", sweep))
-    together = counted(monkeypatch)
-    fast = run_study(study, tmp_path / "fast", scheduler=None).variants
+    fast, marched, together = fast_and_marched(study, tmp_path, monkeypatch)
     solved = sum(k for _, k, _ in together)  # some solved together, some marched
     assert 0 < solved < len(fast)
-    monkeypatch.undo()
-    monkeypatch.setattr(tasks, "guess_of", lambda job, sweep: None)
-    marched = run_study(study, tmp_path / "marched", scheduler=None).variants
     assert (~fast["converged"]).sum() >= 2 and (fast["steps_failed"] < 21).all()
     same_rows(fast, marched)
 
@@ -300,12 +306,8 @@ def test_variants_their_geometry_refuses_are_refused_as_when_built(tmp_path, mon
         "summary": ["camber", "roadwheel_angle"],
     }
     study = load_study(write_study(tmp_path, body, "double_wishbone.yaml"))
-    together = counted(monkeypatch)
-    fast = run_study(study, tmp_path / "fast", scheduler=None).variants
+    fast, marched, together = fast_and_marched(study, tmp_path, monkeypatch)
     assert sum(k for _, k, how in together if how == "measured") > 0
-    monkeypatch.undo()
-    monkeypatch.setattr(tasks, "guess_of", lambda job, sweep: None)
-    marched = run_study(study, tmp_path / "marched", scheduler=None).variants
     refused = marched["error"].str.contains("hardpoints.")
     assert refused.sum() >= 3 and marched["converged"][~refused].sum() >= 3
     same_rows(fast, marched)
