@@ -272,9 +272,23 @@ def test_an_axle_study_moves_one_side_and_equals_its_direct_sweep(tmp_path, caps
         csv = tmp_path / f"axle{vid}.csv"
         assert run_cli(["sweep", geometry, EXAMPLES / "roll.yaml", "-o", csv, "-q"], capsys)[0] == 0
         direct = read_csv(csv)
+        # its design state: a sweep of one step with every target at its design value
+        sweep = yaml.safe_load((EXAMPLES / "roll.yaml").read_text())
+        sweep["steps"] = 1
+        for t in sweep["targets"]:
+            t["start"] = t["stop"] = 0
+        design_sweep = tmp_path / "design_roll.yaml"
+        design_sweep.write_text(yaml.safe_dump(sweep))
+        at_design = tmp_path / f"axle{vid}_design.csv"
+        command = ["sweep", geometry, design_sweep, "-o", at_design, "-q"]
+        assert run_cli(command, capsys)[0] == 0
+        design = read_csv(at_design)
         for m in body["summary"]:
             assert variants.iloc[vid][f"{m}_min"] == pytest.approx(direct[m].min(), abs=1e-9)
             assert variants.iloc[vid][f"{m}_max"] == pytest.approx(direct[m].max(), abs=1e-9)
+            assert variants.iloc[vid][f"{m}_static"] == pytest.approx(
+                design[m][0], abs=1e-9, nan_ok=True
+            )
     # the design pose is as drawn (a moved trackrod end changes the rod's length, not the
     # static toe); in roll the left side's toe moves with it, the right one's does not
     left = variants["roadwheel_angle_left_min"]

@@ -285,7 +285,7 @@ class Composed:
         self, corners: dict, elements=(), name: str = "", comment: str = "", visuals: bool = True
     ) -> None:
         self._corners = dict(corners)
-        trees = {label: g.mechanism.tree(g) for label, g in corners.items()}
+        trees = {label: g.mechanism.tree(g, shapes=visuals) for label, g in corners.items()}
         if list(trees) == [""] and not elements:
             self.tree = trees[""]  # one corner: its own tree
         else:

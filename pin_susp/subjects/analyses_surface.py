@@ -9,6 +9,8 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+import numpy as np
+
 from ..errors import InputError
 
 
@@ -253,4 +255,30 @@ class AnalysesSurface:
         from ..model.sweep import Sweep
 
         design = Sweep([t.at_design() for t in sweep.targets], sweep.source, sweep.sha256)
-        return self.solve_sweep(sweep)[1], self.solve_sweep(design)[1].columns
+        tangents, at_design = [], []
+        steps = self.solve_steps(sweep, tangents=tangents)
+        start = self.solve_steps(design, tangents=at_design)
+        if not _alike(at_design, tangents):  # (each pass's columns by its own route)
+            static = self.sweep_results(design, start, at_design or None).columns
+            return self.sweep_results(sweep, steps, tangents or None), static
+        # one pass of the columns over the design state and the steps: each row's numbers
+        # the same as in a pass of its own (every column is worked out step by step)
+        both = self.sweep_results(sweep, [*start, *steps], [*at_design, *tangents] or None)
+        return _split(both, 1), {k: v[:1] for k, v in both.columns.items()}
+
+
+def _alike(first: list, then: list) -> bool:
+    """Whether two solves' tangent lists (solve_steps') take one route through
+    sweep_results together: both empty, or each step's given (none None) in both."""
+    if not first or not then:
+        return not first and not then
+    return all(t is not None for t in [*first, *then])
+
+
+def _split(both, k: int):
+    """The results of the steps after the first ``k`` rows of ``both`` (their step_index
+    from 0, their q and reasons theirs)."""
+    columns = {name: v[k:] for name, v in both.columns.items()}
+    columns["step_index"] = np.arange(len(both.meta["q"]) - k)
+    meta = dict(both.meta, q=both.meta["q"][k:], why=both.meta["why"][k:])
+    return type(both)(columns, both.units, meta)

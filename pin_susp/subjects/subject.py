@@ -153,7 +153,7 @@ class _AxleKind(SubjectKind):
     def build(self, data: dict, source: str, variant: bool = False) -> Assembly:
         from .axle import AxleModel, load_axle
 
-        return AxleModel(load_axle(data, None if variant else source))
+        return AxleModel(load_axle(data, None if variant else source), visuals=not variant)
 
     def in_mm(self, data: dict, source: str) -> dict:
         from ..io.yamlio import Reader
@@ -179,7 +179,7 @@ class _VehicleKind(SubjectKind):
         from .vehicle import Vehicle
         from .vehicle_file import load_vehicle
 
-        return Vehicle(load_vehicle(data))
+        return Vehicle(load_vehicle(data), visuals=not variant)
 
     def in_mm(self, data: dict, source: str) -> dict:
         """The vehicle file's data in mm and N with each axle inline, as its axle file
