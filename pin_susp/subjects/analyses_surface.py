@@ -259,11 +259,12 @@ class AnalysesSurface:
         steps = self.solve_steps(sweep, tangents=tangents)
         start = self.solve_steps(design, tangents=at_design)
         if not _alike(at_design, tangents):  # (each pass's columns by its own route)
-            static = self.sweep_results(design, start, at_design or None).columns
-            return self.sweep_results(sweep, steps, tangents or None), static
+            static = self.sweep_results(design, start, at_design or None, only).columns
+            return self.sweep_results(sweep, steps, tangents or None, only), static
         # one pass of the columns over the design state and the steps: each row's numbers
         # the same as in a pass of its own (every column is worked out step by step)
-        both = self.sweep_results(sweep, [*start, *steps], [*at_design, *tangents] or None)
+        given = [*at_design, *tangents] or None
+        both = self.sweep_results(sweep, [*start, *steps], given, only)
         return _split(both, 1), {k: v[:1] for k, v in both.columns.items()}
 
 

@@ -527,12 +527,19 @@ class Assembly(SteeringSurface, Composed, AnalysesSurface):
         given = tangents
         qs, tangents = self.measured_at(solved, tangents)
         points = self.label_motion(qs, tangents)
-        for name, (values, column_unit) in self.metric_columns(points, only).items():
+        # (a lone corner's columns as wanted; labelled corners' every one: what their
+        # shared elements read)
+        lone = list(self.corners) == [""] and not self.shared
+        for name, (values, column_unit) in self.metric_columns(
+            points, only if lone else None
+        ).items():
             columns[name], units[name] = values, column_unit
         first = self.labels[0]
         plain = {name: p[first].val for name, p in points.items()}
         for label, g in self.corners.items():
-            if not g.rated_spring or not (only is None or RATE_COLUMNS & set(only)):
+            suffix = self.suffix(label)
+            wanted = only is None or any(f"{r}{suffix}" in only for r in RATE_COLUMNS)
+            if not g.rated_spring or not wanted:
                 continue
             corner, poses = self.label_corner(label, plain, qs)
             for name, (values, column_unit) in rate_columns(corner, poses).items():
