@@ -17,7 +17,12 @@ way in turn in this process, so that the ratios compare like with like:
 - the 10 000-variant tolerance study of examples/study_tolerances.yaml end to end
   on 2 workers, as `pin-susp study` runs it (--full only);
 - the DOE through `pin-susp study` in a fresh process, serially and on 2 workers (the
-  interpreter's start and every import included).
+  interpreter's start and every import included);
+- an axle's and a vehicle's variants, serially (each built and marched as its direct
+  sweep is): examples/axle_front.yaml through examples/heave_roll.yaml (every hardpoint
+  within ±0.5 mm), and examples/study_vehicle.yaml; against the baseline of the same
+  variants each built and swept as a script would (``build``, ``run_sweep`` of the
+  sweep and of its design state), in this process.
 
 The imports a study pays once per process (scipy.stats for a DOE's sampler, matplotlib
 for study.png, pyarrow, dask.distributed) are made and timed first, so that no run's
@@ -168,6 +173,61 @@ def cli(folder: Path, study: Path, scheduler: str, runs: int = 2) -> float:
     return best
 
 
+def axle_file(folder: Path, samples: int) -> Path:
+    """The example axle's Monte Carlo (every hardpoint coordinate of both sides within
+    ±0.5 mm) through its roll at a ride height."""
+    data = {
+        "version": 1,
+        "geometry": str(EXAMPLES / "axle_front.yaml"),
+        "sweep": str(EXAMPLES / "heave_roll.yaml"),
+        "variables": {"all_hardpoints": {"tolerance": 0.5}},
+        "kind": "monte_carlo",
+        "monte_carlo": {"samples": samples, "seed": 1, "distribution": "normal"},
+    }
+    path = folder / f"axle_{samples}.yaml"
+    path.write_text(yaml.safe_dump(data))
+    return path
+
+
+def scripted(study, count: int) -> float:
+    """Seconds a variant of ``study`` takes built and swept as a script would: its
+    subject from its data, ``run_sweep`` of the sweep, then of its design state (the
+    mean over the first ``count`` variants)."""
+    import warnings
+
+    from pin_susp.model.sweep import load_sweep
+    from pin_susp.study.variants import at_design, build, variant_data, variant_table
+
+    sweep = load_sweep(study.sweep_data)
+    design = at_design(sweep)
+    table = variant_table(study)[:count]
+    started = time.perf_counter()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for deltas in table:
+            subject = build(variant_data(study.geometry_data, study.variables, deltas), "v")
+            subject.run_sweep(sweep)
+            subject.run_sweep(design)
+    return (time.perf_counter() - started) / count
+
+
+def assemblies(folder: Path, samples: int) -> dict:
+    """An axle's and a vehicle's variants per second, serially, and the scripted
+    baseline's (``scripted``)."""
+    from pin_susp.study import load_study
+
+    out = {}
+    studies = {
+        "axle": load_study(axle_file(folder, samples)),
+        "vehicle": load_study(EXAMPLES / "study_vehicle.yaml"),
+    }
+    for name, study in studies.items():
+        run = timed(study, folder, f"{name}_serial", None)
+        run["scripted"] = scripted(study, min(study.samples, 20))
+        out[name] = run
+    return out
+
+
 def run(variants: int, full: bool, doe_variants: int = 1000, optimise_runs: int = 3) -> dict:
     from pin_susp.study import load_study
 
@@ -185,6 +245,7 @@ def run(variants: int, full: bool, doe_variants: int = 1000, optimise_runs: int 
             "serial": timed(doe, folder, "doe_serial", None),
             "local, 2 workers": timed(doe, folder, "doe_two", "local", 2),
         }
+        report["assemblies"] = assemblies(folder, 200)
         report["doe_cli"] = {
             way: cli(folder, doe_file(folder, doe_variants), way) for way in ("none", "local")
         }
@@ -237,6 +298,13 @@ def show(report: dict) -> None:
         f"imports, the interpreter's start): {cli['none']:.2f} s serially, "
         f"{cli['local']:.2f} s on 2 workers (best of 2)"
     )
+    for name, w in report["assemblies"].items():
+        per = w["seconds"] / w["variants"]
+        print(
+            f"  {name} ({w['variants']} variants, serially): {w['end_to_end']:.0f} v/s end to "
+            f"end, {per * 1e3:.1f} ms a variant; built and swept as a script would: "
+            f"{w['scripted'] * 1e3:.1f} ms ({w['scripted'] / per:.2f}x)"
+        )
     show_phases(report)
     seconds = report["optimise_seconds"]
     gain = OPTIMISE_BEFORE / seconds

@@ -18,6 +18,7 @@ from pin_susp.study import load_study, run_study, variant_data
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 COLUMNS = ["roadwheel_angle_fl", "roadwheel_angle_fr", "camber_fl", "camber_fr"]
 COLUMNS += ["roadwheel_angle_rl", "camber_rl"]
+COLUMNS += ["wheel_rate_fl", "spring_force_rl"]  # (a rated spring's: worked out when asked)
 
 
 def vehicle_study(folder: Path, body: dict, sweep: str = "vehicle_roll.yaml") -> Path:

@@ -32,7 +32,6 @@ from .steering_surface import SteeringSurface
 CHUNK = 10_000  # steps solved and written at a time by a streamed sweep
 Z = np.array([0.0, 0.0, 1.0])
 
-
 VEHICLE_QUANTITIES = ("pitch", "road_z", "steering_wheel", "rack")  # a body on the road's alone
 
 
@@ -45,19 +44,18 @@ class Assembly(SteeringSurface, Composed, AnalysesSurface):
     ``name``: its name in the file; ``anti_roll_rigid``: whether an anti-roll bar locks
     the corners together (then each wheel's own height is no driver); ``streams``:
     whether a long sweep can be solved and written a chunk at a time
-    (``run_sweep_chunks``); ``poses_at_steps``: whether ``pin-susp urdf --at`` can
-    write the joint values of one of its sweep's steps; ``summary_columns``: the
-    columns a sweep's printed summary shows, in order (None: every metric column);
-    ``spring_senses``: label → the
-    sense of its corner's spring (``Linkage.spring_sense``); ``shared_springs``: the
-    elastic elements its corners share, each (the joints whose turn twists it, its
-    stiffness in N·m/deg or None) — an axle's anti-roll bar, unless rigid;
-    ``markers``: what the 3D view marks from its results' columns (an axle's
-    ``roll_centre``); ``static_columns``: the columns of its corners together a setup
-    sheet adds to each row (an axle's track and roll centre); ``elements``: the elements
-    its corners share (pin_susp/elements/: an axle's anti-roll bar and heave link; none
-    for a corner), the point-based formulation's too (pointwise.ELEMENTS); ``noun``:
-    what a message calls it (``corner``, ``axle``).
+    (``run_sweep_chunks``); ``poses_at_steps``: whether ``pin-susp urdf --at`` can write
+    the joint values of one of its sweep's steps; ``summary_columns``: the columns a
+    sweep's printed summary shows, in order (None: every metric column);
+    ``spring_senses``: label → the sense of its corner's spring
+    (``Linkage.spring_sense``); ``shared_springs``: the elastic elements its corners
+    share, each (the joints whose turn twists it, its stiffness in N·m/deg or None) — an
+    axle's anti-roll bar, unless rigid; ``markers``: what the 3D view marks from its
+    results' columns (an axle's ``roll_centre``); ``static_columns``: the columns of its
+    corners together a setup sheet adds to each row (an axle's track and roll centre);
+    ``elements``: the elements its corners share (pin_susp/elements/: an axle's
+    anti-roll bar and heave link; none for a corner), the point-based formulation's too
+    (pointwise.ELEMENTS); ``noun``: what a message calls it (``corner``, ``axle``).
 
     Both are a :class:`~pin_susp.solve.linkage.Composed` too: ``tree``, ``urdf``,
     ``output_points`` (every point written, each prefixed by its label),
@@ -464,9 +462,10 @@ class Assembly(SteeringSurface, Composed, AnalysesSurface):
         """name → (values, unit): each corner's metric columns (metrics.METRICS, with its
         label's suffix), then the shared elements' (an axle's pair of corners: heave,
         roll, the roll centre, ..., and its rates), from ``points`` (name → {label:
-        jet.Dual}, label_motion's or any engine's points in that form). ``only``: the
-        set of corner columns wanted (a study's summary), else every one."""
+        jet.Dual}, label_motion's or any engine's points in that form). ``only``: a lone
+        corner's columns wanted (a study's), else every one (shared elements read them)."""
         out, sides = {}, {}
+        only = only if list(self.corners) == [""] and not self.shared else None
         for label, g in self.corners.items():
             p, names = self.prefix(label), self.corner_points[label]
             design = {k: self.design_positions[p + k][None] for k in names}
@@ -527,18 +526,12 @@ class Assembly(SteeringSurface, Composed, AnalysesSurface):
         given = tangents
         qs, tangents = self.measured_at(solved, tangents)
         points = self.label_motion(qs, tangents)
-        # (a lone corner's columns as wanted; labelled corners' every one: what their
-        # shared elements read)
-        lone = list(self.corners) == [""] and not self.shared
-        for name, (values, column_unit) in self.metric_columns(
-            points, only if lone else None
-        ).items():
+        for name, (values, column_unit) in self.metric_columns(points, only).items():
             columns[name], units[name] = values, column_unit
         first = self.labels[0]
         plain = {name: p[first].val for name, p in points.items()}
         for label, g in self.corners.items():
-            suffix = self.suffix(label)
-            wanted = only is None or any(f"{r}{suffix}" in only for r in RATE_COLUMNS)
+            wanted = only is None or {f"{r}{self.suffix(label)}" for r in RATE_COLUMNS} & only
             if not g.rated_spring or not wanted:
                 continue
             corner, poses = self.label_corner(label, plain, qs)
