@@ -20,8 +20,17 @@ from ..errors import PinSuspError
 PRELOAD = (
     "distributed",
     "pin_susp.study.tasks",
+    "pin_susp.study.together",  # (a corner's variants measured together)
+    "pin_susp.solve.allocator",
+    "pin_susp.solve.rates",
+    "pin_susp.model.compliance",
+    "pin_susp.model.mechanisms.double_wishbone",
+    "pin_susp.model.mechanisms.macpherson",
+    "pin_susp.model.mechanisms.multilink",
+    "pin_susp.model.mechanisms.trailing_arm",
     "pin_susp.subjects.corner",
     "pin_susp.subjects.axle",
+    "pin_susp.subjects.vehicle",
     "pin_susp.io.tables",
     "pandas",
     "pyarrow",
