@@ -19,10 +19,11 @@ way in turn in this process, so that the ratios compare like with like:
 - the DOE through `pin-susp study` in a fresh process, serially and on 2 workers (the
   interpreter's start and every import included);
 - an axle's and a vehicle's variants, serially (each built and marched as its direct
-  sweep is): examples/axle_front.yaml through examples/heave_roll.yaml (every hardpoint
-  within ±0.5 mm), and examples/study_vehicle.yaml; against the baseline of the same
-  variants each built and swept as a script would (``build``, ``run_sweep`` of the
-  sweep and of its design state), in this process.
+  sweep is): Monte Carlos of examples/axle_front.yaml through examples/heave_roll.yaml
+  and of examples/vehicle_fs.yaml through examples/vehicle_roll.yaml (every hardpoint
+  within ±0.5 mm); against the baseline of the same variants each built and swept as a
+  script would (``build``, ``run_sweep`` of the sweep and of its design state), in this
+  process.
 
 The imports a study pays once per process (scipy.stats for a DOE's sampler, matplotlib
 for study.png, pyarrow, dask.distributed) are made and timed first, so that no run's
@@ -38,7 +39,7 @@ Monte Carlo and the 1 000-variant DOE), ≥ 800 variants/s serially; the optimis
 ≥ 5× faster than before (OPTIMISE_BEFORE).
 
     python benchmarks/bench_study.py [--variants N] [--doe N] [--optimise-runs N] [--full]
-        [--json OUT.json]
+        [--assemblies N] [--cli-runs N] [--json OUT.json]
 """
 
 from __future__ import annotations
@@ -173,18 +174,25 @@ def cli(folder: Path, study: Path, scheduler: str, runs: int = 2) -> float:
     return best
 
 
-def axle_file(folder: Path, samples: int) -> Path:
-    """The example axle's Monte Carlo (every hardpoint coordinate of both sides within
-    ±0.5 mm) through its roll at a ride height."""
+ASSEMBLIES = {  # name → (geometry, sweep): the example axle's roll at a ride height
+    "axle": ("axle_front.yaml", "heave_roll.yaml"),
+    "vehicle": ("vehicle_fs.yaml", "vehicle_roll.yaml"),
+}
+
+
+def assembly_file(folder: Path, name: str, samples: int) -> Path:
+    """A Monte Carlo of ASSEMBLIES[name]: every hardpoint coordinate of every corner
+    within ±0.5 mm."""
+    geometry, sweep = ASSEMBLIES[name]
     data = {
         "version": 1,
-        "geometry": str(EXAMPLES / "axle_front.yaml"),
-        "sweep": str(EXAMPLES / "heave_roll.yaml"),
+        "geometry": str(EXAMPLES / geometry),
+        "sweep": str(EXAMPLES / sweep),
         "variables": {"all_hardpoints": {"tolerance": 0.5}},
         "kind": "monte_carlo",
         "monte_carlo": {"samples": samples, "seed": 1, "distribution": "normal"},
     }
-    path = folder / f"axle_{samples}.yaml"
+    path = folder / f"{name}_{samples}.yaml"
     path.write_text(yaml.safe_dump(data))
     return path
 
@@ -217,23 +225,28 @@ def assemblies(folder: Path, samples: int) -> dict:
     from pin_susp.study import load_study
 
     out = {}
-    studies = {
-        "axle": load_study(axle_file(folder, samples)),
-        "vehicle": load_study(EXAMPLES / "study_vehicle.yaml"),
-    }
-    for name, study in studies.items():
+    for name in ASSEMBLIES:
+        study = load_study(assembly_file(folder, name, samples))
         run = timed(study, folder, f"{name}_serial", None)
         run["scripted"] = scripted(study, min(study.samples, 20))
         out[name] = run
     return out
 
 
-def run(variants: int, full: bool, doe_variants: int = 1000, optimise_runs: int = 3) -> dict:
+def run(
+    variants: int,
+    full: bool,
+    doe_variants: int = 1000,
+    optimise_runs: int = 3,
+    assembly_variants: int = 100,
+    cli_runs: int = 2,
+) -> dict:
     from pin_susp.study import load_study
 
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
         report = {"cores": os.cpu_count(), "variants": variants, "ways": {}}
+        report["cli_runs"] = cli_runs
         report["imports"] = imports()
         study = load_study(study_file(folder, variants))
         report["doe_variants"] = doe_variants
@@ -245,9 +258,11 @@ def run(variants: int, full: bool, doe_variants: int = 1000, optimise_runs: int 
             "serial": timed(doe, folder, "doe_serial", None),
             "local, 2 workers": timed(doe, folder, "doe_two", "local", 2),
         }
-        report["assemblies"] = assemblies(folder, 200)
-        report["doe_cli"] = {
-            way: cli(folder, doe_file(folder, doe_variants), way) for way in ("none", "local")
+        report["assemblies"] = assemblies(folder, assembly_variants)
+        report["doe_cli"] = {  # (none with --cli-runs 0)
+            way: cli(folder, doe_file(folder, doe_variants), way, cli_runs)
+            for way in ("none", "local")
+            if cli_runs
         }
         report["optimise_seconds"] = optimise(folder / "optimise", optimise_runs)
         if full:
@@ -293,11 +308,12 @@ def show(report: dict) -> None:
     for name, seconds in report["imports"].items():
         print(f"    {name:36s} {seconds:6.3f} s")
     cli = report["doe_cli"]
-    print(
-        f"  `pin-susp study` of the DOE {report['doe_variants']} in a fresh process (its "
-        f"imports, the interpreter's start): {cli['none']:.2f} s serially, "
-        f"{cli['local']:.2f} s on 2 workers (best of 2)"
-    )
+    if cli:
+        print(
+            f"  `pin-susp study` of the DOE {report['doe_variants']} in a fresh process (its "
+            f"imports, the interpreter's start): {cli['none']:.2f} s serially, "
+            f"{cli['local']:.2f} s on 2 workers (best of {report['cli_runs']})"
+        )
     for name, w in report["assemblies"].items():
         per = w["phases"]["batches"] / w["variants"]
         print(
@@ -351,9 +367,13 @@ def main() -> None:
     parser.add_argument("--doe", type=int, default=1000, help="the DOE's variants")
     parser.add_argument("--full", action="store_true", help="also the 10 000-variant study")
     parser.add_argument("--optimise-runs", type=int, default=3, help="best of N optimisations")
+    parser.add_argument("--assemblies", type=int, default=100, help="an axle's, a car's")
+    parser.add_argument("--cli-runs", type=int, default=2, help="best of N DOEs by the CLI")
     parser.add_argument("--json", metavar="OUT.json", help="also write the figures as JSON")
     args = parser.parse_args()
-    report = run(args.variants, args.full, args.doe, args.optimise_runs)
+    report = run(
+        args.variants, args.full, args.doe, args.optimise_runs, args.assemblies, args.cli_runs
+    )
     show(report)
     if args.json:
         Path(args.json).write_text(json.dumps(report, indent=2))

@@ -65,7 +65,7 @@ def test_study_benchmark_runs_a_small_slice(tmp_path):
     out = tmp_path / "study.json"
     proc = subprocess.run(
         [sys.executable, str(ROOT / "benchmarks" / "bench_study.py"), "--variants", "64"]
-        + ["--doe", "64", "--optimise-runs", "1"]
+        + ["--doe", "64", "--optimise-runs", "1", "--assemblies", "3", "--cli-runs", "0"]
         + ["--json", str(out)],
         capture_output=True,
         text=True,
@@ -80,6 +80,10 @@ def test_study_benchmark_runs_a_small_slice(tmp_path):
     assert set(report["ways"]) == {"serial", "local, 1 worker", "local, 2 workers"}
     for way in [*report["ways"].values(), *report["doe"].values()]:
         assert way["variants"] == 64 and way["running"] > 0
+    assert set(report["assemblies"]) == {"axle", "vehicle"}
+    for way in report["assemblies"].values():
+        assert way["variants"] == 3 and way["scripted"] > 0
+    assert report["doe_cli"] == {}  # (the DOE through the CLI: `make bench`)
 
 
 def test_attitude_benchmark_quick_slice(tmp_path):
