@@ -531,7 +531,7 @@ class Assembly(SteeringSurface, Composed, AnalysesSurface):
         first = self.labels[0]
         plain = {name: p[first].val for name, p in points.items()}
         for label, g in self.corners.items():
-            wanted = only is None or {f"{r}{self.suffix(label)}" for r in RATE_COLUMNS} & only
+            wanted = only is None or {f"{r}{self.suffix(label)}" for r in RATE_COLUMNS} & {*only}
             if not g.rated_spring or not wanted:
                 continue
             corner, poses = self.label_corner(label, plain, qs)

@@ -119,6 +119,8 @@ class AxleModel(AxleAssembly):
     def __init__(
         self, left, right: Geometry | None = None, name: str = "axle", visuals: bool = True
     ):
+        """An axle file (a path or its data), an AxleGeometry, or two corners' geometries;
+        ``visuals``: the URDF's drawn shapes (a study's variant goes without)."""
         elements = None
         if right is None and not isinstance(left, AxleGeometry):  # an axle file
             left = load_axle(left)

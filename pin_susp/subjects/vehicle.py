@@ -131,6 +131,8 @@ class Vehicle(VehicleExport, VehicleViews, VehicleTangents, VehicleAssembly):
     )
 
     def __init__(self, vehicle, visuals: bool = True):
+        """``vehicle``: its file (a path or its data) or a VehicleGeometry; ``visuals``:
+        the URDF's drawn shapes (a study's variant goes without)."""
         from ..solve.as_set import apply_setup
 
         if not isinstance(vehicle, VehicleGeometry):
