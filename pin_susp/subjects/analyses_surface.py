@@ -270,10 +270,12 @@ class AnalysesSurface:
 
 def _alike(first: list, then: list) -> bool:
     """Whether two solves' tangent lists (solve_steps') take one route through
-    sweep_results together: both empty, or each step's given (none None) in both."""
+    sweep_results together: both empty, or in both each step's given, or none (each
+    step's then worked out from its Jacobian, as in a pass of its own)."""
     if not first or not then:
         return not first and not then
-    return all(t is not None for t in [*first, *then])
+    given = [t is not None for t in [*first, *then]]
+    return all(given) or not any(given)
 
 
 def _split(both, k: int):
