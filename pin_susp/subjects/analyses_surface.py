@@ -262,7 +262,7 @@ class AnalysesSurface:
             static = self.sweep_results(design, start, at_design or None, only).columns
             return self.sweep_results(sweep, steps, tangents or None, only), static
         # one pass of the columns over the design state and the steps: each row's numbers
-        # the same as in a pass of its own (every column is worked out step by step)
+        # those of a pass of its own (every column is worked out step by step; _alike)
         given = [*at_design, *tangents] or None
         both = self.sweep_results(sweep, [*start, *steps], given, only)
         return _split(both, 1), {k: v[:1] for k, v in both.columns.items()}
@@ -271,7 +271,8 @@ class AnalysesSurface:
 def _alike(first: list, then: list) -> bool:
     """Whether two solves' tangent lists (solve_steps') take one route through
     sweep_results together: both empty, or in both each step's given, or none (each
-    step's then worked out from its Jacobian, as in a pass of its own)."""
+    step's then worked out from its Jacobian, as in a pass of its own: a vehicle's rates
+    along its body, solved for every row at once, to the last digit or so)."""
     if not first or not then:
         return not first and not then
     given = [t is not None for t in [*first, *then]]
