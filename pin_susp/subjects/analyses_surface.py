@@ -264,8 +264,17 @@ class AnalysesSurface:
         # one pass of the columns over the design state and the steps: each row's numbers
         # those of a pass of its own (every column is worked out step by step; _alike)
         given = [*at_design, *tangents] or None
-        both = self.sweep_results(sweep, [*start, *steps], given, only)
-        return _split(both, 1), {k: v[:1] for k, v in both.columns.items()}
+        return self._design_and_steps(self.sweep_results(sweep, [*start, *steps], given, only))
+
+    @staticmethod
+    def _design_and_steps(both) -> tuple[object, dict]:
+        """The results of one pass over the design state (its first row) and the steps:
+        the steps' results (their step_index from 0, their q and reasons theirs) and
+        the design state's columns (name → a one-value array)."""
+        columns = {name: v[1:] for name, v in both.columns.items()}
+        columns["step_index"] = np.arange(len(both.meta["q"]) - 1)
+        meta = dict(both.meta, q=both.meta["q"][1:], why=both.meta["why"][1:])
+        return type(both)(columns, both.units, meta), {k: v[:1] for k, v in both.columns.items()}
 
 
 def _alike(first: list, then: list) -> bool:
@@ -277,12 +286,3 @@ def _alike(first: list, then: list) -> bool:
         return not first and not then
     given = [t is not None for t in [*first, *then]]
     return all(given) or not any(given)
-
-
-def _split(both, k: int):
-    """The results of the steps after the first ``k`` rows of ``both`` (their step_index
-    from 0, their q and reasons theirs)."""
-    columns = {name: v[k:] for name, v in both.columns.items()}
-    columns["step_index"] = np.arange(len(both.meta["q"]) - k)
-    meta = dict(both.meta, q=both.meta["q"][k:], why=both.meta["why"][k:])
-    return type(both)(columns, both.units, meta)

@@ -191,11 +191,7 @@ class Corner(Assembly, Linkage):
             self._drive.evaluate(self.q_design)
             tangents = [self._drive.tangent(self.drive_rhs), *tangents]
         both = Results.from_solutions(self, [design, *solutions], sweep, tangents or None, only)
-        columns = {k: v[1:] for k, v in both.columns.items()}
-        columns["step_index"] = np.arange(len(solutions))
-        meta = dict(both.meta, q=both.meta["q"][1:], why=both.meta["why"][1:])
-        static = {k: v[:1] for k, v in both.columns.items()}
-        return Results(columns, both.units, meta), static
+        return self._design_and_steps(both)
 
     # Assembly surface for setup and sensitivity
     @classmethod
